@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Install everything the checks need, then lint, type-check and run the whole test suite.
+# Usage: bash scripts/test.sh [pytest arguments]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_debian=()
+command -v dot >/dev/null || need_debian+=(graphviz)
+if [ ${#need_debian[@]} -gt 0 ]; then
+    if [ "$(id -u)" = 0 ]; then sudo=(); elif command -v sudo >/dev/null; then sudo=(sudo); else
+        echo "scripts/test.sh: please install the Debian packages: ${need_debian[*]}" >&2; exit 1
+    fi
+    "${sudo[@]}" apt-get update -q
+    DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -q --no-install-recommends \
+        "${need_debian[@]}"
+fi
+
+python3 -m pip install -q --disable-pip-version-check -e ".[dev]"
+python3 -m ruff check src tests benchmarks
+python3 -m mypy
+python3 -m pytest "$@"

@@ -1,0 +1,5 @@
+"""``python -m cyborg`` is the same as the ``cyborg`` command."""
+
+from cyborg.app.cli import main
+
+raise SystemExit(main())

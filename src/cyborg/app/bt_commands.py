@@ -1,0 +1,195 @@
+"""``cyborg bt ...``: validate, run and export behavior3editor trees from the shell."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+from pathlib import Path
+from typing import Any, TextIO
+
+from cyborg.app.status_line import StatusLine
+from cyborg.bt import (
+    ManualClock,
+    MonotonicClock,
+    NodeRegistry,
+    Status,
+    Tree,
+    TreeLoadError,
+    TreeRunner,
+    check_file,
+    default_registry,
+    load_tree,
+)
+from cyborg.bt.problems import Problem
+
+
+def add_parser(commands: Any) -> None:
+    bt = commands.add_parser("bt", help="behaviour trees: validate, run, export",
+                             description="Work with behavior3editor exports.")
+    sub = bt.add_subparsers(dest="bt_command", metavar="SUBCOMMAND", required=True)
+
+    validate = sub.add_parser("validate", help="report every problem in a tree file")
+    _file_options(validate)
+    validate.add_argument("--json", action="store_true", help="problems as JSON on stdout")
+    validate.set_defaults(handler=validate_command)
+
+    run = sub.add_parser("run", help="tick a tree with a live status line")
+    _file_options(run)
+    run.add_argument("--rate", type=float, default=10.0, metavar="HZ",
+                     help="ticks per second (default 10)")
+    run.add_argument("--ticks", type=int, default=None, metavar="N",
+                     help="stop after N ticks (default: run until Ctrl-C)")
+    run.add_argument("--until-done", action="store_true",
+                     help="stop when the root returns SUCCESS, FAILURE or ERROR")
+    run.add_argument("--fast", action="store_true",
+                     help="simulated time: tick as fast as possible while nodes see the rate")
+    run.set_defaults(handler=run_command)
+
+    dot = sub.add_parser("dot", help="print the tree as a Graphviz DOT graph")
+    _file_options(dot)
+    dot.add_argument("-o", "--output", type=Path, help="write to this file instead of stdout")
+    dot.set_defaults(handler=dot_command)
+
+    structure = sub.add_parser("json", help="print the tree's structure as JSON")
+    _file_options(structure)
+    structure.add_argument("-o", "--output", type=Path, help="write to this file")
+    structure.set_defaults(handler=json_command)
+
+    nodes = sub.add_parser("nodes", help="list the node types trees can use")
+    nodes.add_argument("--nodes", action="append", default=[], metavar="MODULE",
+                       help="also import this module of node classes (repeatable)")
+    nodes.set_defaults(handler=nodes_command)
+
+
+def _file_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", type=Path, help="behavior3editor export (project, tree, "
+                        "node list or desktop project file)")
+    parser.add_argument("--tree", metavar="ID|TITLE",
+                        help="the tree to use (default: the file's selectedTree)")
+    parser.add_argument("--nodes", action="append", default=[], metavar="MODULE",
+                        help="import this module of node classes first (repeatable)")
+    parser.add_argument("--stub-missing", type=Status.parse, metavar="STATUS",
+                        help="stand a stub returning STATUS (success, failure, running) in for "
+                             "every node without a Python class")
+
+
+def registry_for(args: argparse.Namespace) -> NodeRegistry:
+    registry = default_registry()
+    registry.import_modules(args.nodes)
+    return registry
+
+
+def print_problems(problems: list[Problem], stream: TextIO) -> None:
+    for problem in sorted(problems, key=lambda p: (p.source, p.line or 0)):
+        print(problem, file=stream)
+
+
+def _load(args: argparse.Namespace, **options: Any) -> Tree | None:
+    try:
+        return load_tree(args.file, tree=args.tree, registry=registry_for(args),
+                         stub_missing=args.stub_missing, **options)
+    except TreeLoadError as exc:
+        print_problems(exc.problems, sys.stderr)
+        errors = sum(p.is_error for p in exc.problems)
+        print(f"{args.file}: {errors} error{'s' if errors != 1 else ''}; not loaded",
+              file=sys.stderr)
+        return None
+
+
+def validate_command(args: argparse.Namespace) -> int:
+    problems = check_file(args.file, tree=args.tree, registry=registry_for(args),
+                          stub_missing=args.stub_missing)
+    errors = sum(p.is_error for p in problems)
+    warnings = len(problems) - errors
+    if args.json:
+        json.dump([_problem_json(p) for p in problems], sys.stdout, indent=2)
+        print()
+    else:
+        print_problems(problems, sys.stdout)
+        verdict = "invalid" if errors else "ok"
+        print(f"{args.file}: {verdict} ({errors} error{'s' if errors != 1 else ''}, "
+              f"{warnings} warning{'s' if warnings != 1 else ''})")
+    return 1 if errors else 0
+
+
+def _problem_json(problem: Problem) -> dict[str, Any]:
+    return {"severity": problem.severity.value, "message": problem.message,
+            "file": problem.source, "line": problem.line, "column": problem.column,
+            "tree": problem.tree, "node_id": problem.node_id, "node_title": problem.node_title,
+            "field": problem.field}
+
+
+def run_command(args: argparse.Namespace) -> int:
+    if not args.rate > 0:
+        print(f"--rate must be more than 0, not {args.rate}", file=sys.stderr)
+        return 2
+    if args.ticks is not None and args.ticks < 1:
+        print(f"--ticks must be at least 1, not {args.ticks}", file=sys.stderr)
+        return 2
+    clock = ManualClock() if args.fast else MonotonicClock()
+    tree = _load(args, clock=clock)
+    if tree is None:
+        return 1
+    return run_tree(tree, rate_hz=args.rate, max_ticks=args.ticks, until_done=args.until_done)
+
+
+def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
+             until_done: bool = False, stream: TextIO | None = None) -> int:
+    """Tick ``tree`` in the foreground with a status line until done or Ctrl-C."""
+    stream = stream or sys.stdout
+    runner = TreeRunner(tree, rate_hz=rate_hz)
+    line = StatusLine(tree, stream)
+    runner.add_listener(line.update)
+    print(f"running {tree.title!r} from {tree.source} ({len(tree)} nodes) at {rate_hz:g} Hz; "
+          "Ctrl-C stops", file=stream)
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    interrupted = False
+    try:
+        runner.run(max_ticks=max_ticks, until_done=until_done)
+    except KeyboardInterrupt:
+        interrupted = True
+        runner.stop()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    line.finish(interrupted=interrupted)
+    return 130 if interrupted else 0
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+def _write(text: str, output: Path | None) -> None:
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        output.write_text(text, encoding="utf-8")
+
+
+def dot_command(args: argparse.Namespace) -> int:
+    tree = _load(args)
+    if tree is None:
+        return 1
+    _write(tree.to_dot(), args.output)
+    return 0
+
+
+def json_command(args: argparse.Namespace) -> int:
+    tree = _load(args)
+    if tree is None:
+        return 1
+    _write(json.dumps(tree.structure.to_json(), indent=2) + "\n", args.output)
+    return 0
+
+
+def nodes_command(args: argparse.Namespace) -> int:
+    registry = registry_for(args)
+    for node_type in registry.types():
+        params = ", ".join(
+            param.editor_name + ("" if param.required else f"={param.default!r}")
+            for param in node_type.signature.params)
+        print(f"{node_type.name:<20} {node_type.category.value:<10} "
+              f"{{{params}}}  [{node_type.origin}]")
+    return 0

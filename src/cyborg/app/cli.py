@@ -1,0 +1,52 @@
+"""Entry point of the ``cyborg`` command.
+
+    cyborg up                      run the robot's main job on built-in defaults
+    cyborg bt validate FILE        report every problem in a behavior3editor export
+    cyborg bt run FILE             tick a tree with a live status line
+    cyborg bt dot FILE             the tree as a Graphviz DOT graph
+    cyborg bt json FILE            the tree's structure as JSON
+    cyborg bt nodes                list the node types trees can use
+
+Exit codes: 0 success, 1 the input has errors, 2 wrong usage, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+
+from cyborg import __version__
+from cyborg.app import bt_commands, up
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cyborg", description="Control stack for the NTNU Cyborg robot.")
+    parser.add_argument("--version", action="version", version=f"cyborg {__version__}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="more log output (-vv for debug)")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    up.add_parser(commands)
+    bt_commands.add_parser(commands)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        result: int = args.handler(args)
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:  # e.g. `cyborg bt dot FILE | head`
+        sys.stderr.close()
+        return 0
+    return result
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,54 @@
+"""``cyborg up``: start the robot's main job on built-in defaults.
+
+Today this runs the bundled demo mission (``data/demo.b3.json``, a behavior3editor project made
+of stock nodes and nested subtrees) in the tree runner with a live status line. As the
+simulator, navigation, monitor and detector arrive, ``cyborg up`` starts them too, so the same
+command keeps bringing up the whole system.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from importlib.resources import as_file, files
+from pathlib import Path
+from typing import Any
+
+from cyborg.app.bt_commands import print_problems, run_tree
+from cyborg.bt import ManualClock, MonotonicClock, TreeLoadError, default_registry, load_tree
+
+DEMO_TREE = "demo.b3.json"
+
+
+def add_parser(commands: Any) -> None:
+    up = commands.add_parser("up", help="run the main job on built-in defaults",
+                             description="Start the robot's main job. With no options: the "
+                                         "bundled demo mission in the tree runner.")
+    up.add_argument("--tree", type=Path, default=None, metavar="FILE",
+                    help="behavior3editor export to run instead of the bundled demo")
+    up.add_argument("--rate", type=float, default=10.0, metavar="HZ",
+                    help="tree ticks per second (default 10)")
+    up.add_argument("--ticks", type=int, default=None, metavar="N",
+                    help="stop after N ticks (default: until Ctrl-C)")
+    up.add_argument("--fast", action="store_true",
+                    help="simulated time: run as fast as possible")
+    up.set_defaults(handler=up_command)
+
+
+def up_command(args: argparse.Namespace) -> int:
+    if not args.rate > 0 or (args.ticks is not None and args.ticks < 1):
+        print("--rate must be more than 0 and --ticks at least 1")
+        return 2
+    clock = ManualClock() if args.fast else MonotonicClock()
+    resource = files("cyborg.app").joinpath("data", DEMO_TREE)
+    with as_file(resource) as demo:
+        path = args.tree or demo
+        try:
+            tree = load_tree(path, registry=default_registry(), clock=clock)
+        except TreeLoadError as exc:
+            print_problems(exc.problems, sys.stderr)
+            return 1
+        print("cyborg up:")
+        print(f"  tree runner  {tree.title!r} ({len(tree)} nodes) from "
+              f"{'the bundled demo' if args.tree is None else path}")
+        return run_tree(tree, rate_hz=args.rate, max_ticks=args.ticks)

@@ -1,0 +1,56 @@
+"""The behaviour-tree engine: behavior3editor trees, run correctly and fast.
+
+Load a tree exported by behavior3editor and tick it::
+
+    from cyborg.bt import load_tree
+
+    tree = load_tree("patrol.b3.json")
+    snapshot = tree.tick()
+    print(snapshot.status, snapshot.active)
+
+Write your own nodes by subclassing :class:`Action`, :class:`Condition`, :class:`Decorator` or
+:class:`Composite` and registering them with :func:`register`. Run a tree at a fixed rate with
+:class:`TreeRunner`. This package does no I/O beyond reading tree files and imports nothing
+else of cyborg.
+"""
+
+from cyborg.bt.blackboard import Blackboard
+from cyborg.bt.builder import Subtree
+from cyborg.bt.clock import Clock, ManualClock, MonotonicClock
+from cyborg.bt.composites import MemPriority, MemSequence, Parallel, Priority, Sequence
+from cyborg.bt.decorators import (
+    Delay,
+    ForceFailure,
+    ForceSuccess,
+    Inverter,
+    Limiter,
+    MaxTime,
+    Repeater,
+    RepeatUntilFailure,
+    RepeatUntilSuccess,
+    Retry,
+    RunOnce,
+    Timeout,
+)
+from cyborg.bt.editor_format import ProjectSpec, parse_project, read_project, render_title
+from cyborg.bt.leaves import Error, Failer, Runner, Succeeder, Wait
+from cyborg.bt.loader import check_file, load_tree, loads_tree
+from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
+from cyborg.bt.problems import Problem, Severity, TreeLoadError
+from cyborg.bt.registry import NodeRegistry, NodeType, default_registry, register
+from cyborg.bt.runner import TreeRunner
+from cyborg.bt.snapshot import TickSnapshot, TreeStructure
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+from cyborg.bt.tree import Tree
+
+__all__ = [
+    "ERROR", "FAILURE", "RUNNING", "SUCCESS",
+    "Action", "Blackboard", "Category", "Clock", "Composite", "Condition", "Decorator",
+    "Delay", "Error", "Failer", "ForceFailure", "ForceSuccess", "Inverter", "Limiter",
+    "ManualClock", "MaxTime", "MemPriority", "MemSequence", "MonotonicClock", "Node",
+    "NodeRegistry", "NodeType", "Parallel", "Priority", "Problem", "ProjectSpec",
+    "RepeatUntilFailure", "RepeatUntilSuccess", "Repeater", "Retry", "RunOnce", "Runner",
+    "Sequence", "Severity", "Status", "Subtree", "Succeeder", "TickSnapshot", "Timeout", "Tree",
+    "TreeLoadError", "TreeRunner", "TreeStructure", "Wait", "check_file", "default_registry",
+    "load_tree", "loads_tree", "parse_project", "read_project", "register", "render_title",
+]

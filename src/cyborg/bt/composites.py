@@ -1,0 +1,121 @@
+"""Composite nodes: Sequence, Priority, their memory variants, and Parallel.
+
+Without memory (Sequence, Priority) the composite restarts from its first child on every tick,
+so a higher-priority child can take over at any time; the child it replaces is halted at the
+end of that tick. With memory (MemSequence, MemPriority) it resumes at the child that was
+RUNNING, and starts from the first child only when a new activation begins.
+"""
+
+from __future__ import annotations
+
+from cyborg.bt.node import Composite
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+
+
+class Sequence(Composite):
+    """Tick children in order; return the first status that is not SUCCESS, else SUCCESS."""
+
+    def tick(self) -> Status:
+        for child in self.children:
+            status = child.execute()
+            if status is not SUCCESS:
+                return status
+        return SUCCESS
+
+
+class Priority(Composite):
+    """Tick children in order; return the first status that is not FAILURE, else FAILURE.
+
+    Also known as Selector or Fallback.
+    """
+
+    def tick(self) -> Status:
+        for child in self.children:
+            status = child.execute()
+            if status is not FAILURE:
+                return status
+        return FAILURE
+
+
+class MemSequence(Composite):
+    """A Sequence that resumes at the RUNNING child instead of re-checking earlier ones."""
+
+    _continue: Status = SUCCESS
+
+    def on_start(self) -> None:
+        self.memory["running_child"] = 0
+
+    def tick(self) -> Status:
+        memory = self.memory
+        children = self.children
+        go_on = self._continue
+        for index in range(memory["running_child"], len(children)):
+            status = children[index].execute()
+            if status is not go_on:
+                if status is RUNNING:
+                    memory["running_child"] = index
+                return status
+        return go_on
+
+
+class MemPriority(MemSequence):
+    """A Priority that resumes at the RUNNING child instead of re-trying earlier ones."""
+
+    _continue = FAILURE
+
+
+class Parallel(Composite):
+    """Tick all children every tick until enough of them succeed or fail.
+
+    ``successThreshold`` children must succeed for SUCCESS, and ``failureThreshold`` failures
+    give FAILURE; ``-1`` means "all children". Children that have completed in the current
+    activation are not ticked again. When the result is decided, children still RUNNING are
+    halted. If every child has completed and the success threshold was not reached, the result
+    is FAILURE. A child's ERROR halts the others and is returned.
+    """
+
+    def __init__(self, success_threshold: int = -1, failure_threshold: int = 1) -> None:
+        self.success_threshold = success_threshold
+        self.failure_threshold = failure_threshold
+
+    def check(self) -> list[str]:
+        problems = []
+        count = len(self.children)
+        for field, value in (
+            ("successThreshold", self.success_threshold),
+            ("failureThreshold", self.failure_threshold),
+        ):
+            if value != -1 and not 1 <= value <= count:
+                problems.append(f"{field} must be -1 (all) or 1..{count} (children), not {value}")
+        return problems
+
+    def _needed(self, threshold: int) -> int:
+        return len(self.children) if threshold == -1 else threshold
+
+    def on_start(self) -> None:
+        self.memory["done"] = [None] * len(self.children)
+
+    def tick(self) -> Status:
+        done: list[Status | None] = self.memory["done"]
+        successes = failures = 0
+        for index, child in enumerate(self.children):
+            status = done[index]
+            if status is None:
+                status = child.execute()
+                if status is not RUNNING:
+                    done[index] = status
+            if status is SUCCESS:
+                successes += 1
+            elif status is FAILURE:
+                failures += 1
+            elif status is ERROR:
+                self.halt_children()
+                return ERROR
+        if successes >= self._needed(self.success_threshold):
+            result = SUCCESS
+        elif failures >= self._needed(self.failure_threshold) or None not in done:
+            result = FAILURE
+        else:
+            return RUNNING
+        self.halt_children()
+        return result

@@ -1,0 +1,58 @@
+"""The editor's stock actions: Succeeder, Failer, Runner, Error and Wait."""
+
+from __future__ import annotations
+
+from cyborg.bt.node import Action, elapsed_ms
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+
+
+class Succeeder(Action):
+    """Always SUCCESS."""
+
+    def tick(self) -> Status:
+        return SUCCESS
+
+
+class Failer(Action):
+    """Always FAILURE."""
+
+    def tick(self) -> Status:
+        return FAILURE
+
+
+class Runner(Action):
+    """Always RUNNING."""
+
+    def tick(self) -> Status:
+        return RUNNING
+
+
+class Error(Action):
+    """Always ERROR."""
+
+    def tick(self) -> Status:
+        return ERROR
+
+
+class Wait(Action):
+    """RUNNING until ``milliseconds`` have passed since the activation began, then SUCCESS.
+
+    ``Wait 0`` succeeds in its first tick. Time comes from the tree's clock.
+    """
+
+    def __init__(self, milliseconds: float = 0) -> None:
+        self.milliseconds = milliseconds
+
+    def check(self) -> list[str]:
+        problems = super().check()
+        if self.milliseconds < 0:
+            problems.append(f"milliseconds must be 0 or more, not {self.milliseconds}")
+        return problems
+
+    def on_start(self) -> None:
+        self.memory["start"] = self.now
+
+    def tick(self) -> Status:
+        if elapsed_ms(self.now, self.memory["start"]) >= self.milliseconds:
+            return SUCCESS
+        return RUNNING

@@ -1,0 +1,65 @@
+"""Problems found in a tree file, and the error that carries them.
+
+Each :class:`Problem` names where it is — file and line, tree, node id and title, property —
+so that a user can find it in the editor. Loading collects every problem before it gives up,
+so one run of ``cyborg bt validate`` reports them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+
+class Severity(StrEnum):
+    ERROR = "error"
+    WARNING = "warning"
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong (or suspicious) in a tree file."""
+
+    message: str
+    source: str = ""
+    """The file, or ``"<string>"`` for text given directly."""
+    line: int | None = None
+    column: int | None = None
+    tree: str | None = None
+    """Title of the tree the problem is in (or its id if untitled)."""
+    node_id: str | None = None
+    node_title: str | None = None
+    field: str | None = None
+    """The property or JSON key at fault."""
+    severity: Severity = Severity.ERROR
+
+    @property
+    def is_error(self) -> bool:
+        return self.severity is Severity.ERROR
+
+    def __str__(self) -> str:
+        where = self.source or "<string>"
+        if self.line is not None:
+            where += f":{self.line}"
+            if self.column is not None:
+                where += f":{self.column}"
+        parts = []
+        if self.tree is not None:
+            parts.append(f"tree {self.tree!r}")
+        if self.node_id is not None:
+            title = f" {self.node_title!r}" if self.node_title else ""
+            parts.append(f"node{title} (id {self.node_id})")
+        context = ", ".join(parts)
+        prefix = f"{where}: {self.severity.value}: "
+        return prefix + (f"{context}: " if context else "") + self.message
+
+
+class TreeLoadError(Exception):
+    """A tree file could not be loaded; :attr:`problems` lists every reason."""
+
+    def __init__(self, problems: list[Problem]) -> None:
+        self.problems = problems
+        errors = [p for p in problems if p.is_error]
+        shown = "\n".join(f"  {p}" for p in errors)
+        count = f"{len(errors)} error{'s' if len(errors) != 1 else ''}"
+        super().__init__(f"cannot load the tree ({count}):\n{shown}")

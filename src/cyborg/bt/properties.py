@@ -1,0 +1,256 @@
+"""Node properties: from the editor's JSON to a node's keyword arguments.
+
+A node declares its properties as the keyword parameters of its ``__init__``, with type hints::
+
+    class MoveTo(Action):
+        def __init__(self, location: str, radius: float = 0.5) -> None: ...
+
+The editor writes property names in camelCase (``maxLoop``); Python parameters are snake_case
+(``max_loop``). Both spellings are accepted. Values are checked against the hints:
+
+* ``int`` takes whole numbers (``2.0`` becomes ``2``), ``float`` takes any number, ``bool`` takes
+  ``true``/``false``; a string holding a number or boolean is converted, because the editor's
+  property panel lets users type numbers as text;
+* ``str``, ``Literal[...]``, ``Enum`` (by value or name), ``X | None``, ``list[X]``,
+  ``dict[str, X]`` and ``Any`` are supported; other hints are passed through unchecked.
+
+A required parameter with no property is an error; a property no parameter takes is a warning
+(the editor lets users annotate any node), unless the node accepts ``**kwargs``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import re
+import types
+import typing
+from dataclasses import dataclass
+from enum import Enum
+from typing import Any, Literal, Union
+
+_MISSING = inspect.Parameter.empty
+
+
+@dataclass(frozen=True)
+class Param:
+    """One property a node type takes."""
+
+    name: str
+    """The Python keyword (``max_loop``)."""
+    editor_name: str
+    """The camelCase name the editor uses (``maxLoop``)."""
+    hint: Any
+    default: Any = _MISSING
+
+    @property
+    def required(self) -> bool:
+        return self.default is _MISSING
+
+
+@dataclass(frozen=True)
+class Signature:
+    """The properties a node type takes, read from its ``__init__``."""
+
+    params: tuple[Param, ...]
+    takes_any: bool
+    """True when ``__init__`` has ``**kwargs``: unknown properties are passed through."""
+
+    def defaults(self) -> dict[str, Any]:
+        """The editor-named defaults, as they would appear in a ``custom_nodes`` entry."""
+        return {p.editor_name: p.default for p in self.params if not p.required}
+
+
+@dataclass(frozen=True)
+class Binding:
+    """The result of matching a node's properties to its signature."""
+
+    kwargs: dict[str, Any]
+    errors: list[tuple[str, str]]
+    """(field, message) pairs that stop the node from being built."""
+    warnings: list[tuple[str, str]]
+
+
+def snake_case(name: str) -> str:
+    """``maxLoop`` -> ``max_loop``; ``successThreshold`` -> ``success_threshold``."""
+    return re.sub(r"(?<=[a-z0-9])([A-Z])", r"_\1", name).lower()
+
+
+def camel_case(name: str) -> str:
+    """``max_loop`` -> ``maxLoop``."""
+    head, *rest = name.split("_")
+    return head + "".join(part[:1].upper() + part[1:] for part in rest)
+
+
+def signature_of(factory: Any) -> Signature:
+    """Read the properties of a node class (its ``__init__``) or factory function."""
+    target = factory.__init__ if inspect.isclass(factory) else factory
+    if target is object.__init__:
+        return Signature((), False)
+    sig = inspect.signature(target)
+    try:
+        hints = typing.get_type_hints(target)
+    except Exception:  # unresolvable forward references: check nothing rather than fail
+        hints = {}
+    params = []
+    takes_any = False
+    for index, parameter in enumerate(sig.parameters.values()):
+        if index == 0 and inspect.isclass(factory) and parameter.name in ("self", "cls"):
+            continue
+        if parameter.kind is inspect.Parameter.VAR_KEYWORD:
+            takes_any = True
+            continue
+        if parameter.kind in (inspect.Parameter.VAR_POSITIONAL,
+                              inspect.Parameter.POSITIONAL_ONLY):
+            continue
+        params.append(Param(parameter.name, camel_case(parameter.name),
+                            hints.get(parameter.name, Any), parameter.default))
+    return Signature(tuple(params), takes_any)
+
+
+def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
+    """Match editor ``properties`` against ``signature``; convert and check each value."""
+    by_name: dict[str, Param] = {}
+    for param in signature.params:
+        by_name[param.name] = param
+        by_name[param.editor_name] = param
+    kwargs: dict[str, Any] = {}
+    source: dict[str, str] = {}
+    errors: list[tuple[str, str]] = []
+    warnings: list[tuple[str, str]] = []
+    for key, value in properties.items():
+        match = by_name.get(key) or by_name.get(snake_case(key))
+        if match is None:
+            if signature.takes_any:
+                kwargs[key] = value
+            else:
+                known = ", ".join(p.editor_name for p in signature.params) or "none"
+                warnings.append((key, f"unknown property {key!r} is ignored (known: {known})"))
+            continue
+        if match.name in source:
+            errors.append((key, f"property {key!r} repeats {source[match.name]!r}"))
+            continue
+        source[match.name] = key
+        try:
+            kwargs[match.name] = convert(value, match.hint)
+        except ValueError as exc:
+            errors.append((key, f"property {key!r}: {exc}"))
+    for param in signature.params:
+        if param.required and param.name not in source:
+            errors.append((param.editor_name,
+                           f"missing property {param.editor_name!r} ({describe(param.hint)})"))
+    return Binding(kwargs, errors, warnings)
+
+
+def convert(value: Any, hint: Any) -> Any:
+    """Check ``value`` against the type ``hint``, converting where the editor is loose.
+
+    Raises ValueError with a message that names the expected type and the value.
+    """
+    if hint is Any or hint is inspect.Parameter.empty:
+        return value
+    origin = typing.get_origin(hint)
+    if origin in (Union, types.UnionType):
+        return _convert_union(value, hint)
+    if origin is Literal:
+        choices = typing.get_args(hint)
+        if value in choices:
+            return value
+        raise ValueError(f"expected one of {', '.join(map(repr, choices))}, got {value!r}")
+    if origin is list:
+        return _convert_list(value, hint)
+    if origin is dict:
+        return _convert_dict(value, hint)
+    if hint is type(None):
+        if value is None:
+            return None
+        raise _mismatch(value, hint)
+    if hint is bool:
+        return _convert_bool(value)
+    if hint is int:
+        return _convert_int(value)
+    if hint is float:
+        return _convert_float(value)
+    if hint is str:
+        if isinstance(value, str):
+            return value
+        raise _mismatch(value, hint)
+    if isinstance(hint, type) and issubclass(hint, Enum):
+        return _convert_enum(value, hint)
+    return value
+
+
+def describe(hint: Any) -> str:
+    """A short human name for a type hint (``int``, ``str | None``)."""
+    if hint is Any or hint is inspect.Parameter.empty:
+        return "any value"
+    if isinstance(hint, type) and typing.get_origin(hint) is None:
+        return hint.__name__
+    return str(hint).replace("typing.", "")
+
+
+def _mismatch(value: Any, hint: Any) -> ValueError:
+    return ValueError(f"expected {describe(hint)}, got {value!r} ({type(value).__name__})")
+
+
+def _convert_union(value: Any, hint: Any) -> Any:
+    for option in typing.get_args(hint):
+        try:
+            return convert(value, option)
+        except ValueError:
+            continue
+    raise _mismatch(value, hint)
+
+
+def _convert_list(value: Any, hint: Any) -> list[Any]:
+    if not isinstance(value, list):
+        raise _mismatch(value, hint)
+    (item_hint,) = typing.get_args(hint) or (Any,)
+    return [convert(item, item_hint) for item in value]
+
+
+def _convert_dict(value: Any, hint: Any) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise _mismatch(value, hint)
+    args = typing.get_args(hint)
+    value_hint = args[1] if len(args) == 2 else Any
+    return {key: convert(item, value_hint) for key, item in value.items()}
+
+
+def _convert_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.strip().lower() in ("true", "false"):
+        return value.strip().lower() == "true"
+    raise _mismatch(value, bool)
+
+
+def _number(value: Any, hint: type) -> float:
+    if isinstance(value, bool):
+        raise _mismatch(value, hint)
+    if isinstance(value, int | float):
+        return value
+    if isinstance(value, str):
+        try:
+            return float(value.strip())
+        except ValueError:
+            raise _mismatch(value, hint) from None
+    raise _mismatch(value, hint)
+
+
+def _convert_int(value: Any) -> int:
+    number = _number(value, int)
+    if number != number or number in (float("inf"), float("-inf")) or number != int(number):
+        raise _mismatch(value, int)
+    return int(number)
+
+
+def _convert_float(value: Any) -> float:
+    return float(_number(value, float))
+
+
+def _convert_enum(value: Any, hint: type[Enum]) -> Enum:
+    for member in hint:
+        if value == member.value or (isinstance(value, str) and value == member.name):
+            return member
+    choices = ", ".join(repr(member.value) for member in hint)
+    raise ValueError(f"expected one of {choices}, got {value!r}")

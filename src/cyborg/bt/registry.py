@@ -1,0 +1,171 @@
+"""The node registry: which Python class implements each node name in the editor.
+
+Register your own nodes with the :func:`register` decorator::
+
+    from cyborg.bt import Action, Status, register
+
+    @register("Bedtime?")          # the name used in behavior3editor; default: the class name
+    class Bedtime(Condition):
+        def __init__(self, hour: int = 22) -> None:
+            self.hour = hour
+        def tick(self) -> Status: ...
+
+Another package can add nodes without being imported by hand, by declaring an entry point in
+the group ``cyborg.nodes`` (in its ``pyproject.toml``)::
+
+    [project.entry-points."cyborg.nodes"]
+    my_nodes = "my_package.nodes"          # a module: importing it runs its @register lines
+    Greet = "my_package.nodes:Greet"       # or one class, registered under the entry's name
+
+:func:`default_registry` holds the stock nodes, everything registered with the decorator and
+every entry point's nodes.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import logging
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, TypeVar, overload
+
+from cyborg.bt import composites, decorators, leaves
+from cyborg.bt.node import Category, Node
+from cyborg.bt.properties import Signature, signature_of
+
+ENTRY_POINT_GROUP = "cyborg.nodes"
+
+N = TypeVar("N", bound=type[Node])
+
+
+@dataclass(frozen=True)
+class NodeType:
+    """A registered node: its editor name, implementing class and properties."""
+
+    name: str
+    cls: type[Node]
+    signature: Signature
+    origin: str
+    """Where it came from: ``stock``, a module name, or ``entry point <name>``."""
+
+    @property
+    def category(self) -> Category:
+        return self.cls.category
+
+
+class NodeRegistry:
+    """Maps editor node names to node classes."""
+
+    def __init__(self) -> None:
+        self._types: dict[str, NodeType] = {}
+
+    def add(self, cls: type[Node], name: str | None = None, *, origin: str = "") -> NodeType:
+        """Register ``cls`` under ``name`` (default: the class name). Replaces an older entry."""
+        if not (inspect.isclass(cls) and issubclass(cls, Node)):
+            raise TypeError(f"{cls!r} is not a Node subclass")
+        if not hasattr(cls, "category"):
+            raise TypeError(
+                f"{cls.__name__} must derive from Action, Condition, Composite or Decorator"
+            )
+        key = name if name is not None else cls.__name__
+        if not key:
+            raise ValueError("a node name cannot be empty")
+        node_type = NodeType(key, cls, signature_of(cls), origin or cls.__module__)
+        self._types[key] = node_type
+        return node_type
+
+    def get(self, name: str) -> NodeType | None:
+        return self._types.get(name)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._types
+
+    def names(self) -> list[str]:
+        """All registered names, sorted."""
+        return sorted(self._types)
+
+    def types(self) -> list[NodeType]:
+        return [self._types[name] for name in self.names()]
+
+    def copy(self) -> NodeRegistry:
+        """An independent registry with the same entries (for adding nodes locally)."""
+        other = NodeRegistry()
+        other._types = dict(self._types)
+        return other
+
+    def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> list[str]:
+        """Register the nodes of every installed entry point in ``group``.
+
+        Returns a message for each entry point that could not be loaded (they are skipped).
+        """
+        problems = []
+        for entry in entry_points(group=group):
+            try:
+                loaded = entry.load()
+            except Exception as exc:
+                problems.append(f"entry point {entry.name!r} ({entry.value}): "
+                                f"{type(exc).__name__}: {exc}")
+                continue
+            if inspect.isclass(loaded) and issubclass(loaded, Node):
+                self.add(loaded, entry.name, origin=f"entry point {entry.name}")
+            elif not inspect.ismodule(loaded):
+                problems.append(f"entry point {entry.name!r} ({entry.value}) is neither a "
+                                "module nor a Node subclass")
+        if self is not _REGISTERED:
+            self._types.update({k: v for k, v in _REGISTERED._types.items()
+                                if k not in self._types})
+        return problems
+
+    def import_modules(self, modules: Iterable[str]) -> None:
+        """Import modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``)."""
+        for module in modules:
+            importlib.import_module(module)
+        self._types.update(_REGISTERED._types)
+
+
+_REGISTERED = NodeRegistry()
+"""Where :func:`register` puts nodes; :func:`default_registry` starts from it."""
+
+
+@overload
+def register(name: N, /) -> N: ...
+@overload
+def register(name: str | None = None, /) -> Callable[[N], N]: ...
+def register(name: Any = None, /) -> Any:
+    """Class decorator: make a node available to trees under ``name`` (default: class name)."""
+    if inspect.isclass(name) and issubclass(name, Node):
+        _REGISTERED.add(name)
+        return name
+
+    def decorate(cls: N) -> N:
+        _REGISTERED.add(cls, name)
+        return cls
+
+    return decorate
+
+
+STOCK_NODES: tuple[type[Node], ...] = (
+    composites.Sequence, composites.Priority, composites.MemSequence, composites.MemPriority,
+    composites.Parallel,
+    decorators.Inverter, decorators.Repeater, decorators.RepeatUntilFailure,
+    decorators.RepeatUntilSuccess, decorators.MaxTime, decorators.Limiter, decorators.Retry,
+    decorators.Timeout, decorators.ForceSuccess, decorators.ForceFailure, decorators.Delay,
+    decorators.RunOnce,
+    leaves.Failer, leaves.Succeeder, leaves.Runner, leaves.Error, leaves.Wait,
+)
+"""The nodes every registry starts with: behavior3editor's palette and a few more."""
+
+for _cls in STOCK_NODES:
+    _REGISTERED.add(_cls, origin="stock")
+
+
+def default_registry(*, entry_points: bool = True) -> NodeRegistry:
+    """A new registry with the stock nodes, every ``@register``-ed node and (by default)
+    the nodes of installed entry points."""
+    registry = _REGISTERED.copy()
+    if entry_points:
+        for problem in registry.load_entry_points():
+            logging.getLogger("cyborg.bt").warning("skipping node %s", problem)
+    return registry

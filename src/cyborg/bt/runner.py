@@ -1,0 +1,157 @@
+"""Ticking a tree at a fixed rate, with pause, resume, single steps and stop.
+
+    runner = TreeRunner(tree, rate_hz=10)
+    runner.add_listener(lambda snapshot: print(snapshot.status))
+    runner.start()          # ticks in a background thread; or runner.run() to block
+    runner.pause()          # ticks stop; RUNNING nodes stay RUNNING (pause(halt=True) halts them)
+    runner.step()           # one tick while paused, returns its snapshot
+    runner.resume()
+    runner.stop()           # ends the loop and halts every RUNNING node
+
+The rate is kept on the tree's clock: ticks are due at ``start + k / rate``. When a tick
+overruns its slot the next one starts at once and the schedule restarts from there, so a slow
+tick never causes a burst of catch-up ticks. On a simulated or manual clock the runner goes as
+fast as the clock lets it, so a long mission can run faster than real time.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+
+from cyborg.bt.clock import Clock
+from cyborg.bt.snapshot import TickSnapshot
+from cyborg.bt.status import RUNNING
+from cyborg.bt.tree import Tree
+
+log = logging.getLogger("cyborg.bt")
+
+Listener = Callable[[TickSnapshot], None]
+
+
+class TreeRunner:
+    """Ticks a :class:`~cyborg.bt.tree.Tree` at ``rate_hz`` (default 10 Hz, as in 2018)."""
+
+    def __init__(self, tree: Tree, *, rate_hz: float = 10.0, clock: Clock | None = None) -> None:
+        if not rate_hz > 0:
+            raise ValueError(f"the tick rate must be more than 0 Hz, not {rate_hz}")
+        self.tree = tree
+        self.rate_hz = rate_hz
+        self.clock: Clock = clock or tree.clock
+        self._listeners: list[Listener] = []
+        self._tick_lock = threading.RLock()
+        self._state = threading.Condition()
+        self._wake = threading.Event()
+        self._paused = False
+        self._stopped = False
+        self._thread: threading.Thread | None = None
+
+    # ------------------------------------------------------------------ observers
+    def add_listener(self, listener: Listener) -> Callable[[], None]:
+        """Call ``listener(snapshot)`` after every tick (in the ticking thread).
+
+        Returns a function that removes the listener. A listener that raises is logged and
+        kept; the tree keeps ticking.
+        """
+        self._listeners.append(listener)
+        return lambda: self._listeners.remove(listener)
+
+    @property
+    def paused(self) -> bool:
+        return self._paused
+
+    @property
+    def stopped(self) -> bool:
+        return self._stopped
+
+    # ------------------------------------------------------------------ control
+    def pause(self, *, halt: bool = False) -> None:
+        """Stop ticking. With ``halt`` also halt the RUNNING nodes (a moving robot stops)."""
+        with self._state:
+            self._paused = True
+            self._wake.set()
+        if halt:
+            with self._tick_lock:
+                self.tree.halt()
+
+    def resume(self) -> None:
+        """Tick again at the set rate."""
+        with self._state:
+            self._paused = False
+            self._state.notify_all()
+
+    def step(self) -> TickSnapshot:
+        """Tick once now, in the calling thread; meant for a paused runner."""
+        return self._tick()
+
+    def stop(self, timeout: float | None = 5.0) -> None:
+        """End the loop and halt every RUNNING node. Waits for a background loop to end."""
+        with self._state:
+            self._stopped = True
+            self._wake.set()
+            self._state.notify_all()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout)
+        if thread is None:
+            with self._tick_lock:
+                self.tree.halt()
+
+    # ------------------------------------------------------------------ loops
+    def start(self, *, max_ticks: int | None = None, until_done: bool = False) -> None:
+        """Run :meth:`run` in a daemon thread."""
+        if self._thread is not None:
+            raise RuntimeError("the runner is already started")
+        self._thread = threading.Thread(target=self.run, name=f"bt:{self.tree.title}",
+                                        kwargs={"max_ticks": max_ticks, "until_done": until_done},
+                                        daemon=True)
+        self._thread.start()
+
+    def join(self, timeout: float | None = None) -> None:
+        """Wait for a background loop to end."""
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    def run(self, *, max_ticks: int | None = None, until_done: bool = False) -> None:
+        """Tick until stopped, ``max_ticks`` ticks are done, or (with ``until_done``) the root
+        returns something other than RUNNING. RUNNING nodes are halted on the way out."""
+        period = 1.0 / self.rate_hz
+        clock = self.clock
+        anchor = clock.now()  # ticks are due at anchor + slot * period (no drift from sums)
+        slot = 0
+        done = 0
+        try:
+            while True:
+                with self._state:
+                    while self._paused and not self._stopped:
+                        self._state.wait()
+                        anchor, slot = clock.now(), 0
+                    if self._stopped:
+                        break
+                    self._wake.clear()
+                snapshot = self._tick()
+                done += 1
+                if max_ticks is not None and done >= max_ticks:
+                    break
+                if until_done and snapshot.status is not RUNNING:
+                    break
+                slot += 1
+                due = anchor + slot * period
+                now = clock.now()
+                if due < now:  # overran: restart the schedule rather than burst
+                    anchor, slot, due = now, 0, now
+                clock.sleep_until(due, self._wake)
+        finally:
+            with self._tick_lock:
+                self.tree.halt()
+
+    def _tick(self) -> TickSnapshot:
+        with self._tick_lock:
+            snapshot = self.tree.tick()
+        for listener in list(self._listeners):
+            try:
+                listener(snapshot)
+            except Exception:
+                log.exception("tick listener %r raised", listener)
+        return snapshot

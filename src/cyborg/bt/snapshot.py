@@ -1,0 +1,136 @@
+"""What a tree looks like, and what happened in one tick.
+
+:class:`TreeStructure` is the tree's shape, built once per tree: every node with its stable id,
+label, name, category, subtree depth and children. Its JSON form (schema
+``cyborg.bt.structure/1``, in ``structure.schema.json`` beside this module and described in
+docs/tree-structure.md) is what monitors draw.
+
+:class:`TickSnapshot` is produced after every tick. It keeps references to the tick's own lists
+(no copying in the hot path); ids and JSON are computed only when asked for.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+from cyborg.bt.status import Status
+
+if TYPE_CHECKING:
+    from cyborg.bt.node import Node
+    from cyborg.bt.tree import Tree
+
+SCHEMA = "cyborg.bt.structure/1"
+
+
+class TickSnapshot:
+    """The result of one tick: root status, nodes visited with their status, active path."""
+
+    def __init__(self, tick: int, time: float, duration: float, status: Status,
+                 visits: list[tuple[Node, Status]], running: list[Node],
+                 halted: list[Node]) -> None:
+        self.tick = tick
+        """Tick number, from 1."""
+        self.time = time
+        """Clock time at which the tick began, in seconds."""
+        self.duration = duration
+        """Wall time the tick took, in seconds."""
+        self.status = status
+        """The root's status."""
+        self._visits = visits
+        self._running = running
+        self._halted = halted
+
+    @property
+    def visit_count(self) -> int:
+        return len(self._visits)
+
+    @cached_property
+    def visited(self) -> list[tuple[str, Status]]:
+        """``(node id, status)`` for each node ticked, in completion order (children first)."""
+        return [(node.uid, status) for node, status in self._visits]
+
+    @cached_property
+    def statuses(self) -> dict[str, Status]:
+        """Status of each node ticked in this tick, by node id."""
+        return {node.uid: status for node, status in self._visits}
+
+    @cached_property
+    def active(self) -> list[str]:
+        """Ids of the nodes RUNNING after this tick, root first (the active path; with a
+        Parallel it is a subtree, listed depth first)."""
+        return [node.uid for node in sorted(self._running, key=_index)]
+
+    @cached_property
+    def halted(self) -> list[str]:
+        """Ids of the nodes halted in this tick, in the order they were halted."""
+        return [node.uid for node in self._halted]
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict: ``{"tick", "time", "duration", "status", "visited", "active",
+        "halted"}`` with statuses as lower-case names."""
+        return {
+            "tick": self.tick,
+            "time": self.time,
+            "duration": self.duration,
+            "status": self.status.label,
+            "visited": [[uid, status.label] for uid, status in self.visited],
+            "active": self.active,
+            "halted": self.halted,
+        }
+
+    def __repr__(self) -> str:
+        return (f"<TickSnapshot tick={self.tick} status={self.status.name} "
+                f"visited={self.visit_count} active={len(self._running)}>")
+
+
+def _index(node: Node) -> int:
+    return node.index
+
+
+@dataclass(frozen=True)
+class TreeStructure:
+    """The shape of a tree, as JSON-ready nested dicts (see :meth:`to_json`)."""
+
+    root: dict[str, Any]
+    tree_id: str
+    title: str
+    source: str
+    node_count: int
+
+    @classmethod
+    def of(cls, tree: Tree) -> TreeStructure:
+        return cls(_describe(tree.root), tree.tree_id, tree.title, tree.source, len(tree.nodes))
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"schema", "tree_id", "title", "source", "node_count", "root"}``; each node is
+        ``{"id", "node_id", "name", "title", "label", "category", "depth", "index",
+        "properties", "children"}`` and tree nodes add ``"tree_id"``."""
+        return {
+            "schema": SCHEMA,
+            "tree_id": self.tree_id,
+            "title": self.title,
+            "source": self.source,
+            "node_count": self.node_count,
+            "root": self.root,
+        }
+
+
+def _describe(node: Node) -> dict[str, Any]:
+    entry: dict[str, Any] = {
+        "id": node.uid,
+        "node_id": node.node_id,
+        "name": node.name,
+        "title": node.title,
+        "label": node.label,
+        "category": node.category.value,
+        "depth": node.subtree_depth,
+        "index": node.index,
+        "properties": dict(node.properties),
+    }
+    tree_id = getattr(node, "tree_id", None)
+    if tree_id is not None:
+        entry["tree_id"] = tree_id
+    entry["children"] = [_describe(child) for child in node.children]
+    return entry

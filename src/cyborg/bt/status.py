@@ -1,0 +1,43 @@
+"""The four results a behaviour-tree node can return.
+
+The numbers are behavior3's (``SUCCESS=1, FAILURE=2, RUNNING=3, ERROR=4``) so that logs and
+messages line up with trees and tools written for behavior3editor. Compare statuses with ``is``:
+the members are singletons, and identity checks are the cheapest comparison in the hot path.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class Status(IntEnum):
+    """Result of ticking a node once."""
+
+    SUCCESS = 1
+    """The node reached its goal."""
+    FAILURE = 2
+    """The node could not reach its goal."""
+    RUNNING = 3
+    """The node needs more ticks; it will be ticked again or halted."""
+    ERROR = 4
+    """The node's code raised, or returned something that is not a status."""
+
+    @property
+    def label(self) -> str:
+        """Lower-case name, as shown in status lines and JSON (``"running"``)."""
+        return self.name.lower()
+
+    @classmethod
+    def parse(cls, text: str) -> Status:
+        """Status from its name in any case (``"success"``, ``"RUNNING"``)."""
+        try:
+            return cls[text.strip().upper()]
+        except KeyError:
+            names = ", ".join(member.label for member in cls)
+            raise ValueError(f"unknown status {text!r}; expected one of {names}") from None
+
+
+SUCCESS = Status.SUCCESS
+FAILURE = Status.FAILURE
+RUNNING = Status.RUNNING
+ERROR = Status.ERROR

@@ -1,0 +1,112 @@
+"""A running behaviour tree: one root, a clock, a blackboard, and the tick.
+
+:meth:`Tree.tick` ticks the root once and then enforces the halting rule:
+
+    A node that was RUNNING and is not reached in the next tick is halted in that tick,
+    deepest first, and its ``on_halt`` runs exactly once.
+
+The same pass also halts a node left RUNNING under a parent that itself completed (a custom
+composite that forgot its child), so an abandoned action can always cancel what it started.
+Every tick returns a :class:`~cyborg.bt.snapshot.TickSnapshot`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+from cyborg.bt.blackboard import Blackboard
+from cyborg.bt.clock import Clock, MonotonicClock
+from cyborg.bt.node import Node, TickRecord
+from cyborg.bt.snapshot import TickSnapshot, TreeStructure
+from cyborg.bt.status import RUNNING, Status
+
+
+class Tree:
+    """A tree of live nodes ready to tick. Build one with :func:`cyborg.bt.load_tree`."""
+
+    def __init__(self, root: Node, *, record: TickRecord, blackboard: Blackboard,
+                 clock: Clock | None = None, source: str = "", tree_id: str = "",
+                 title: str = "") -> None:
+        self.root = root
+        self.blackboard = blackboard
+        self.clock: Clock = clock or MonotonicClock()
+        self.source = source
+        self.tree_id = tree_id
+        self.title = title
+        self.ticks = 0
+        """Number of ticks done so far."""
+        self.last: TickSnapshot | None = None
+        self._record = record
+        self._running: list[Node] = []
+        self.nodes: list[Node] = list(root.walk())
+        """Every node, depth first, pre-order; ``nodes[i].index == i``."""
+        for index, node in enumerate(self.nodes):
+            node.index = index
+        self.by_uid: dict[str, Node] = {node.uid: node for node in self.nodes}
+        self._structure: TreeStructure | None = None
+
+    def __iter__(self) -> Iterator[Node]:
+        return iter(self.nodes)
+
+    def __len__(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def running(self) -> list[Node]:
+        """Nodes RUNNING after the last tick, deepest first."""
+        return list(self._running)
+
+    def tick(self) -> TickSnapshot:
+        """Tick the root once, halt what was abandoned, and return the tick's snapshot."""
+        record = self._record
+        record.now = now = self.clock.now()
+        visits: list[tuple[Node, Status]] = []
+        running: list[Node] = []
+        halted: list[Node] = []
+        record.visits = visits
+        record.running = running
+        record.halted = halted
+        started = time.perf_counter()
+        status = self.root.execute()
+        previous = self._running
+        if previous:
+            still = set(running)
+            for node in previous:  # deepest first, so children go before their parents
+                if node.status is RUNNING and node not in still:
+                    node.halt()
+        if running:
+            for node in running:
+                parent = node.parent
+                if parent is not None and parent.status is not RUNNING:
+                    node.halt()  # left RUNNING under a parent that completed
+            if halted:
+                running = [node for node in running if node.status is RUNNING]
+        self._running = running
+        self.ticks += 1
+        snapshot = TickSnapshot(self.ticks, now, time.perf_counter() - started, status,
+                                visits, running, halted)
+        self.last = snapshot
+        return snapshot
+
+    def halt(self) -> list[Node]:
+        """Halt every RUNNING node, deepest first; returns the nodes halted."""
+        record = self._record
+        halted: list[Node] = []
+        record.halted = halted
+        self.root.halt()
+        self._running = []
+        return halted
+
+    @property
+    def structure(self) -> TreeStructure:
+        """The tree's shape, for monitors and exports (built once)."""
+        if self._structure is None:
+            self._structure = TreeStructure.of(self)
+        return self._structure
+
+    def to_dot(self) -> str:
+        """The structure as a Graphviz DOT graph."""
+        from cyborg.bt.dot import structure_to_dot
+
+        return structure_to_dot(self.structure.to_json())

@@ -1,0 +1,36 @@
+"""Shared test fixtures: where the project's shared data lives.
+
+The sample trees, maps and models are read from ``../shared`` beside the checkout, or from the
+folder named by the ``CYBORG_SHARED`` environment variable.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from cyborg.bt import registry
+
+
+def shared_dir() -> Path:
+    path = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
+    if not path.is_dir():
+        raise FileNotFoundError(f"shared data folder {path} not found; set CYBORG_SHARED")
+    return path
+
+
+@pytest.fixture
+def shared() -> Path:
+    return shared_dir()
+
+
+@pytest.fixture(autouse=True)
+def _restore_registered_nodes() -> Iterator[None]:
+    """Nodes a test registers with @register do not leak into other tests."""
+    saved = dict(registry._REGISTERED._types)
+    yield
+    registry._REGISTERED._types.clear()
+    registry._REGISTERED._types.update(saved)

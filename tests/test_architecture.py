@@ -1,0 +1,36 @@
+"""The package keeps its dependency direction and its modules stay small."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SOURCE = Path(__file__).resolve().parents[1] / "src" / "cyborg"
+INDEPENDENT = ("bt",)
+"""Packages that import nothing of cyborg but themselves."""
+
+
+def _cyborg_imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+    return {name for name in found if name == "cyborg" or name.startswith("cyborg.")}
+
+
+@pytest.mark.parametrize("package", INDEPENDENT)
+def test_independent_packages_import_only_themselves(package: str) -> None:
+    for path in sorted((SOURCE / package).rglob("*.py")):
+        for name in _cyborg_imports(path):
+            assert name.startswith(f"cyborg.{package}"), f"{path} imports {name}"
+
+
+def test_modules_stay_small() -> None:
+    for path in sorted(SOURCE.rglob("*.py")):
+        lines = len(path.read_text().splitlines())
+        assert lines <= 420, f"{path} has {lines} lines; split it"

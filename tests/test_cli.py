@@ -1,0 +1,146 @@
+"""The `cyborg` command: bt validate/run/dot/json/nodes and up."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cyborg.app.cli import main
+from tests.builders import N, project_json, tree_json
+from tests.conftest import shared_dir
+
+PATROL = shared_dir() / "trees" / "patrol_recharge.b3.json"
+STOCK = shared_dir() / "trees" / "stock_nodes.tree.json"
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "tree.json"
+    path.write_text(text)
+    return path
+
+
+def test_validate_ok(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "validate", str(STOCK)]) == 0
+    assert "ok (0 errors, 0 warnings)" in capsys.readouterr().out
+
+
+def test_validate_reports_all_problems_and_fails(tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    spec = N("Sequence", N("Nope", id="n1"), N("Inverter", id="i1"),
+             N("Wait", id="w1", milliseconds="soon"), id="s")
+    path = _write(tmp_path, json.dumps(tree_json(spec), indent=2))
+    assert main(["bt", "validate", str(path)]) == 1
+    out = capsys.readouterr().out
+    lines = [line for line in out.splitlines() if ": error: " in line]
+    assert len(lines) == 3
+    assert all(line.startswith(f"{path}:") for line in lines)
+    assert "(id n1)" in out and "(id i1)" in out and "(id w1)" in out
+    assert "invalid (3 errors" in out
+
+
+def test_validate_json_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _write(tmp_path, '{"trees": [}')
+    assert main(["bt", "validate", "--json", str(path)]) == 1
+    (problem,) = json.loads(capsys.readouterr().out)
+    assert problem["severity"] == "error" and problem["line"] == 1 and problem["column"] == 12
+
+
+def test_validate_unknown_custom_nodes_and_stubs(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "validate", str(PATROL)]) == 1
+    out = capsys.readouterr().out
+    assert "unknown node name 'MoveTo' (declared in custom_nodes" in out
+    assert main(["bt", "validate", str(PATROL), "--stub-missing", "success"]) == 0
+
+
+def test_validate_with_user_node_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "robot_nodes.py").write_text(
+        "from cyborg.bt import Action, Decorator, Status, register\n"
+        "@register\nclass MoveTo(Action):\n"
+        "    def __init__(self, location: str, radius: float = 0.5) -> None: ...\n"
+        "    def tick(self) -> Status: return Status.SUCCESS\n"
+        "@register\nclass CheckBattery(Decorator):\n"
+        "    def __init__(self, threshold: float) -> None: ...\n"
+        "    def tick(self) -> Status: return Status.FAILURE\n"
+        "@register\nclass Charge(Action):\n"
+        "    def __init__(self, target: float) -> None: ...\n"
+        "    def tick(self) -> Status: return Status.SUCCESS\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert main(["bt", "validate", str(PATROL), "--nodes", "robot_nodes"]) == 0
+    assert main(["bt", "nodes", "--nodes", "robot_nodes"]) == 0
+    out = capsys.readouterr().out
+    assert "MoveTo" in out and "{location, radius=0.5}" in out
+
+
+def test_run_shows_status_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = N("MemSequence", N("Wait", id="w", title="Pause", milliseconds=300),
+             N("Succeeder", id="s"), id="m")
+    path = _write(tmp_path, project_json([tree_json(spec, title="Little")]))
+    assert main(["bt", "run", str(path), "--fast", "--until-done"]) == 0
+    out = capsys.readouterr().out
+    assert "tick      1  RUNNING  Little > MemSequence > Pause" in out
+    assert "tick      4  SUCCESS  -" in out
+    assert "done after 4 ticks; last root status SUCCESS" in out
+
+
+def test_run_by_tree_title_and_ticks(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["bt", "run", str(PATROL), "--tree", "Recharge tree", "--stub-missing",
+                 "running", "--ticks", "3", "--rate", "50"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "running 'Recharge tree'" in out
+    assert "Recharge tree > MemSequence > MoveTo Dock" in out
+    assert "done after 3 ticks" in out
+
+
+def test_run_rejects_bad_file_and_options(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "run", str(tmp_path / "none.json")]) == 1
+    assert "cannot read the file" in capsys.readouterr().err
+    assert main(["bt", "run", str(STOCK), "--rate", "0"]) == 2
+    assert main(["bt", "run", str(STOCK), "--ticks", "0"]) == 2
+    with pytest.raises(SystemExit):
+        main(["bt", "run", str(STOCK), "--stub-missing", "maybe"])
+
+
+def test_dot_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "dot", str(STOCK)]) == 0
+    assert capsys.readouterr().out.startswith('digraph "Stock nodes" {')
+    out = tmp_path / "tree.json"
+    assert main(["bt", "json", str(STOCK), "-o", str(out)]) == 0
+    assert json.loads(out.read_text())["schema"] == "cyborg.bt.structure/1"
+
+
+def _cyborg(*args: str) -> subprocess.Popen[str]:
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    return subprocess.Popen([sys.executable, "-m", "cyborg", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env)
+
+
+def test_up_runs_the_bundled_demo() -> None:
+    process = _cyborg("up", "--fast", "--ticks", "50")
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 0, err
+    assert "tree runner  'Demo mission'" in out
+    assert "Patrol > MemSequence > Walk to hall" in out
+    assert "done after 50 ticks" in out
+
+
+def test_ctrl_c_stops_cleanly_and_halts() -> None:
+    process = _cyborg("up")
+    assert process.stdout is not None
+    first = process.stdout.readline()
+    assert first.startswith("cyborg up")
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=30)
+    assert process.returncode == 130, err
+    assert "interrupted after" in out and "running nodes halted" in out
+    assert "Traceback" not in err
