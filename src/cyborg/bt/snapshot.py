@@ -12,7 +12,6 @@ docs/tree-structure.md) is what monitors draw.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 from cyborg.bt.status import Status
@@ -26,6 +25,9 @@ SCHEMA = "cyborg.bt.structure/1"
 
 class TickSnapshot:
     """The result of one tick: root status, nodes visited with their status, active path."""
+
+    __slots__ = ("_active", "_halted", "_halted_ids", "_running", "_statuses", "_visited",
+                 "_visits", "duration", "status", "tick", "time")
 
     def __init__(self, tick: int, time: float, duration: float, status: Status,
                  visits: list[tuple[Node, Status]], running: list[Node],
@@ -41,31 +43,44 @@ class TickSnapshot:
         self._visits = visits
         self._running = running
         self._halted = halted
+        self._visited: list[tuple[str, Status]] | None = None
+        self._statuses: dict[str, Status] | None = None
+        self._active: list[str] | None = None
+        self._halted_ids: list[str] | None = None
 
     @property
     def visit_count(self) -> int:
         return len(self._visits)
 
-    @cached_property
+    # The id lists are built on first use only: most ticks' snapshots are never read in full.
+    @property
     def visited(self) -> list[tuple[str, Status]]:
         """``(node id, status)`` for each node ticked, in completion order (children first)."""
-        return [(node.uid, status) for node, status in self._visits]
+        if self._visited is None:
+            self._visited = [(node.uid, status) for node, status in self._visits]
+        return self._visited
 
-    @cached_property
+    @property
     def statuses(self) -> dict[str, Status]:
         """Status of each node ticked in this tick, by node id."""
-        return {node.uid: status for node, status in self._visits}
+        if self._statuses is None:
+            self._statuses = {node.uid: status for node, status in self._visits}
+        return self._statuses
 
-    @cached_property
+    @property
     def active(self) -> list[str]:
         """Ids of the nodes RUNNING after this tick, root first (the active path; with a
         Parallel it is a subtree, listed depth first)."""
-        return [node.uid for node in sorted(self._running, key=_index)]
+        if self._active is None:
+            self._active = [node.uid for node in sorted(self._running, key=_index)]
+        return self._active
 
-    @cached_property
+    @property
     def halted(self) -> list[str]:
         """Ids of the nodes halted in this tick, in the order they were halted."""
-        return [node.uid for node in self._halted]
+        if self._halted_ids is None:
+            self._halted_ids = [node.uid for node in self._halted]
+        return self._halted_ids
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict: ``{"tick", "time", "duration", "status", "visited", "active",

@@ -12,8 +12,8 @@ Every tick returns a :class:`~cyborg.bt.snapshot.TickSnapshot`.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
+from time import perf_counter
 
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.clock import Clock, MonotonicClock
@@ -64,10 +64,8 @@ class Tree:
         visits: list[tuple[Node, Status]] = []
         running: list[Node] = []
         halted: list[Node] = []
-        record.visits = visits
-        record.running = running
-        record.halted = halted
-        started = time.perf_counter()
+        record.visits, record.running, record.halted = visits, running, halted
+        started = perf_counter()
         status = self.root.execute()
         previous = self._running
         if previous:
@@ -83,10 +81,9 @@ class Tree:
             if halted:
                 running = [node for node in running if node.status is RUNNING]
         self._running = running
-        self.ticks += 1
-        snapshot = TickSnapshot(self.ticks, now, time.perf_counter() - started, status,
-                                visits, running, halted)
-        self.last = snapshot
+        self.ticks = ticks = self.ticks + 1
+        self.last = snapshot = TickSnapshot(ticks, now, perf_counter() - started, status,
+                                            visits, running, halted)
         return snapshot
 
     def halt(self) -> list[Node]:
