@@ -79,6 +79,19 @@ def test_validate_with_user_node_module(tmp_path: Path, monkeypatch: pytest.Monk
     assert "MoveTo" in out and "{location, radius=0.5}" in out
 
 
+def test_bad_node_module_is_a_one_line_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "broken_nodes.py").write_text("raise ValueError('oops in module')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert main(["bt", "validate", str(STOCK), "--nodes", "no_such_module"]) == 1
+    err = capsys.readouterr().err
+    assert "cannot import node module 'no_such_module' (--nodes): ModuleNotFoundError" in err
+    assert main(["bt", "run", str(STOCK), "--nodes", "broken_nodes"]) == 1
+    err = capsys.readouterr().err
+    assert "'broken_nodes' (--nodes): ValueError: oops in module" in err
+    assert "Traceback" not in err
+
+
 def test_run_shows_status_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = N("MemSequence", N("Wait", id="w", title="Pause", milliseconds=300),
              N("Succeeder", id="s"), id="m")

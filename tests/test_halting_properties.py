@@ -261,14 +261,38 @@ class Checker:
         for uid, status in snapshot.visited:
             node = self.tree.by_uid[uid]
             children = [statuses.get(child.uid) for child in node.children]
+            resumed = uid in self.active  # continuing an activation from the last tick
             if node.name in ("Sequence", "Priority", "MemSequence", "MemPriority"):
-                check_ordered(node, status, children)
+                first = check_ordered(node, status, children)
+                if node.name.startswith("Mem") and resumed:
+                    # A memory composite resumes at the child that was RUNNING.
+                    assert node.children[first].uid in self.active, f"{uid} did not resume"
+                else:
+                    assert first == 0, f"{uid} did not start at its first child"
             elif node.name in ("Inverter", "ForceSuccess", "ForceFailure"):
                 (child,) = children
                 assert child is not None
                 assert status is DECORATE[node.name].get(child, child)
-            elif node.name == "Parallel" and status is not RUNNING:
-                assert not any(c.status is RUNNING for c in node.children)
+            elif node.name == "Parallel":
+                self.check_parallel(node, status, children, resumed)
+
+    def check_parallel(self, node: Node, status: Status, children: list[Status | None],
+                       resumed: bool) -> None:
+        """A Parallel ticks, in order, every child that has not completed in this activation
+        (stopping at an ERROR, which it returns); once decided, no child is left RUNNING."""
+        candidates = [index for index, child in enumerate(node.children)
+                      if not resumed or child.uid in self.active]
+        ticked = [index for index, child in enumerate(children) if child is not None]
+        assert ticked == candidates[:len(ticked)], f"{node.uid} ticked {ticked}"
+        if ERROR in children:
+            assert children[ticked[-1]] is ERROR and status is ERROR
+        else:
+            assert ticked == candidates, f"{node.uid} skipped a child"
+            assert status is not ERROR
+        if status is not RUNNING:
+            assert not any(child.status is RUNNING for child in node.children)
+        else:
+            assert any(child.status is RUNNING for child in node.children)
 
 
 DECORATE: dict[str, dict[Status, Status]] = {
@@ -278,15 +302,13 @@ DECORATE: dict[str, dict[Status, Status]] = {
 }
 
 
-def check_ordered(node: Node, status: Status, children: list[Status | None]) -> None:
-    """Sequence-like nodes tick a contiguous run of children (from the first one, without
-    memory) that continue, and return the status of the one that stops them."""
+def check_ordered(node: Node, status: Status, children: list[Status | None]) -> int:
+    """Sequence-like nodes tick a contiguous run of children that continue, and return the
+    status of the one that stops them. Returns the index of the first child ticked."""
     go_on = SUCCESS if "Sequence" in node.name else FAILURE
     ticked = [index for index, child in enumerate(children) if child is not None]
     assert ticked, f"{node.uid} ticked no child"
     assert ticked == list(range(ticked[0], ticked[-1] + 1)), f"{node.uid} skipped a child"
-    if not node.name.startswith("Mem"):
-        assert ticked[0] == 0
     run = [children[index] for index in ticked]
     assert all(child is go_on for child in run[:-1])
     if run[-1] is go_on:
@@ -294,6 +316,7 @@ def check_ordered(node: Node, status: Status, children: list[Status | None]) -> 
         assert status is go_on
     else:
         assert status is run[-1]
+    return ticked[0]
 
 
 def halt_tree(checker: Checker) -> None:

@@ -75,9 +75,18 @@ def _file_options(parser: argparse.ArgumentParser) -> None:
                              "every node without a Python class")
 
 
+class CommandError(Exception):
+    """A problem with the command's input, reported as one line without a traceback."""
+
+
 def registry_for(args: argparse.Namespace) -> NodeRegistry:
     registry = default_registry()
-    registry.import_modules(args.nodes)
+    for module in args.nodes:
+        try:
+            registry.import_modules([module])
+        except Exception as exc:
+            raise CommandError(f"cannot import node module {module!r} (--nodes): "
+                               f"{type(exc).__name__}: {exc}") from exc
     return registry
 
 

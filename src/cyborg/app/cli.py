@@ -40,6 +40,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         result: int = args.handler(args)
+    except bt_commands.CommandError as exc:
+        print(f"cyborg: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:  # e.g. `cyborg bt dot FILE | head`
