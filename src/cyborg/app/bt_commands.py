@@ -37,14 +37,9 @@ def add_parser(commands: Any) -> None:
 
     run = sub.add_parser("run", help="tick a tree with a live status line")
     _file_options(run)
-    run.add_argument("--rate", type=float, default=10.0, metavar="HZ",
-                     help="ticks per second (default 10)")
-    run.add_argument("--ticks", type=int, default=None, metavar="N",
-                     help="stop after N ticks (default: run until Ctrl-C)")
+    add_run_options(run)
     run.add_argument("--until-done", action="store_true",
                      help="stop when the root returns SUCCESS, FAILURE or ERROR")
-    run.add_argument("--fast", action="store_true",
-                     help="simulated time: tick as fast as possible while nodes see the rate")
     run.set_defaults(handler=run_command)
 
     dot = sub.add_parser("dot", help="print the tree as a Graphviz DOT graph")
@@ -77,6 +72,25 @@ def _file_options(parser: argparse.ArgumentParser) -> None:
 
 class CommandError(Exception):
     """A problem with the command's input, reported as one line without a traceback."""
+
+
+def add_run_options(parser: argparse.ArgumentParser) -> None:
+    """``--rate``, ``--ticks`` and ``--fast``, shared by every command that runs a tree."""
+    parser.add_argument("--rate", type=float, default=10.0, metavar="HZ",
+                        help="tree ticks per second (default 10)")
+    parser.add_argument("--ticks", type=int, default=None, metavar="N",
+                        help="stop after N ticks (default: run until Ctrl-C)")
+    parser.add_argument("--fast", action="store_true",
+                        help="simulated time: tick as fast as possible while nodes see the rate")
+
+
+def run_options_problem(args: argparse.Namespace) -> str | None:
+    """What is wrong with ``--rate``/``--ticks``, if anything."""
+    if not args.rate > 0:
+        return f"--rate must be more than 0, not {args.rate}"
+    if args.ticks is not None and args.ticks < 1:
+        return f"--ticks must be at least 1, not {args.ticks}"
+    return None
 
 
 def registry_for(args: argparse.Namespace) -> NodeRegistry:
@@ -131,11 +145,9 @@ def _problem_json(problem: Problem) -> dict[str, Any]:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    if not args.rate > 0:
-        print(f"--rate must be more than 0, not {args.rate}", file=sys.stderr)
-        return 2
-    if args.ticks is not None and args.ticks < 1:
-        print(f"--ticks must be at least 1, not {args.ticks}", file=sys.stderr)
+    problem = run_options_problem(args)
+    if problem is not None:
+        print(problem, file=sys.stderr)
         return 2
     clock = ManualClock() if args.fast else MonotonicClock()
     tree = _load(args, clock=clock)

@@ -14,7 +14,12 @@ from importlib.resources import as_file, files
 from pathlib import Path
 from typing import Any
 
-from cyborg.app.bt_commands import print_problems, run_tree
+from cyborg.app.bt_commands import (
+    add_run_options,
+    print_problems,
+    run_options_problem,
+    run_tree,
+)
 from cyborg.bt import ManualClock, MonotonicClock, TreeLoadError, default_registry, load_tree
 
 DEMO_TREE = "demo.b3.json"
@@ -26,18 +31,14 @@ def add_parser(commands: Any) -> None:
                                          "bundled demo mission in the tree runner.")
     up.add_argument("--tree", type=Path, default=None, metavar="FILE",
                     help="behavior3editor export to run instead of the bundled demo")
-    up.add_argument("--rate", type=float, default=10.0, metavar="HZ",
-                    help="tree ticks per second (default 10)")
-    up.add_argument("--ticks", type=int, default=None, metavar="N",
-                    help="stop after N ticks (default: until Ctrl-C)")
-    up.add_argument("--fast", action="store_true",
-                    help="simulated time: run as fast as possible")
+    add_run_options(up)
     up.set_defaults(handler=up_command)
 
 
 def up_command(args: argparse.Namespace) -> int:
-    if not args.rate > 0 or (args.ticks is not None and args.ticks < 1):
-        print("--rate must be more than 0 and --ticks at least 1")
+    problem = run_options_problem(args)
+    if problem is not None:
+        print(problem, file=sys.stderr)
         return 2
     clock = ManualClock() if args.fast else MonotonicClock()
     resource = files("cyborg.app").joinpath("data", DEMO_TREE)
