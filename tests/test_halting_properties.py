@@ -291,7 +291,7 @@ class Checker:
             assert status is not ERROR
         if status is not RUNNING:
             assert not any(child.status is RUNNING for child in node.children)
-        else:
+        elif node.status is RUNNING:  # not halted later in the tick
             assert any(child.status is RUNNING for child in node.children)
 
 

@@ -240,3 +240,26 @@ def test_orphan_nodes_are_warnings() -> None:
                                "properties": {}}
     tree = loads_tree(json.dumps(data), registry=registry())
     assert "lonely" not in tree.by_uid
+
+
+def test_decorator_with_two_children() -> None:
+    data = tree_json(N("Sequence", N("Succeeder", id="a"), N("Failer", id="b"), id="s"))
+    data["nodes"]["s"]["name"] = "Inverter"
+    (problem,) = _errors(json.dumps(data))
+    assert problem.node_id == "s"
+    assert "a decorator takes exactly one child, it has 2" in problem.message
+
+
+def test_composite_exported_with_child_key_is_accepted() -> None:
+    data = tree_json(N("Inverter", N("Succeeder", id="a"), id="s"))
+    data["nodes"]["s"]["name"] = "Sequence"
+    tree = loads_tree(json.dumps(data), registry=registry())
+    assert [child.uid for child in tree.by_uid["s"].children] == ["a"]
+
+
+def test_both_child_and_children() -> None:
+    data = tree_json(N("Sequence", N("Succeeder", id="a"), id="s"))
+    data["nodes"]["s"]["child"] = "a"
+    (problem,) = _errors(json.dumps(data))
+    assert (problem.node_id, problem.field) == ("s", "child")
+    assert "both 'child' and 'children'" in problem.message

@@ -21,6 +21,7 @@ from cyborg.bt import (
     RUNNING,
     SUCCESS,
     Action,
+    Composite,
     ManualClock,
     NodeRegistry,
     Status,
@@ -97,11 +98,28 @@ class StartBoom(Action):
         return SUCCESS
 
 
+class HaltBoom(Action):
+    """Keeps running; raises in on_halt."""
+
+    def tick(self) -> Status:
+        return RUNNING
+
+    def on_halt(self) -> None:
+        raise OSError("cannot cancel")
+
+
+class Forgetful(Composite):
+    """A faulty composite: ticks its first child and succeeds even if the child runs on."""
+
+    def tick(self) -> Status:
+        self.children[0].execute()
+        return SUCCESS
+
+
 def custom_registry() -> NodeRegistry:
     reg = registry()
-    reg.add(Advance)
-    reg.add(Returns)
-    reg.add(StartBoom)
+    for cls in (Advance, Returns, StartBoom, HaltBoom, Forgetful):
+        reg.add(cls)
     return reg
 
 
@@ -590,6 +608,30 @@ def test_tick_return_value_coercion(value: str, status: Status,
         assert isinstance(tree.by_uid["r"].last_error, TypeError)
     else:
         assert caplog.records == []
+
+
+def test_exception_in_on_halt_is_logged_and_halting_goes_on(
+        caplog: pytest.LogCaptureFixture) -> None:
+    tree = build(N("Sequence", N("HaltBoom", id="h"), id="s"))
+    tree.tick()
+    with caplog.at_level(logging.ERROR, logger="cyborg.bt"):
+        halted = tree.halt()
+    assert [node.uid for node in halted] == ["h", "s", ROOT]
+    assert len(caplog.records) == 1
+    assert "h" in caplog.records[0].getMessage().split()
+    assert "on_halt" in caplog.records[0].getMessage()
+    assert tree.running == []
+
+
+def test_node_left_running_under_a_completed_parent_is_halted() -> None:
+    tree = build(N("Forgetful", leaf("a", "R"), id="f"))
+    snapshot = tree.tick()
+    assert snapshot.status is SUCCESS
+    assert snapshot.halted == ["a"]
+    assert snapshot.active == []
+    assert events(tree) == parse_events("a:start a:tick a:halt")
+    tree.tick()
+    assert events(tree) == parse_events("a:start a:tick a:halt")
 
 
 def test_time_is_read_once_at_the_start_of_each_tick() -> None:

@@ -126,3 +126,12 @@ def test_overrun_does_not_burst() -> None:
     runner.add_listener(slow)
     runner.run(max_ticks=5)
     assert times == pytest.approx([0.0, 0.1, 0.65, 0.75, 0.85])
+
+
+def test_decimal_clock_steps_do_not_cost_an_extra_tick() -> None:
+    """0.35 s - 0.1 s is 249.99999999999997 ms in floating point; it counts as 250 ms."""
+    clock = ManualClock(0.1)
+    tree = tree_from(N("Timeout", N("Runner"), milliseconds=250), clock=clock)
+    assert tree.tick().status is Status.RUNNING
+    clock.set(0.35)
+    assert tree.tick().status is Status.FAILURE
