@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 SOURCE = Path(__file__).resolve().parents[1] / "src" / "cyborg"
-INDEPENDENT = ("bt",)
+INDEPENDENT = ("bt", "bus")
 """Packages that import nothing of cyborg but themselves."""
 
 

@@ -1,0 +1,210 @@
+"""ROS 2 message, service and action types, from rosbags plus our own interface files.
+
+:class:`MessageTypes` starts from rosbags' ROS 2 Jazzy type store (std_msgs, geometry_msgs,
+sensor_msgs, nav_msgs, action_msgs, ...) and adds every ``.msg``, ``.srv`` and ``.action`` file
+found under interface folders laid out as ROS packages (``<package>/msg/Name.msg``). The folder
+bundled with cyborg holds ``cyborg_msgs`` and the few standard services rosbags lacks
+(``std_srvs``, ``example_interfaces``). Like ROS, it registers for a service ``pkg/srv/X`` the
+messages ``X_Request``, ``X_Response`` and ``X_Event``, and for an action ``pkg/action/X`` the
+goal, result and feedback messages plus the ``SendGoal`` and ``GetResult`` services and the
+``FeedbackMessage``.
+
+    types = MessageTypes()
+    raw = types.serialize(message, "std_msgs/msg/String")     # CDR, little endian
+    message = types.deserialize(raw, "std_msgs/msg/String")   # numpy arrays are views on raw
+    types.hash("std_srvs/srv/SetBool")                         # "RIHS01_abe9e4bb..."
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rosbags.interfaces import Nodetype
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+from cyborg.bus.type_hash import (
+    EMPTY_STRUCT_FIELD,
+    SERVICE_EVENT_INFO,
+    TIME,
+    UUID,
+    Fields,
+    action_fields,
+    fields_from_rosbags,
+    rihs01,
+    service_fields,
+)
+
+BUNDLED_INTERFACES = Path(__file__).with_name("interfaces")
+"""The interface files shipped with cyborg (cyborg_msgs and standard services)."""
+
+_KINDS = {"msg": 1, "srv": 2, "action": 3}  # file kind -> number of `---` separated parts
+
+
+class InterfaceError(ValueError):
+    """An interface file could not be read; the message names the file and the reason."""
+
+
+@dataclass(frozen=True)
+class Interface:
+    """One interface file: ``pkg/msg/Name``, ``pkg/srv/Name`` or ``pkg/action/Name``."""
+
+    name: str
+    kind: str
+    parts: tuple[str, ...]
+    source: str
+
+
+def read_interfaces(root: Path) -> list[Interface]:
+    """Every interface file under ``root`` (``<package>/<msg|srv|action>/<Name>.<kind>``)."""
+    found = []
+    for path in sorted(root.glob("*/*/*")):
+        kind = path.suffix.lstrip(".")
+        if kind not in _KINDS or path.parent.name != kind:
+            continue
+        package = path.parent.parent.name
+        text = path.read_text(encoding="utf-8")
+        parts = tuple(_split_parts(text))
+        if len(parts) != _KINDS[kind]:
+            raise InterfaceError(f"{path}: a .{kind} file has {_KINDS[kind]} part(s) separated "
+                                 f"by '---' lines, this one has {len(parts)}")
+        found.append(Interface(f"{package}/{kind}/{path.stem}", kind, parts, str(path)))
+    return found
+
+
+def _split_parts(text: str) -> list[str]:
+    parts: list[list[str]] = [[]]
+    for line in text.splitlines():
+        if line.strip() == "---":
+            parts.append([])
+        else:
+            parts[-1].append(line)
+    return ["\n".join(lines) + "\n" for lines in parts]
+
+
+class MessageTypes:
+    """A type store: rosbags' ROS 2 types plus interface folders; CDR and RIHS01 hashes."""
+
+    def __init__(self, interface_dirs: Iterable[Path] = (BUNDLED_INTERFACES,)) -> None:
+        self.store = get_typestore(Stores.ROS2_JAZZY)
+        self._synthetic: dict[str, Fields] = {}
+        self.services: set[str] = set()
+        self.actions: set[str] = set()
+        for folder in interface_dirs:
+            self.add_interfaces(read_interfaces(folder))
+
+    # ------------------------------------------------------------------ registration
+    def add_interfaces(self, interfaces: Iterable[Interface]) -> None:
+        """Register interface files (all at once, so they may refer to each other)."""
+        definitions: dict[str, Any] = {}
+        for interface in interfaces:
+            try:
+                definitions.update(self._definitions(interface))
+            except Exception as exc:
+                raise InterfaceError(f"{interface.source}: {exc}") from exc
+        self.store.register(definitions)
+
+    def _definitions(self, interface: Interface) -> dict[str, Any]:
+        name, parts = interface.name, interface.parts
+        package = name.split("/", 1)[0]
+        if interface.kind == "msg":
+            return {name: self._parse(parts[0], name, package)}
+        if interface.kind == "srv":
+            self.services.add(name)
+            return self._service(name, self._parse(parts[0], f"{name}_Request", package),
+                                 self._parse(parts[1], f"{name}_Response", package))
+        self.actions.add(name)
+        goal, result, feedback = (f"{name}_Goal", f"{name}_Result", f"{name}_Feedback")
+        definitions = {goal: self._parse(parts[0], goal, package),
+                       result: self._parse(parts[1], result, package),
+                       feedback: self._parse(parts[2], feedback, package),
+                       f"{name}_FeedbackMessage": _struct(("goal_id", _name(UUID)),
+                                                          ("feedback", _name(feedback)))}
+        definitions.update(self._service(
+            f"{name}_SendGoal",
+            _struct(("goal_id", _name(UUID)), ("goal", _name(goal))),
+            _struct(("accepted", _base("bool")), ("stamp", _name(TIME)))))
+        definitions.update(self._service(
+            f"{name}_GetResult",
+            _struct(("goal_id", _name(UUID))),
+            _struct(("status", _base("int8")), ("result", _name(result)))))
+        self._synthetic.update(action_fields(name))
+        return definitions
+
+    def _service(self, name: str, request: Any, response: Any) -> dict[str, Any]:
+        self._synthetic.update({name: service_fields(name)[name]})
+        one = 1
+        event = _struct(("info", _name(SERVICE_EVENT_INFO)),
+                        ("request", (Nodetype.SEQUENCE, (_name(f"{name}_Request"), one))),
+                        ("response", (Nodetype.SEQUENCE, (_name(f"{name}_Response"), one))))
+        return {f"{name}_Request": request, f"{name}_Response": response,
+                f"{name}_Event": event}
+
+    @staticmethod
+    def _parse(text: str, name: str, package: str) -> Any:
+        """rosbags' definition of one message part; unqualified names resolve to ``package``."""
+        as_message = f"{package}/msg/{name.rsplit('/', 1)[-1]}"
+        consts, fields = get_types_from_msg(text, as_message)[as_message]
+        if not fields:  # ROS gives an empty struct one uint8 member, on the wire too
+            fields = [(EMPTY_STRUCT_FIELD, (Nodetype.BASE, ("uint8", 0)))]
+        for field_name, (node_type, spec) in fields:
+            if isinstance(spec, str) and spec.endswith("/wstring"):
+                raise InterfaceError(f"field {field_name!r} of {name}: wstring is not supported")
+        return consts, fields
+
+    # ------------------------------------------------------------------ queries
+    def __contains__(self, type_name: object) -> bool:
+        return type_name in self.store.fielddefs or type_name in self._synthetic
+
+    def names(self) -> list[str]:
+        """Every registered message type, plus service and action names."""
+        return sorted({*self.store.fielddefs, *self.services, *self.actions})
+
+    def fields(self, type_name: str) -> Fields:
+        """A type's fields in type-hash form (synthetic service and action types included)."""
+        synthetic = self._synthetic.get(type_name)
+        if synthetic is not None:
+            return synthetic
+        try:
+            return fields_from_rosbags(self.store.fielddefs[type_name][1])
+        except KeyError:
+            raise KeyError(f"unknown type {type_name!r}") from None
+
+    def hash(self, type_name: str) -> str:
+        """The RIHS01 type hash of a message, service or action, as in rmw_zenoh's keys."""
+        return rihs01(type_name, self.fields)
+
+    def message_class(self, type_name: str) -> type:
+        """The Python class (a dataclass) for a message type."""
+        try:
+            cls: type = self.store.types[type_name]
+        except KeyError:
+            raise KeyError(f"unknown message type {type_name!r}") from None
+        return cls
+
+    def serialize(self, message: Any, type_name: str) -> memoryview:
+        """CDR bytes (little endian, with the 4-byte encapsulation header)."""
+        data: memoryview = self.store.serialize_cdr(message, type_name)
+        return data
+
+    def deserialize(self, data: bytes | bytearray | memoryview, type_name: str) -> Any:
+        """A message from CDR bytes; primitive arrays are read-only numpy views on ``data``.
+
+        Nothing is copied, and because the views are read-only, one receiver of a buffer
+        cannot change what another receiver of the same buffer sees.
+        """
+        return self.store.deserialize_cdr(memoryview(data).toreadonly(), type_name)
+
+
+def _base(type_name: str) -> tuple[Nodetype, tuple[str, int]]:
+    return (Nodetype.BASE, (type_name, 0))
+
+
+def _name(type_name: str) -> tuple[Nodetype, str]:
+    return (Nodetype.NAME, type_name)
+
+
+def _struct(*fields: tuple[str, Any]) -> tuple[list[Any], list[tuple[str, Any]]]:
+    return [], list(fields)
