@@ -149,7 +149,7 @@ class MessageTypes:
         consts, fields = get_types_from_msg(text, as_message)[as_message]
         if not fields:  # ROS gives an empty struct one uint8 member, on the wire too
             fields = [(EMPTY_STRUCT_FIELD, (Nodetype.BASE, ("uint8", 0)))]
-        for field_name, (node_type, spec) in fields:
+        for field_name, (_kind, spec) in fields:
             if isinstance(spec, str) and spec.endswith("/wstring"):
                 raise InterfaceError(f"field {field_name!r} of {name}: wstring is not supported")
         return consts, fields
