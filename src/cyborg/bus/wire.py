@@ -46,7 +46,10 @@ def fully_qualified(namespace: str, name: str) -> str:
 
 
 def dds_type_name(type_name: str) -> str:
-    """``std_msgs/msg/String`` -> ``std_msgs::msg::dds_::String_`` (services: ``pkg::srv::dds_::X_``)."""
+    """``std_msgs/msg/String`` -> ``std_msgs::msg::dds_::String_``.
+
+    A service ``pkg/srv/X`` becomes ``pkg::srv::dds_::X_`` (no Request/Response suffix).
+    """
     package, kind, name = type_name.split("/")
     return f"{package}::{kind}::dds_::{name}_"
 
