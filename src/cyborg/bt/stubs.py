@@ -20,9 +20,6 @@ class StubLeaf(Action):
 
     result: Status = Status.SUCCESS
 
-    def __init__(self) -> None:
-        pass
-
     def tick(self) -> Status:
         return self.result
 

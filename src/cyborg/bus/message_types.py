@@ -135,10 +135,10 @@ class MessageTypes:
 
     def _service(self, name: str, request: Any, response: Any) -> dict[str, Any]:
         self._synthetic.update({name: service_fields(name)[name]})
-        one = 1
+        # X_Event carries the request and the response as sequences bounded to one element.
         event = _struct(("info", _name(SERVICE_EVENT_INFO)),
-                        ("request", (Nodetype.SEQUENCE, (_name(f"{name}_Request"), one))),
-                        ("response", (Nodetype.SEQUENCE, (_name(f"{name}_Response"), one))))
+                        ("request", (Nodetype.SEQUENCE, (_name(f"{name}_Request"), 1))),
+                        ("response", (Nodetype.SEQUENCE, (_name(f"{name}_Response"), 1))))
         return {f"{name}_Request": request, f"{name}_Response": response,
                 f"{name}_Event": event}
 
