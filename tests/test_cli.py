@@ -85,10 +85,11 @@ def test_bad_node_module_is_a_one_line_error(tmp_path: Path, monkeypatch: pytest
     monkeypatch.syspath_prepend(str(tmp_path))
     assert main(["bt", "validate", str(STOCK), "--nodes", "no_such_module"]) == 1
     err = capsys.readouterr().err
-    assert "cannot import node module 'no_such_module' (--nodes): ModuleNotFoundError" in err
+    assert "cannot import node module 'no_such_module': ModuleNotFoundError" in err
+    assert err.rstrip().endswith("(--nodes)")
     assert main(["bt", "run", str(STOCK), "--nodes", "broken_nodes"]) == 1
     err = capsys.readouterr().err
-    assert "'broken_nodes' (--nodes): ValueError: oops in module" in err
+    assert "cannot import node module 'broken_nodes': ValueError: oops in module (--nodes)" in err
     assert "Traceback" not in err
 
 

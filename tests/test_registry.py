@@ -176,3 +176,12 @@ def test_entry_points_add_nodes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch)
 def test_unknown_name_after_entry_points_still_lists_names() -> None:
     with pytest.raises(TreeLoadError, match=r"registered: .*Sequence"):
         loads_tree(json.dumps(tree_json(N("NoSuchNode"))), registry=default_registry())
+
+
+def test_import_modules_names_the_failing_module() -> None:
+    from cyborg.bt.registry import NodeModuleError
+
+    reg = default_registry(entry_points=False)
+    with pytest.raises(NodeModuleError, match=r"cannot import node module 'no_such_nodes': "
+                                               r"ModuleNotFoundError"):
+        reg.import_modules(["no_such_nodes"])

@@ -11,6 +11,7 @@ from typing import Any, TextIO
 
 from cyborg.app.status_line import StatusLine
 from cyborg.bt import (
+    Clock,
     ManualClock,
     MonotonicClock,
     NodeRegistry,
@@ -23,6 +24,7 @@ from cyborg.bt import (
     load_tree,
 )
 from cyborg.bt.problems import Problem
+from cyborg.bt.registry import NodeModuleError
 
 
 def add_parser(commands: Any) -> None:
@@ -93,14 +95,17 @@ def run_options_problem(args: argparse.Namespace) -> str | None:
     return None
 
 
+def run_clock(args: argparse.Namespace) -> Clock:
+    """Simulated time with ``--fast``, else the wall clock."""
+    return ManualClock() if args.fast else MonotonicClock()
+
+
 def registry_for(args: argparse.Namespace) -> NodeRegistry:
     registry = default_registry()
-    for module in args.nodes:
-        try:
-            registry.import_modules([module])
-        except Exception as exc:
-            raise CommandError(f"cannot import node module {module!r} (--nodes): "
-                               f"{type(exc).__name__}: {exc}") from exc
+    try:
+        registry.import_modules(args.nodes)
+    except NodeModuleError as exc:
+        raise CommandError(f"{exc} (--nodes)") from exc
     return registry
 
 
@@ -149,8 +154,7 @@ def run_command(args: argparse.Namespace) -> int:
     if problem is not None:
         print(problem, file=sys.stderr)
         return 2
-    clock = ManualClock() if args.fast else MonotonicClock()
-    tree = _load(args, clock=clock)
+    tree = _load(args, clock=run_clock(args))
     if tree is None:
         return 1
     return run_tree(tree, rate_hz=args.rate, max_ticks=args.ticks, until_done=args.until_done)

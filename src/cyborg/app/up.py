@@ -17,10 +17,11 @@ from typing import Any
 from cyborg.app.bt_commands import (
     add_run_options,
     print_problems,
+    run_clock,
     run_options_problem,
     run_tree,
 )
-from cyborg.bt import ManualClock, MonotonicClock, TreeLoadError, default_registry, load_tree
+from cyborg.bt import TreeLoadError, default_registry, load_tree
 
 DEMO_TREE = "demo.b3.json"
 
@@ -40,7 +41,7 @@ def up_command(args: argparse.Namespace) -> int:
     if problem is not None:
         print(problem, file=sys.stderr)
         return 2
-    clock = ManualClock() if args.fast else MonotonicClock()
+    clock = run_clock(args)
     resource = files("cyborg.app").joinpath("data", DEMO_TREE)
     with as_file(resource) as demo:
         path = args.tree or demo

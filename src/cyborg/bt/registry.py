@@ -119,10 +119,21 @@ class NodeRegistry:
         return problems
 
     def import_modules(self, modules: Iterable[str]) -> None:
-        """Import modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``)."""
+        """Import modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``).
+
+        Raises :class:`NodeModuleError` naming the first module that cannot be imported.
+        """
         for module in modules:
-            importlib.import_module(module)
+            try:
+                importlib.import_module(module)
+            except Exception as exc:
+                raise NodeModuleError(f"cannot import node module {module!r}: "
+                                      f"{type(exc).__name__}: {exc}") from exc
         self._types.update(_REGISTERED._types)
+
+
+class NodeModuleError(ImportError):
+    """A module of node classes could not be imported; the message names it and why."""
 
 
 _REGISTERED = NodeRegistry()
