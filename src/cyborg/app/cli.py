@@ -6,6 +6,11 @@
     cyborg bt dot FILE             the tree as a Graphviz DOT graph
     cyborg bt json FILE            the tree's structure as JSON
     cyborg bt nodes                list the node types trees can use
+    cyborg router                  run a Zenoh router (the bus's meeting point)
+    cyborg node list|info          nodes on the bus (ours and ROS 2 peers)
+    cyborg topic list|echo|pub|hz  topics on the bus
+    cyborg service list|call       services on the bus
+    cyborg param list|get|set      parameters of a node
 
 Exit codes: 0 success, 1 the input has errors, 2 wrong usage, 130 interrupted.
 """
@@ -18,7 +23,7 @@ import sys
 from collections.abc import Sequence
 
 from cyborg import __version__
-from cyborg.app import bt_commands, up
+from cyborg.app import bt_commands, bus_commands, up
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -30,6 +35,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     up.add_parser(commands)
     bt_commands.add_parser(commands)
+    bus_commands.add_parser(commands)
     return parser
 
 

@@ -1,11 +1,26 @@
 """Messaging for cyborg's programs, on Zenoh and wire-compatible with ROS 2 (rmw_zenoh).
 
-So far: ROS 2 message, service and action types with CDR and RIHS01 type hashes
-(:mod:`cyborg.bus.message_types`, :mod:`cyborg.bus.type_hash`), and rmw_zenoh's keys, liveliness
-tokens, QoS strings, GIDs and attachments (:mod:`cyborg.bus.wire`). This package imports nothing
-else of cyborg.
+* :class:`Context` — one Zenoh session per process; :class:`BusConfig` says how it connects;
+* :class:`Node` — publishers and subscriptions (latched too), services, actions, parameters,
+  timers (:mod:`cyborg.bus.node`);
+* ROS 2 message, service and action types with CDR and RIHS01 type hashes
+  (:class:`MessageTypes`), and rmw_zenoh's keys, tokens, QoS strings, GIDs and attachments
+  (:mod:`cyborg.bus.wire`);
+* the ROS graph from liveliness tokens (:mod:`cyborg.bus.graph`).
+
+This package imports nothing else of cyborg.
 """
 
+from cyborg.bus.actions import ActionError, ClientGoal, GoalStatus, ServerGoal
+from cyborg.bus.config import BusConfig, BusConfigError
+from cyborg.bus.context import Context
+from cyborg.bus.conversion import MessageValueError, new_message, to_plain
 from cyborg.bus.message_types import BUNDLED_INTERFACES, InterfaceError, MessageTypes
+from cyborg.bus.node import Node, default_context
+from cyborg.bus.services import ServiceError, ServiceTimeoutError
+from cyborg.bus.wire import Durability, History, Qos, Reliability
 
-__all__ = ["BUNDLED_INTERFACES", "InterfaceError", "MessageTypes"]
+__all__ = ["BUNDLED_INTERFACES", "ActionError", "BusConfig", "BusConfigError", "ClientGoal",
+           "Context", "Durability", "GoalStatus", "History", "InterfaceError", "MessageTypes",
+           "MessageValueError", "Node", "Qos", "Reliability", "ServerGoal", "ServiceError",
+           "ServiceTimeoutError", "default_context", "new_message", "to_plain"]

@@ -43,6 +43,10 @@ BUNDLED_INTERFACES = Path(__file__).with_name("interfaces")
 _KINDS = {"msg": 1, "srv": 2, "action": 3}  # file kind -> number of `---` separated parts
 
 
+CDR_LITTLE_ENDIAN = b"\x00\x01\x00\x00"
+"""The encapsulation header of little-endian plain CDR, as rmw_zenoh writes it."""
+
+
 class InterfaceError(ValueError):
     """An interface file could not be read; the message names the file and the reason."""
 
@@ -186,8 +190,24 @@ class MessageTypes:
 
     def serialize(self, message: Any, type_name: str) -> memoryview:
         """CDR bytes (little endian, with the 4-byte encapsulation header)."""
-        data: memoryview = self.store.serialize_cdr(message, type_name)
+        data: memoryview = self.store.serialize_cdr(message, type_name, little_endian=True)
         return data
+
+    def cdr_size(self, message: Any, type_name: str) -> int:
+        """The length of ``message`` in CDR, header included, without serialising it."""
+        size: int = 4 + self.store.get_msgdef(type_name).getsize_cdr(0, message, self.store)
+        return size
+
+    def serialize_into(self, message: Any, type_name: str, buffer: memoryview) -> int:
+        """Write the CDR of ``message`` into ``buffer`` (e.g. shared memory); returns its length.
+
+        ``buffer`` must hold :meth:`cdr_size` bytes. This is the one copy a large message costs
+        on its way to another process.
+        """
+        msgdef = self.store.get_msgdef(type_name)
+        buffer[0:4] = CDR_LITTLE_ENDIAN
+        end: int = msgdef.serialize_cdr_le(buffer[4:], 0, message, self.store)
+        return end + 4
 
     def deserialize(self, data: bytes | bytearray | memoryview, type_name: str) -> Any:
         """A message from CDR bytes; primitive arrays are read-only numpy views on ``data``.

@@ -1,0 +1,326 @@
+"""``cyborg router|node|topic|service|param``: the bus from the shell, in the ros2 style.
+
+    cyborg router                          run a Zenoh router (the local meeting point)
+    cyborg node list                       nodes alive now (ours and ROS 2 peers)
+    cyborg topic list -t                   topics with their types
+    cyborg topic echo /robot/battery       print messages as YAML
+    cyborg topic pub /chatter std_msgs/msg/String "{data: hi}" --once
+    cyborg topic hz /camera/image
+    cyborg service call /add example_interfaces/srv/AddTwoInts "{a: 2, b: 40}"
+    cyborg param set /detector confidence_threshold 0.6
+
+Every command takes ``--connect ENDPOINT`` to reach another machine's router.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import sys
+import threading
+import time
+from typing import Any
+
+import yaml
+
+from cyborg.app.bt_commands import CommandError
+from cyborg.app.param_commands import add_param_parser
+from cyborg.bus import BusConfig, Context, MessageValueError, Node, Qos, new_message, to_plain
+from cyborg.bus.config import BusConfigError
+from cyborg.bus.wire import EntityKind
+
+ARRAY_PREVIEW = 16
+
+
+def add_parser(commands: Any) -> None:
+    router = commands.add_parser("router", help="run a Zenoh router for the bus")
+    router.add_argument("--listen", action="append", default=[], metavar="ENDPOINT",
+                        help="where to listen (default tcp/127.0.0.1:7447; tcp/[::]:7447 for "
+                             "other machines)")
+    router.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="another router to link to (repeatable)")
+    router.set_defaults(handler=router_command)
+
+    node = _group(commands, "node", "nodes on the bus")
+    listing = node.add_parser("list", help="list live nodes")
+    _connection(listing)
+    listing.set_defaults(handler=node_list)
+    info = node.add_parser("info", help="a node's publishers, subscriptions and services")
+    info.add_argument("name")
+    _connection(info)
+    info.set_defaults(handler=node_info)
+
+    topic = _group(commands, "topic", "topics on the bus")
+    listing = topic.add_parser("list", help="list topics")
+    listing.add_argument("-t", "--show-types", action="store_true")
+    _connection(listing)
+    listing.set_defaults(handler=topic_list)
+    echo = topic.add_parser("echo", help="print messages of a topic as YAML")
+    echo.add_argument("topic")
+    echo.add_argument("type", nargs="?", help="message type (default: from the graph)")
+    echo.add_argument("--once", action="store_true", help="print one message and exit")
+    echo.add_argument("--count", type=int, default=0, help="exit after this many messages")
+    echo.add_argument("--timeout", type=float, default=0.0, help="give up after S seconds")
+    echo.add_argument("--latched", action="store_true", help="also get the latched message")
+    echo.add_argument("--full", action="store_true", help="print long arrays in full")
+    _connection(echo)
+    echo.set_defaults(handler=topic_echo)
+    pub = topic.add_parser("pub", help="publish a message given as YAML")
+    pub.add_argument("topic")
+    pub.add_argument("type")
+    pub.add_argument("values", nargs="?", default="{}", help="fields as YAML, e.g. '{data: hi}'")
+    pub.add_argument("-r", "--rate", type=float, default=1.0, help="messages per second")
+    pub.add_argument("--once", action="store_true", help="publish once, then exit")
+    pub.add_argument("--times", type=int, default=0, help="publish this many times, then exit")
+    pub.add_argument("--latched", action="store_true", help="latched (transient local)")
+    _connection(pub)
+    pub.set_defaults(handler=topic_pub)
+    hz = topic.add_parser("hz", help="print the rate of a topic")
+    hz.add_argument("topic")
+    hz.add_argument("type", nargs="?")
+    hz.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
+    _connection(hz)
+    hz.set_defaults(handler=topic_hz)
+
+    service = _group(commands, "service", "services on the bus")
+    listing = service.add_parser("list", help="list services")
+    listing.add_argument("-t", "--show-types", action="store_true")
+    _connection(listing)
+    listing.set_defaults(handler=service_list)
+    call = service.add_parser("call", help="call a service with a request given as YAML")
+    call.add_argument("name")
+    call.add_argument("type", nargs="?", help="service type (default: from the graph)")
+    call.add_argument("values", nargs="?", default="{}")
+    call.add_argument("--timeout", type=float, default=5.0)
+    _connection(call)
+    call.set_defaults(handler=service_call)
+
+    add_param_parser(_group(commands, "param", "parameters of a node"), _connection)
+
+
+def _group(commands: Any, name: str, text: str) -> Any:
+    parser = commands.add_parser(name, help=text)
+    return parser.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND", required=True)
+
+
+def _connection(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="router to join (default $CYBORG_CONNECT or tcp/127.0.0.1:7447)")
+    parser.add_argument("--wait", type=float, default=1.0, metavar="S",
+                        help="seconds to wait for the graph to fill (default 1)")
+
+
+def open_context(args: argparse.Namespace) -> Context:
+    """A context for a command; waits until the router is reached and the graph settles."""
+    try:
+        context = Context(BusConfig.from_environment(args.connect))
+    except BusConfigError as exc:
+        raise CommandError(str(exc)) from exc
+    deadline = time.monotonic() + max(args.wait, 0.1) + 1.0
+    while time.monotonic() < deadline:
+        info = context.session.info
+        if info.routers_zid() or info.peers_zid():
+            break
+        time.sleep(0.05)
+    else:
+        endpoints = ", ".join(context.config.connect) or "(none)"
+        context.close()
+        raise CommandError(f"no router reachable at {endpoints}; start one with "
+                           "`cyborg router` (or `cyborg up`), or pass --connect")
+    time.sleep(args.wait)
+    return context
+
+
+def router_command(args: argparse.Namespace) -> int:
+    listen = args.listen or ["tcp/127.0.0.1:7447"]
+    try:
+        context = Context(BusConfig.router(listen, args.connect))
+    except BusConfigError as exc:
+        raise CommandError(str(exc)) from exc
+    except Exception as exc:
+        raise CommandError(f"cannot start a router on {', '.join(listen)}: {exc}") from exc
+    print(f"cyborg router {context.zid} listening on {', '.join(listen)} (Ctrl-C stops)",
+          flush=True)
+    try:
+        threading.Event().wait()
+    finally:
+        context.close()
+    return 0
+
+
+def node_list(args: argparse.Namespace) -> int:
+    with open_context(args) as context:
+        for name in context.graph.nodes():
+            print(name)
+    return 0
+
+
+def node_info(args: argparse.Namespace) -> int:
+    with open_context(args) as context:
+        if args.name not in context.graph.nodes():
+            raise CommandError(f"no node {args.name!r} (see `cyborg node list`)")
+        print(args.name)
+        titles = {EntityKind.PUBLISHER: "Publishers", EntityKind.SUBSCRIPTION: "Subscribers",
+                  EntityKind.SERVICE_SERVER: "Service Servers",
+                  EntityKind.SERVICE_CLIENT: "Service Clients"}
+        endpoints = context.graph.node_endpoints(args.name)
+        for kind, title in titles.items():
+            print(f"  {title}:")
+            for entity in sorted({(e.topic, e.type_name) for e in endpoints if e.kind is kind}):
+                print(f"    {entity[0]}: {entity[1]}")
+    return 0
+
+
+def topic_list(args: argparse.Namespace) -> int:
+    with open_context(args) as context:
+        for topic, type_names in sorted(context.graph.topics().items()):
+            print(f"{topic} [{', '.join(sorted(type_names))}]" if args.show_types else topic)
+    return 0
+
+
+def service_list(args: argparse.Namespace) -> int:
+    with open_context(args) as context:
+        for name, type_names in sorted(context.graph.services().items()):
+            print(f"{name} [{', '.join(sorted(type_names))}]" if args.show_types else name)
+    return 0
+
+
+def _absolute(name: str) -> str:
+    return name if name.startswith("/") else "/" + name
+
+
+def _type_from_graph(context: Context, name: str, found: dict[str, set[str]], what: str) -> str:
+    types = found.get(_absolute(name), set())
+    if len(types) != 1:
+        known = ", ".join(sorted(found)) or "none"
+        raise CommandError(f"{what} {name}: " + (
+            f"several types ({', '.join(sorted(types))}); give one" if types else
+            f"not in the graph; give its type (known {what}s: {known})"))
+    type_name = next(iter(types))
+    if type_name not in context.types:
+        raise CommandError(f"{what} {name}: type {type_name} is not registered here")
+    return type_name
+
+
+def _parse_values(text: str) -> dict[str, Any]:
+    try:
+        data = yaml.safe_load(text) if text.strip() else {}
+    except yaml.YAMLError as exc:
+        raise CommandError(f"values {text!r} are not YAML: {exc}") from exc
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise CommandError(f"values {text!r}: expected a mapping such as '{{data: hi}}'")
+    return data
+
+
+def _message(context: Context, type_name: str, text: str) -> Any:
+    if type_name not in context.types:
+        raise CommandError(f"unknown type {type_name!r}")
+    try:
+        return new_message(context.types, type_name, _parse_values(text))
+    except MessageValueError as exc:
+        raise CommandError(f"{type_name}: {exc}") from exc
+
+
+def _shorten(data: Any, full: bool) -> Any:
+    if isinstance(data, dict):
+        return {key: _shorten(value, full) for key, value in data.items()}
+    if isinstance(data, list):
+        if not full and len(data) > ARRAY_PREVIEW:
+            return [*data[:ARRAY_PREVIEW], f"... ({len(data)} items; --full shows all)"]
+        return [_shorten(item, full) for item in data]
+    return data
+
+
+def topic_echo(args: argparse.Namespace) -> int:
+    limit = 1 if args.once else args.count
+    with open_context(args) as context:
+        type_name = args.type or _type_from_graph(context, args.topic, context.graph.topics(),
+                                                  "topic")
+        done = threading.Event()
+        seen = [0]
+
+        def show(message: Any) -> None:
+            if done.is_set():
+                return
+            sys.stdout.write(yaml.safe_dump(_shorten(to_plain(message), args.full),
+                                            sort_keys=False) + "---\n")
+            sys.stdout.flush()
+            seen[0] += 1
+            if limit and seen[0] >= limit:
+                done.set()
+
+        node = Node("cyborg_topic_echo", context=context)
+        node.create_subscription(args.topic, type_name, show,
+                                 Qos.latched() if args.latched else Qos(depth=100))
+        finished = done.wait(args.timeout or None)
+        if args.timeout and not finished:
+            raise CommandError(f"{args.topic}: {seen[0]} message(s) within {args.timeout:g} s")
+    return 0
+
+
+def topic_pub(args: argparse.Namespace) -> int:
+    times = 1 if args.once else args.times
+    if args.rate <= 0:
+        raise CommandError(f"--rate must be positive, not {args.rate}")
+    with open_context(args) as context:
+        message = _message(context, args.type, args.values)
+        node = Node("cyborg_topic_pub", context=context)
+        publisher = node.create_publisher(args.topic, args.type,
+                                          Qos.latched() if args.latched else Qos(depth=10))
+        if not args.latched:  # give subscribers a moment to see the new publisher
+            context.graph.wait_for(lambda graph: publisher.subscription_count() > 0, 1.0)
+        sent = 0
+        while not times or sent < times:
+            publisher.publish(message)
+            sent += 1
+            print(f"publishing #{sent}: {to_plain(message)}", flush=True)
+            if not times or sent < times:
+                time.sleep(1.0 / args.rate)
+        time.sleep(0.2 if not args.latched else 0.5)  # let the last message leave
+    return 0
+
+
+def topic_hz(args: argparse.Namespace) -> int:
+    with open_context(args) as context:
+        type_name = args.type or _type_from_graph(context, args.topic, context.graph.topics(),
+                                                  "topic")
+        arrivals: list[float] = []
+        node = Node("cyborg_topic_hz", context=context)
+        node.create_subscription(args.topic, type_name,
+                                 lambda _m: arrivals.append(time.monotonic()), Qos(depth=1000))
+        started = time.monotonic()
+        while not args.duration or time.monotonic() - started < args.duration:
+            time.sleep(1.0)
+            window = arrivals[-1000:]
+            if len(window) < 2:
+                print("no new messages", flush=True)
+                continue
+            gaps = [b - a for a, b in itertools.pairwise(window)]
+            mean = sum(gaps) / len(gaps)
+            print(f"average rate: {1.0 / mean:.3f}\n\tmin: {min(gaps):.3f}s max: "
+                  f"{max(gaps):.3f}s window: {len(window)}", flush=True)
+    return 0
+
+
+def service_call(args: argparse.Namespace) -> int:
+    from cyborg.bus import ServiceError
+    if args.type and args.type.lstrip().startswith("{"):  # NAME VALUES, type from the graph
+        args.type, args.values = None, args.type
+    with open_context(args) as context:
+        type_name = args.type or _type_from_graph(context, args.name,
+                                                  context.graph.services(), "service")
+        if type_name not in context.types.services:
+            raise CommandError(f"unknown service type {type_name!r}")
+        request = _message(context, f"{type_name}_Request", args.values)
+        node = Node("cyborg_service_call", context=context)
+        client = node.create_client(args.name, type_name)
+        print(f"requester: making request: {to_plain(request)}\n")
+        try:
+            response = client.call(request, timeout=args.timeout)
+        except ServiceError as exc:
+            raise CommandError(str(exc)) from exc
+        print("response:")
+        print(yaml.safe_dump(to_plain(response), sort_keys=False), end="")
+    return 0

@@ -1,0 +1,70 @@
+"""``cyborg param list|get|set``: a node's parameters from the shell."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from typing import Any
+
+import yaml
+
+from cyborg.app.bt_commands import CommandError
+from cyborg.bus import Node, ServiceError
+from cyborg.bus.parameter_client import ParameterClient, ParameterError
+
+
+def add_param_parser(param: Any, connection: Callable[[argparse.ArgumentParser], None]) -> None:
+    listing = param.add_parser("list", help="a node's parameters")
+    listing.add_argument("node")
+    connection(listing)
+    listing.set_defaults(handler=param_list)
+    get = param.add_parser("get", help="a parameter's value")
+    get.add_argument("node")
+    get.add_argument("name")
+    connection(get)
+    get.set_defaults(handler=param_get)
+    set_ = param.add_parser("set", help="set a parameter (the value is read as YAML)")
+    set_.add_argument("node")
+    set_.add_argument("name")
+    set_.add_argument("value")
+    connection(set_)
+    set_.set_defaults(handler=param_set)
+
+
+def _client(args: argparse.Namespace, run: Callable[[ParameterClient], None]) -> int:
+    from cyborg.app.bus_commands import open_context
+    with open_context(args) as context:
+        target = args.node if args.node.startswith("/") else "/" + args.node
+        if target not in context.graph.nodes():
+            raise CommandError(f"no node {target!r} (see `cyborg node list`)")
+        client = ParameterClient(Node("cyborg_param", context=context), target)
+        try:
+            run(client)
+        except (ParameterError, ServiceError) as exc:
+            raise CommandError(str(exc)) from exc
+    return 0
+
+
+def param_list(args: argparse.Namespace) -> int:
+    return _client(args, lambda client: print(
+        "\n".join(f"  {name}" for name in client.names())))
+
+
+def param_get(args: argparse.Namespace) -> int:
+    def show(client: ParameterClient) -> None:
+        value = client.get([args.name])[args.name]
+        print(yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("..."
+                                                                                   ).strip())
+    return _client(args, show)
+
+
+def param_set(args: argparse.Namespace) -> int:
+    try:
+        value = yaml.safe_load(args.value)
+    except yaml.YAMLError as exc:
+        raise CommandError(f"value {args.value!r} is not YAML: {exc}") from exc
+
+    def apply(client: ParameterClient) -> None:
+        client.set({args.name: value})
+        print("Set parameter successful")
+    return _client(args, apply)

@@ -1,0 +1,367 @@
+"""Actions: long-running goals with feedback, a result and cancel, in ROS 2's conventions.
+
+An action ``/robot/move_to_goal`` is three services and two topics under ``_action``:
+``send_goal``, ``cancel_goal`` (action_msgs/srv/CancelGoal) and ``get_result`` services, the
+``feedback`` topic and the latched ``status`` topic (action_msgs/msg/GoalStatusArray).
+
+Server side, ``execute(goal)`` runs on a thread of its own per goal and returns the result; it
+reports progress with ``goal.publish_feedback(...)`` and should watch ``goal.cancel_requested``
+(then stop and call ``goal.canceled()``). Returning ends the goal as SUCCEEDED, unless it called
+``goal.abort()`` or ``goal.canceled()``; raising ends it as ABORTED.
+
+Client side::
+
+    goal = client.send_goal(Goal(goal_name="kitchen"), feedback=print)
+    goal.cancel()                      # later, e.g. when a behaviour is halted
+    status, result = goal.result(timeout=60)
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from concurrent.futures import Future
+from enum import IntEnum
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from cyborg.bus.services import Responder, ServiceError
+from cyborg.bus.wire import Qos
+
+if TYPE_CHECKING:
+    from cyborg.bus.node import Node
+
+log = logging.getLogger("cyborg.bus")
+
+STATUS_QOS = Qos.latched(depth=1)
+KEEP_FINISHED = 100
+"""Finished goals whose results can still be fetched."""
+
+
+class GoalStatus(IntEnum):
+    """action_msgs/msg/GoalStatus values."""
+
+    UNKNOWN = 0
+    ACCEPTED = 1
+    EXECUTING = 2
+    CANCELING = 3
+    SUCCEEDED = 4
+    CANCELED = 5
+    ABORTED = 6
+
+    @property
+    def terminal(self) -> bool:
+        return self >= GoalStatus.SUCCEEDED
+
+
+class ActionError(RuntimeError):
+    """A goal was rejected, or the action server could not be reached."""
+
+
+def _stamp(types: Any, seconds: float | None = None) -> Any:
+    now = time.time() if seconds is None else seconds
+    return types.message_class("builtin_interfaces/msg/Time")(
+        sec=int(now), nanosec=int((now % 1) * 1e9))
+
+
+def _uuid(types: Any, raw: bytes) -> Any:
+    return types.message_class("unique_identifier_msgs/msg/UUID")(
+        uuid=np.frombuffer(raw, dtype=np.uint8).copy())
+
+
+class ServerGoal:
+    """One goal on the server: the request, its status, feedback and cancel flag."""
+
+    def __init__(self, server: ActionServer, goal_id: bytes, request: Any) -> None:
+        self.server, self.id, self.request = server, goal_id, request
+        self.status = GoalStatus.ACCEPTED
+        self.accepted_at = time.time()
+        self._cancel = threading.Event()
+        self._ending: GoalStatus | None = None
+
+    @property
+    def cancel_requested(self) -> bool:
+        return self._cancel.is_set()
+
+    def publish_feedback(self, feedback: Any) -> None:
+        self.server._feedback(self, feedback)
+
+    def abort(self) -> None:
+        self._ending = GoalStatus.ABORTED
+
+    def canceled(self) -> None:
+        self._ending = GoalStatus.CANCELED
+
+    def succeed(self) -> None:
+        self._ending = GoalStatus.SUCCEEDED
+
+
+class ActionServer:
+    """Accepts goals, runs ``execute(goal) -> result`` for each, answers result requests.
+
+    ``accept(request) -> bool`` may reject goals; ``cancel(goal) -> bool`` may refuse a cancel.
+    """
+
+    def __init__(self, node: Node, name: str, action_type: str,
+                 execute: Callable[[ServerGoal], Any], *,
+                 accept: Callable[[Any], bool] | None = None,
+                 cancel: Callable[[ServerGoal], bool] | None = None) -> None:
+        types = node.types
+        if action_type not in types.actions:
+            raise KeyError(f"{name}: unknown action type {action_type!r}")
+        self.node, self.types, self.action_type = node, types, action_type
+        self.execute, self.accept, self.allow_cancel = execute, accept, cancel
+        self.name = name
+        self._goals: dict[bytes, ServerGoal] = {}
+        self._results: dict[bytes, tuple[GoalStatus, Any]] = {}
+        self._waiting: dict[bytes, list[Responder]] = {}
+        self._lock = threading.Lock()
+        base = f"{name}/_action/"
+        self._entities: list[Any] = [
+            node.create_service(base + "send_goal", f"{action_type}_SendGoal", self._on_goal),
+            node.create_service(base + "cancel_goal", "action_msgs/srv/CancelGoal",
+                                self._on_cancel),
+            node.create_service(base + "get_result", f"{action_type}_GetResult",
+                                self._on_get_result, deferred=True)]
+        self._feedback_pub = node.create_publisher(
+            base + "feedback", f"{action_type}_FeedbackMessage")
+        self._status_pub = node.create_publisher(
+            base + "status", "action_msgs/msg/GoalStatusArray", STATUS_QOS)
+        self._publish_status()
+
+    def _on_goal(self, request: Any) -> Any:
+        goal_id = bytes(request.goal_id.uuid)
+        accepted = self.accept(request.goal) if self.accept is not None else True
+        response = self.types.message_class(f"{self.action_type}_SendGoal_Response")(
+            accepted=bool(accepted), stamp=_stamp(self.types))
+        if accepted:
+            goal = ServerGoal(self, goal_id, request.goal)
+            with self._lock:
+                self._goals[goal_id] = goal
+            self._publish_status()
+            threading.Thread(target=self._run, args=(goal,), daemon=True,
+                             name=f"cyborg-goal{self.name}").start()
+        return response
+
+    def _run(self, goal: ServerGoal) -> None:
+        self._set_status(goal, GoalStatus.EXECUTING)
+        result_class = self.types.message_class(f"{self.action_type}_Result")
+        try:
+            result = self.execute(goal)
+            status = goal._ending or GoalStatus.SUCCEEDED
+        except Exception as exc:
+            log.error("action %s: execute raised %s: %s", self.name, type(exc).__name__, exc,
+                      exc_info=True)
+            result, status = None, GoalStatus.ABORTED
+        if not isinstance(result, result_class):
+            if result is not None:
+                log.error("action %s: execute returned %s, not %s_Result", self.name,
+                          type(result).__name__, self.action_type)
+                status = GoalStatus.ABORTED
+            result = _default(self.types, f"{self.action_type}_Result")
+        self._finish(goal, status, result)
+
+    def _finish(self, goal: ServerGoal, status: GoalStatus, result: Any) -> None:
+        with self._lock:
+            self._results[goal.id] = (status, result)
+            while len(self._results) > KEEP_FINISHED:
+                oldest = next(iter(self._results))
+                self._results.pop(oldest)
+                self._goals.pop(oldest, None)
+            waiting = self._waiting.pop(goal.id, [])
+        self._set_status(goal, status)
+        for responder in waiting:
+            responder.reply(self._result_response(status, result))
+
+    def _result_response(self, status: GoalStatus, result: Any) -> Any:
+        return self.types.message_class(f"{self.action_type}_GetResult_Response")(
+            status=int(status), result=result)
+
+    def _on_get_result(self, request: Any, responder: Responder) -> None:
+        goal_id = bytes(request.goal_id.uuid)
+        with self._lock:
+            finished = self._results.get(goal_id)
+            if finished is None and goal_id in self._goals:
+                self._waiting.setdefault(goal_id, []).append(responder)
+                return
+        if finished is None:  # unknown goal: ROS answers UNKNOWN with an empty result
+            result_type = f"{self.action_type}_Result"
+            responder.reply(self._result_response(GoalStatus.UNKNOWN,
+                                                  _default(self.types, result_type)))
+            return
+        responder.reply(self._result_response(*finished))
+
+    def _on_cancel(self, request: Any) -> Any:
+        wanted = bytes(request.goal_info.goal_id.uuid)
+        before = request.goal_info.stamp.sec + request.goal_info.stamp.nanosec * 1e-9
+        with self._lock:
+            candidates = [g for g in self._goals.values() if not g.status.terminal]
+        if any(wanted):
+            candidates = [g for g in candidates if g.id == wanted]
+        elif before:
+            candidates = [g for g in candidates if g.accepted_at <= before]
+        canceling = [g for g in candidates
+                     if self.allow_cancel is None or self.allow_cancel(g)]
+        for goal in canceling:
+            goal._cancel.set()
+            self._set_status(goal, GoalStatus.CANCELING)
+        code = 0 if canceling or not candidates else 1
+        if any(wanted) and not candidates:
+            code = 3 if wanted in self._goals else 2
+        info = self.types.message_class("action_msgs/msg/GoalInfo")
+        return self.types.message_class("action_msgs/srv/CancelGoal_Response")(
+            return_code=code, goals_canceling=[
+                info(goal_id=_uuid(self.types, g.id), stamp=_stamp(self.types, g.accepted_at))
+                for g in canceling])
+
+    def _feedback(self, goal: ServerGoal, feedback: Any) -> None:
+        message = self.types.message_class(f"{self.action_type}_FeedbackMessage")(
+            goal_id=_uuid(self.types, goal.id), feedback=feedback)
+        self._feedback_pub.publish(message)
+
+    def _set_status(self, goal: ServerGoal, status: GoalStatus) -> None:
+        if goal.status.terminal:
+            return
+        goal.status = status
+        self._publish_status()
+
+    def _publish_status(self) -> None:
+        types = self.types
+        status_class = types.message_class("action_msgs/msg/GoalStatus")
+        info = types.message_class("action_msgs/msg/GoalInfo")
+        with self._lock:
+            goals = list(self._goals.values())
+        self._status_pub.publish(types.message_class("action_msgs/msg/GoalStatusArray")(
+            status_list=[status_class(goal_info=info(goal_id=_uuid(types, g.id),
+                                                     stamp=_stamp(types, g.accepted_at)),
+                                      status=int(g.status)) for g in goals]))
+
+    def destroy(self) -> None:
+        with self._lock:
+            goals = list(self._goals.values())
+        for goal in goals:
+            goal._cancel.set()
+        for entity in (*self._entities, self._feedback_pub, self._status_pub):
+            entity.destroy()
+
+
+def _default(types: Any, type_name: str) -> Any:
+    from cyborg.bus.conversion import new_message
+    return new_message(types, type_name)
+
+
+class ClientGoal:
+    """A goal sent by an :class:`ActionClient`: status, last feedback, result, cancel."""
+
+    def __init__(self, client: ActionClient, goal_id: bytes, accepted: bool,
+                 on_feedback: Callable[[Any], object] | None = None) -> None:
+        self.client, self.id, self.accepted = client, goal_id, accepted
+        self.on_feedback = on_feedback
+        self.status = GoalStatus.ACCEPTED if accepted else GoalStatus.UNKNOWN
+        self.feedback: Any = None
+        self._result: Future[tuple[GoalStatus, Any]] = Future()
+        if accepted:
+            client.node.context.calls.submit(self._fetch_result)
+
+    def _fetch_result(self) -> None:
+        request = self.client.types.message_class(
+            f"{self.client.action_type}_GetResult_Request")(
+            goal_id=_uuid(self.client.types, self.id))
+        while not self._result.done():
+            try:
+                response = self.client._get_result.call(request, timeout=3600.0)
+            except ServiceError as exc:
+                if self.client._closed:
+                    self._result.set_exception(ActionError(f"{self.client.name}: client closed"))
+                    return
+                log.debug("get_result of %s: %s; retrying", self.client.name, exc)
+                time.sleep(0.5)
+                continue
+            self.status = GoalStatus(response.status)
+            self._result.set_result((self.status, response.result))
+
+    @property
+    def done(self) -> bool:
+        return self._result.done()
+
+    def result(self, timeout: float | None = None) -> tuple[GoalStatus, Any]:
+        """Block until the goal ends; returns ``(status, result)``."""
+        return self._result.result(timeout)
+
+    def add_done_callback(self, callback: Callable[[ClientGoal], object]) -> None:
+        self._result.add_done_callback(lambda _future: callback(self))
+
+    def cancel(self, timeout: float = 5.0) -> bool:
+        """Ask the server to cancel; True if it agreed (the result then says CANCELED)."""
+        return self.client._cancel(self, timeout)
+
+
+class ActionClient:
+    """Sends goals to an action server and follows them."""
+
+    def __init__(self, node: Node, name: str, action_type: str) -> None:
+        types = node.types
+        if action_type not in types.actions:
+            raise KeyError(f"{name}: unknown action type {action_type!r}")
+        self.node, self.types, self.name, self.action_type = node, types, name, action_type
+        self._goals: dict[bytes, ClientGoal] = {}
+        self._closed = False
+        base = f"{name}/_action/"
+        self._send = node.create_client(base + "send_goal", f"{action_type}_SendGoal")
+        self._cancel_client = node.create_client(base + "cancel_goal",
+                                                 "action_msgs/srv/CancelGoal")
+        self._get_result = node.create_client(base + "get_result", f"{action_type}_GetResult")
+        self._feedback_sub = node.create_subscription(
+            base + "feedback", f"{action_type}_FeedbackMessage", self._on_feedback)
+        self._status_sub = node.create_subscription(
+            base + "status", "action_msgs/msg/GoalStatusArray", self._on_status, STATUS_QOS)
+
+    def wait_for_server(self, timeout: float = 5.0) -> bool:
+        return self._send.wait_for_service(timeout)
+
+    def send_goal(self, goal: Any, feedback: Callable[[Any], object] | None = None,
+                  timeout: float = 5.0) -> ClientGoal:
+        """Send a goal; raises :class:`ActionError` if the server rejects it or is absent."""
+        goal_id = uuid.uuid4().bytes
+        request = self.types.message_class(f"{self.action_type}_SendGoal_Request")(
+            goal_id=_uuid(self.types, goal_id), goal=goal)
+        try:
+            response = self._send.call(request, timeout)
+        except ServiceError as exc:
+            raise ActionError(f"action {self.name}: {exc}") from exc
+        if not response.accepted:
+            raise ActionError(f"action {self.name}: the server rejected the goal")
+        handle = ClientGoal(self, goal_id, True, feedback)
+        self._goals[goal_id] = handle
+        return handle
+
+    def _cancel(self, goal: ClientGoal, timeout: float) -> bool:
+        info = self.types.message_class("action_msgs/msg/GoalInfo")(
+            goal_id=_uuid(self.types, goal.id), stamp=_stamp(self.types, 0.0))
+        request = self.types.message_class("action_msgs/srv/CancelGoal_Request")(goal_info=info)
+        response = self._cancel_client.call(request, timeout)
+        return int(response.return_code) == 0 and bool(response.goals_canceling)
+
+    def _on_feedback(self, message: Any) -> None:
+        goal = self._goals.get(bytes(message.goal_id.uuid))
+        if goal is None:
+            return
+        goal.feedback = message.feedback
+        if goal.on_feedback is not None:
+            goal.on_feedback(message.feedback)
+
+    def _on_status(self, message: Any) -> None:
+        for entry in message.status_list:
+            goal = self._goals.get(bytes(entry.goal_info.goal_id.uuid))
+            if goal is not None and not goal.done:
+                goal.status = GoalStatus(entry.status)
+
+    def destroy(self) -> None:
+        self._closed = True
+        for entity in (self._send, self._cancel_client, self._get_result, self._feedback_sub,
+                       self._status_sub):
+            entity.destroy()

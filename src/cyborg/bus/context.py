@@ -1,0 +1,184 @@
+"""One Zenoh session per process, shared by every node in it.
+
+A :class:`Context` owns the session, the message types, the ROS graph (from liveliness tokens),
+the table for in-process delivery, and the counters of dropped input. Nodes created in the same
+context exchange messages in-process without serialising them; nodes in other contexts, other
+processes or other machines are reached through Zenoh.
+
+    with Context() as context:                 # joins the local router, if one runs
+        talker = Node("talker", context=context)
+        ...
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import logging
+import socket
+import threading
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import zenoh
+
+from cyborg.bus.config import BusConfig
+from cyborg.bus.graph import Graph
+from cyborg.bus.message_types import MessageTypes
+from cyborg.bus.readonly import ReadonlyCopier
+from cyborg.bus.wire import LIVELINESS_PREFIX, domain_id
+
+log = logging.getLogger("cyborg.bus")
+
+SHM_PREFIX = "@cyborg_shm"
+"""Liveliness tokens and keys of subscriptions that take large messages through shared memory."""
+
+
+def host_id() -> str:
+    """Identifies this machine (and boot), so shared memory is only offered to local peers."""
+    boot = Path("/proc/sys/kernel/random/boot_id")
+    text = socket.gethostname() + (boot.read_text().strip() if boot.exists() else "")
+    return hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+
+
+class Context:
+    """A process's connection to the bus. Close it (or use ``with``) to leave cleanly."""
+
+    def __init__(self, config: BusConfig | None = None, *, types: MessageTypes | None = None,
+                 domain: int | None = None) -> None:
+        self.config = config if config is not None else BusConfig.from_environment()
+        self.types = types if types is not None else MessageTypes()
+        self.copier = ReadonlyCopier(self.types)
+        self.domain = domain_id() if domain is None else domain
+        self.host = host_id()
+        self.session = zenoh.open(self.config.to_zenoh())
+        self.zid = str(self.session.zid())
+        self.graph = Graph(self.domain)
+        self.dropped: Counter[str] = Counter()
+        """Input dropped, by reason: ``'/topic: cannot decode'``, ``'/topic: slot reused'``."""
+        self._ids = itertools.count(0)
+        self._lock = threading.Lock()
+        self._local: dict[str, list[Any]] = {}
+        self._latched: dict[str, list[Any]] = {}
+        self._shm_readers: dict[str, set[str]] = {}
+        self._nodes: list[Any] = []
+        self._warned: set[str] = set()
+        self._closed = False
+        self.calls = ThreadPoolExecutor(max_workers=8, thread_name_prefix="cyborg-call")
+        liveliness = self.session.liveliness()
+        self._graph_sub = liveliness.declare_subscriber(
+            f"{LIVELINESS_PREFIX}/{self.domain}/**", self._on_token, history=True)
+        self._shm_sub = liveliness.declare_subscriber(
+            f"{SHM_PREFIX}/{self.domain}/{self.host}/**", self._on_shm_token, history=True)
+
+    # ------------------------------------------------------------------ identity
+    def next_id(self) -> int:
+        """A fresh node or entity id, unique in this session."""
+        with self._lock:
+            return next(self._ids)
+
+    # ------------------------------------------------------------------ graph feed
+    def _on_token(self, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if sample.kind == zenoh.SampleKind.PUT:
+            self.graph.add(key)
+        else:
+            self.graph.remove(key)
+
+    def _on_shm_token(self, sample: zenoh.Sample) -> None:
+        # @cyborg_shm/<domain>/<host>/<zid>/<eid>/<mangled topic>
+        chunks = str(sample.key_expr).split("/")
+        if len(chunks) != 6:
+            return
+        topic, reader = chunks[5].replace("%", "/"), f"{chunks[3]}/{chunks[4]}"
+        with self._lock:
+            readers = self._shm_readers.setdefault(topic, set())
+            if sample.kind == zenoh.SampleKind.PUT:
+                readers.add(reader)
+            else:
+                readers.discard(reader)
+
+    def shm_reader_count(self, topic: str) -> int:
+        """Subscriptions of other sessions on this machine that take ``topic`` via shared memory."""
+        with self._lock:
+            return sum(1 for r in self._shm_readers.get(topic, ()) if not r.startswith(self.zid))
+
+    def shm_token(self, entity_id: int, topic: str) -> str:
+        return f"{SHM_PREFIX}/{self.domain}/{self.host}/{self.zid}/{entity_id}/" + \
+            topic.replace("/", "%")
+
+    def shm_key(self, data_key: str) -> str:
+        """The key on which slot references of ``data_key`` travel, on this machine only."""
+        return f"{SHM_PREFIX}/{self.host}/{data_key}"
+
+    # ------------------------------------------------------------------ in-process delivery
+    def add_local(self, topic: str, subscription: Any) -> list[Any]:
+        """Register an in-process subscription; returns the latched messages it should get."""
+        with self._lock:
+            self._local.setdefault(topic, []).append(subscription)
+            return list(self._latched.get(topic, ()))
+
+    def remove_local(self, topic: str, subscription: Any) -> None:
+        with self._lock:
+            subscribers = self._local.get(topic, [])
+            if subscription in subscribers:
+                subscribers.remove(subscription)
+
+    def local_subscriptions(self, topic: str) -> list[Any]:
+        return self._local.get(topic, [])
+
+    def latch(self, topic: str, publisher: Any, delivery: Any) -> None:
+        """Remember the last message of a latched publisher for late in-process subscribers."""
+        with self._lock:
+            entries = [d for d in self._latched.get(topic, []) if d[0] is not publisher]
+            self._latched[topic] = [*entries, (publisher, delivery)]
+
+    def unlatch(self, topic: str, publisher: Any) -> None:
+        with self._lock:
+            self._latched[topic] = [d for d in self._latched.get(topic, [])
+                                    if d[0] is not publisher]
+
+    # ------------------------------------------------------------------ dropped input
+    def drop(self, reason: str, detail: str = "") -> None:
+        """Count one dropped input; the first of each kind is logged as a warning."""
+        with self._lock:
+            self.dropped[reason] += 1
+            first = reason not in self._warned
+            self._warned.add(reason)
+        if first:
+            log.warning("dropped input (%s)%s; further drops of this kind are counted",
+                        reason, f": {detail}" if detail else "")
+
+    # ------------------------------------------------------------------ lifetime
+    def register_node(self, node: Any) -> None:
+        with self._lock:
+            self._nodes.append(node)
+
+    def forget_node(self, node: Any) -> None:
+        with self._lock:
+            if node in self._nodes:
+                self._nodes.remove(node)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def close(self) -> None:
+        """Destroy every node, then close the session. Safe to call twice."""
+        if self._closed:
+            return
+        for node in list(self._nodes):
+            node.destroy()
+        self._closed = True
+        self.calls.shutdown(wait=False, cancel_futures=True)
+        for declared in (self._graph_sub, self._shm_sub):
+            declared.undeclare()
+        self.session.close()
+
+    def __enter__(self) -> Context:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

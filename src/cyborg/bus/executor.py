@@ -1,0 +1,73 @@
+"""Where a node's callbacks run: one thread per node, one callback at a time.
+
+Messages arrive on Zenoh's threads (or, in-process, on the publisher's thread); they are queued
+here so that a node's code never runs two callbacks at once and a slow callback never stalls the
+network. An exception in a callback is logged with its traceback — once per callback, then
+counted — and the node keeps running.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from collections.abc import Callable
+from typing import Any
+
+log = logging.getLogger("cyborg.bus")
+
+_STOP = object()
+
+
+class CallbackThread:
+    """Runs submitted callables in order on one daemon thread."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.errors = 0
+        self._reported: set[str] = set()
+        self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._thread = threading.Thread(target=self._run, name=f"cyborg-node{name}",
+                                         daemon=True)
+        self._thread.start()
+
+    def submit(self, function: Callable[..., object], *args: Any) -> None:
+        self._queue.put((function, args))
+
+    def in_thread(self) -> bool:
+        return threading.current_thread() is self._thread
+
+    def _run(self) -> None:
+        while True:
+            item = self._queue.get()
+            if item is _STOP:
+                return
+            function, args = item
+            self.call(function, *args)
+
+    def call(self, function: Callable[..., object], *args: Any) -> object:
+        """Run ``function`` now, containing and logging what it raises."""
+        try:
+            return function(*args)
+        except Exception as exc:
+            self.errors += 1
+            where = getattr(function, "__qualname__", repr(function))
+            if where not in self._reported:
+                self._reported.add(where)
+                log.error("node %s: callback %s raised %s: %s (further errors of this "
+                          "callback are only counted)", self.name, where,
+                          type(exc).__name__, exc, exc_info=True)
+            return None
+
+    def close(self, timeout: float = 2.0) -> None:
+        """Finish the callback running now, drop the rest, stop the thread."""
+        if not self._thread.is_alive():
+            return
+        while True:  # pending callbacks are dropped: the node is going away
+            try:
+                self._queue.get_nowait()
+            except queue.Empty:
+                break
+        self._queue.put(_STOP)
+        if not self.in_thread():
+            self._thread.join(timeout)

@@ -1,0 +1,174 @@
+"""A node: a named participant of the bus, visible to ``cyborg node list`` and ``ros2 node list``.
+
+    from cyborg.bus import Context, Node, Qos
+
+    with Context() as context:
+        node = Node("talker", namespace="/robot1", context=context)
+        String = node.types.message_class("std_msgs/msg/String")
+        chatter = node.create_publisher("chatter", "std_msgs/msg/String")
+        chatter.publish(String(data="hello"))
+
+Each node runs its callbacks (subscriptions, services, timers) one at a time on its own thread.
+Nodes of one process normally share one :class:`~cyborg.bus.context.Context`; without one, a
+node uses the process's default context (see :func:`default_context`).
+"""
+
+from __future__ import annotations
+
+import atexit
+import re
+import threading
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+from cyborg.bus.context import Context
+from cyborg.bus.executor import CallbackThread
+from cyborg.bus.message_types import MessageTypes
+from cyborg.bus.parameters import Parameters
+from cyborg.bus.services import ServiceClient, ServiceServer
+from cyborg.bus.topics import Publisher, Subscription
+from cyborg.bus.wire import Qos, node_token
+
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_NAMESPACE = re.compile(r"^(/[A-Za-z][A-Za-z0-9_]*)*/?$")
+
+_E = TypeVar("_E")
+
+_default: Context | None = None
+_default_lock = threading.Lock()
+
+
+def default_context() -> Context:
+    """The process-wide context, opened on first use from the environment, closed at exit."""
+    global _default
+    with _default_lock:
+        if _default is None or _default.closed:
+            _default = Context()
+            atexit.register(_default.close)
+        return _default
+
+
+class Node:
+    """A ROS-style node: publishers, subscriptions, services, actions, parameters, timers."""
+
+    def __init__(self, name: str, namespace: str = "/", *, context: Context | None = None,
+                 parameters: dict[str, Any] | None = None) -> None:
+        if not _NAME.match(name):
+            raise ValueError(f"node name {name!r}: letters, digits and _ only, starting "
+                             "with a letter")
+        namespace = "/" + namespace.strip("/") if namespace.strip("/") else "/"
+        if not _NAMESPACE.match(namespace):
+            raise ValueError(f"namespace {namespace!r}: /-separated names of letters, digits, _")
+        self.context = context if context is not None else default_context()
+        self.name, self.namespace = name, namespace
+        self.fq_name = f"{namespace.rstrip('/')}/{name}"
+        self.id = self.context.next_id()
+        self.callbacks = CallbackThread(self.fq_name)
+        self._entities: list[Any] = []
+        self._timers: list[Timer] = []
+        self._destroyed = False
+        self.token_key = node_token(self.context.domain, self.context.zid, self.id,
+                                    namespace, name)
+        self._token = self.context.session.liveliness().declare_token(self.token_key)
+        self.context.register_node(self)
+        self.parameters = Parameters(self, overrides=parameters or {})
+
+    @property
+    def types(self) -> MessageTypes:
+        return self.context.types
+
+    # ------------------------------------------------------------------ topics
+    def create_publisher(self, topic: str, type_name: str, qos: Qos | None = None) -> Publisher:
+        """A publisher; ``Qos.latched()`` keeps the last message for late subscribers."""
+        return self._keep(Publisher(self, topic, type_name, qos or Qos(depth=10)))
+
+    def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], object],
+                            qos: Qos | None = None) -> Subscription:
+        """Call ``callback(message)`` for each message; use ``Qos.latched()`` for latched topics."""
+        return self._keep(Subscription(self, topic, type_name, callback, qos or Qos(depth=10)))
+
+    # ------------------------------------------------------------------ services
+    def create_service(self, name: str, service_type: str, handler: Callable[..., Any], *,
+                       deferred: bool = False) -> ServiceServer:
+        """Serve ``handler(request) -> response`` (see :class:`ServiceServer`)."""
+        return self._keep(ServiceServer(self, name, service_type, handler, deferred=deferred))
+
+    def create_client(self, name: str, service_type: str) -> ServiceClient:
+        return self._keep(ServiceClient(self, name, service_type))
+
+    # ------------------------------------------------------------------ actions
+    def create_action_server(self, name: str, action_type: str,
+                             execute: Callable[[Any], Any], **options: Any) -> Any:
+        """Serve an action (see :class:`cyborg.bus.actions.ActionServer`)."""
+        from cyborg.bus.actions import ActionServer
+        return self._keep(ActionServer(self, name, action_type, execute, **options))
+
+    def create_action_client(self, name: str, action_type: str) -> Any:
+        from cyborg.bus.actions import ActionClient
+        return self._keep(ActionClient(self, name, action_type))
+
+    # ------------------------------------------------------------------ timers
+    def create_timer(self, period: float, callback: Callable[[], object]) -> Timer:
+        """Call ``callback()`` every ``period`` seconds (wall time) on the node's thread."""
+        timer = Timer(self, period, callback)
+        self._timers.append(timer)
+        return timer
+
+    # ------------------------------------------------------------------ lifetime
+    def _keep(self, entity: _E) -> _E:
+        if self._destroyed:
+            entity.destroy()  # type: ignore[attr-defined]
+            raise RuntimeError(f"node {self.fq_name} was destroyed")
+        self._entities.append(entity)
+        return entity
+
+    def destroy(self) -> None:
+        """Withdraw everything the node declared and stop its thread. Safe to call twice."""
+        if self._destroyed:
+            return
+        self._destroyed = True
+        for timer in self._timers:
+            timer.cancel()
+        for entity in reversed(self._entities):
+            entity.destroy()
+        if not self.context.closed:
+            self._token.undeclare()
+        self.callbacks.close()
+        self.context.forget_node(self)
+
+    def __enter__(self) -> Node:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.destroy()
+
+
+class Timer:
+    """A periodic callback on the node's thread; ticks that would pile up are skipped."""
+
+    def __init__(self, node: Node, period: float, callback: Callable[[], object]) -> None:
+        if period <= 0:
+            raise ValueError(f"timer period must be positive, not {period}")
+        self.period, self.callback = period, callback
+        self._node = node
+        self._stop = threading.Event()
+        self._pending = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True,
+                                        name=f"cyborg-timer{node.fq_name}")
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.period):
+            if not self._pending.is_set():
+                self._pending.set()
+                self._node.callbacks.submit(self._fire)
+
+    def _fire(self) -> None:
+        self._pending.clear()
+        if not self._stop.is_set():
+            self.callback()
+
+    def cancel(self) -> None:
+        self._stop.set()
+        if threading.current_thread() is not self._thread:
+            self._thread.join(1.0)

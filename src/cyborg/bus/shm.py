@@ -1,0 +1,227 @@
+"""Large messages between processes of one machine, through shared-memory slots.
+
+A publisher owns a small ring of *slots*: files in ``/dev/shm``, each mapped into memory. To
+send, it serialises the message straight into a free slot (the one copy the transfer costs) and
+publishes a :class:`SlotRef` — path, generation, length — over Zenoh. A subscriber maps the slot
+read-only and deserialises in place: numpy fields of the message are views on the shared memory.
+
+Who may write a slot is decided by ``flock`` locks, one open file per lease:
+
+* the writer takes an exclusive lock while it fills a slot and releases it before announcing;
+* a reader takes a shared lock before reading and holds it as long as any view made from the
+  slot is alive (a ``weakref.finalize`` on the lease array closes the file);
+* the writer skips slots it cannot lock and grows the ring up to ``max_slots``; when every slot
+  is leased, :meth:`SlotWriter.write` returns ``None`` and the caller sends the bytes inline.
+
+A reader that finds a newer generation in the slot (the writer went round the ring before the
+reader got its lock) drops the frame; the caller counts it. Locks vanish with the process that
+held them, so a crashed reader never blocks a writer, and writers remove slot files of dead
+processes when they start.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import mmap
+import os
+import re
+import secrets
+import struct
+import tempfile
+import weakref
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+SHM_DIR = Path("/dev/shm") if Path("/dev/shm").is_dir() else Path(tempfile.gettempdir())
+PREFIX = "cyborg-shm-"
+_HEADER = struct.Struct("<QQ")  # generation, payload length
+_REF = struct.Struct("<QQH")  # generation, length, path length; then the path
+_GRANULE = 1 << 20
+_OWNER = re.compile(rf"^{re.escape(PREFIX)}(\d+)-")
+
+
+@dataclass(frozen=True)
+class SlotRef:
+    """Where a message lies: which slot file, which generation of it, how many bytes."""
+
+    path: str
+    generation: int
+    length: int
+
+    def encode(self) -> bytes:
+        raw = self.path.encode()
+        return _REF.pack(self.generation, self.length, len(raw)) + raw
+
+    @classmethod
+    def decode(cls, data: bytes) -> SlotRef:
+        """Parse a reference; ValueError for anything that is not one of ours."""
+        if len(data) < _REF.size:
+            raise ValueError("slot reference too short")
+        generation, length, path_length = _REF.unpack_from(data)
+        path = data[_REF.size:].decode()
+        if len(path) != path_length or not Path(path).name.startswith(PREFIX):
+            raise ValueError("not a cyborg shared-memory slot reference")
+        return cls(path, generation, length)
+
+
+class _Slot:
+    def __init__(self, path: Path, capacity: int) -> None:
+        self.path = path
+        self.capacity = capacity
+        self.fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o600)
+        os.ftruncate(self.fd, _HEADER.size + capacity)
+        self.map = mmap.mmap(self.fd, _HEADER.size + capacity)
+
+    def try_lock(self) -> bool:
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return False
+        return True
+
+    def unlock(self) -> None:
+        fcntl.flock(self.fd, fcntl.LOCK_UN)
+
+    def close(self) -> None:
+        self.path.unlink(missing_ok=True)
+        with contextlib.suppress(BufferError):  # a view still lives here: the GC unmaps it
+            self.map.close()
+        os.close(self.fd)
+
+
+class SlotWriter:
+    """One publisher's ring of shared-memory slots."""
+
+    def __init__(self, min_slots: int = 4, max_slots: int = 16) -> None:
+        self.min_slots, self.max_slots = min_slots, max_slots
+        self._slots: list[_Slot] = []
+        self._next = 0
+        self._generation = 0
+        self._tag = f"{PREFIX}{os.getpid()}-{secrets.token_hex(4)}"
+        self._count = 0
+        remove_stale_slots()
+
+    def write(self, length: int, fill: Callable[[memoryview], object]) -> SlotRef | None:
+        """Fill ``length`` bytes of a free slot with ``fill(view)``; None if none is free."""
+        slot = self._free_slot(length)
+        if slot is None:
+            return None
+        try:
+            self._generation += 1
+            _HEADER.pack_into(slot.map, 0, self._generation, length)
+            with memoryview(slot.map) as whole, whole[_HEADER.size:][:length] as view:
+                fill(view)
+        finally:
+            slot.unlock()
+        return SlotRef(str(slot.path), self._generation, length)
+
+    def _free_slot(self, length: int) -> _Slot | None:
+        count = len(self._slots)
+        if count < self.min_slots:  # build the ring first, so a slot is reused as late as possible
+            return self._append_slot(length)
+        for step in range(count):
+            index = (self._next + step) % count
+            slot = self._slots[index]
+            if slot.try_lock():
+                if slot.capacity < length:  # too small: replace it with a bigger one
+                    slot.unlock()
+                    slot.close()
+                    slot = self._slots[index] = self._new_slot(length)
+                    slot.try_lock()
+                self._next = index + 1
+                return slot
+        return self._append_slot(length) if count < self.max_slots else None
+
+    def _append_slot(self, length: int) -> _Slot:
+        slot = self._new_slot(length)
+        self._slots.append(slot)
+        slot.try_lock()
+        self._next = 0  # after the newest slot comes the oldest
+        return slot
+
+    def _new_slot(self, length: int) -> _Slot:
+        self._count += 1
+        capacity = -(-length // _GRANULE) * _GRANULE
+        return _Slot(SHM_DIR / f"{self._tag}-{self._count}", capacity)
+
+    def close(self) -> None:
+        """Remove the slot files; readers holding views keep their mappings."""
+        for slot in self._slots:
+            slot.close()
+        self._slots.clear()
+
+
+class SlotReader:
+    """Maps publishers' slots (read-only) and leases them for as long as views live."""
+
+    def __init__(self, cache_size: int = 64) -> None:
+        self._maps: OrderedDict[str, mmap.mmap] = OrderedDict()
+        self._cache_size = cache_size
+
+    def read(self, ref: SlotRef) -> np.ndarray | None:
+        """A read-only byte array over the message, or None if the slot was reused or gone.
+
+        The slot stays leased (the writer cannot reuse it) until the returned array and every
+        view made from it have been garbage-collected.
+        """
+        try:
+            fd = os.open(ref.path, os.O_RDONLY)
+        except FileNotFoundError:
+            return None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            mapped = self._map(ref.path)
+            generation, length = _HEADER.unpack_from(mapped, 0)
+            if generation != ref.generation or length != ref.length:
+                raise BlockingIOError("slot reused")
+            lease = np.frombuffer(mapped, np.uint8, count=length, offset=_HEADER.size)
+        except (BlockingIOError, ValueError, OSError):
+            os.close(fd)
+            return None
+        weakref.finalize(lease, os.close, fd)
+        return lease
+
+    def _map(self, path: str) -> mmap.mmap:
+        mapped = self._maps.get(path)
+        if mapped is None:
+            # mmap keeps a duplicate of the descriptor it maps; map through a descriptor of
+            # its own, or the duplicate would hold the lease's lock for as long as the mapping.
+            fd = os.open(path, os.O_RDONLY)
+            try:
+                mapped = mmap.mmap(fd, 0, prot=mmap.PROT_READ)
+            finally:
+                os.close(fd)
+            self._maps[path] = mapped
+            while len(self._maps) > self._cache_size:
+                self._maps.popitem(last=False)  # unmapped once no view uses it
+        self._maps.move_to_end(path)
+        return mapped
+
+    def close(self) -> None:
+        self._maps.clear()
+
+
+def remove_stale_slots(folder: Path = SHM_DIR) -> int:
+    """Delete slot files whose owning process is gone; returns how many."""
+    removed = 0
+    for path in folder.glob(f"{PREFIX}*"):
+        match = _OWNER.match(path.name)
+        if match and not _alive(int(match.group(1))):
+            path.unlink(missing_ok=True)
+            removed += 1
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

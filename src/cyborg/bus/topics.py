@@ -1,0 +1,287 @@
+"""Typed publishers and subscriptions: in-process, shared memory, or Zenoh with rmw_zenoh keys.
+
+How a message travels depends on where its subscribers are:
+
+* same :class:`~cyborg.bus.context.Context` (same process): handed over as a read-only sharing
+  copy (:mod:`cyborg.bus.readonly`), never serialised;
+* another process on this machine, for messages of ``SHM_THRESHOLD`` bytes or more: serialised
+  once into a shared-memory slot (:mod:`cyborg.bus.shm`); only a slot reference crosses Zenoh;
+* anyone else (other machines, ROS 2 nodes): CDR on the rmw_zenoh data key with the 33-byte
+  attachment, so ``ros2 topic echo`` reads it.
+
+A latched publisher (``Qos.latched()``, transient-local) keeps its last ``depth`` messages for
+subscribers that join later, in-process and remote.
+
+Ownership: once published, a message belongs to the bus. In-process subscribers share its numpy
+arrays read-only; write new arrays for the next message instead of filling the old ones.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import zenoh
+import zenoh.ext
+
+from cyborg.bus.shm import SlotReader, SlotRef, SlotWriter
+from cyborg.bus.wire import (
+    Attachment,
+    Durability,
+    EntityKind,
+    History,
+    Qos,
+    Reliability,
+    data_key,
+    endpoint_token,
+    fully_qualified,
+    gid,
+)
+
+if TYPE_CHECKING:
+    from cyborg.bus.node import Node
+
+SHM_THRESHOLD = 64 * 1024
+"""Messages of at least this many bytes go to local processes through shared memory."""
+
+
+class _Endpoint:
+    """What publishers and subscriptions share: names, keys, the liveliness token, the GID."""
+
+    def __init__(self, node: Node, topic: str, type_name: str, qos: Qos,
+                 kind: EntityKind) -> None:
+        context = node.context
+        if type_name not in context.types:
+            raise KeyError(f"{topic}: unknown message type {type_name!r}")
+        self.node, self.context, self.qos = node, context, qos
+        self.topic = fully_qualified(node.namespace, topic)
+        self.type_name = type_name
+        self.type_hash = context.types.hash(type_name)
+        self.key = data_key(context.domain, self.topic, type_name, self.type_hash)
+        self.entity_id = context.next_id()
+        self.token_key = endpoint_token(
+            context.domain, context.zid, node.id, self.entity_id, kind, node.namespace,
+            node.name, self.topic, type_name, self.type_hash, qos)
+        self.gid = gid(self.token_key)
+        self._token: zenoh.LivelinessToken | None = None
+        self._closed = False
+
+    def _announce(self) -> None:
+        self._token = self.context.session.liveliness().declare_token(self.token_key)
+
+    def _withdraw(self) -> bool:
+        if self._closed or self.context.closed:
+            self._closed = True
+            return False
+        self._closed = True
+        if self._token is not None:
+            self._token.undeclare()
+        return True
+
+
+class Publisher(_Endpoint):
+    """Publishes messages of one type on one topic. Create with :meth:`Node.create_publisher`."""
+
+    def __init__(self, node: Node, topic: str, type_name: str, qos: Qos) -> None:
+        super().__init__(node, topic, type_name, qos, EntityKind.PUBLISHER)
+        self._class = self.context.types.message_class(type_name)
+        self._sequence = 0
+        self._lock = threading.Lock()
+        session = self.context.session
+        reliability = (zenoh.Reliability.RELIABLE if qos.reliability is Reliability.RELIABLE
+                       else zenoh.Reliability.BEST_EFFORT)
+        block = qos.reliability is Reliability.RELIABLE and qos.history is History.KEEP_ALL
+        congestion = zenoh.CongestionControl.BLOCK if block else zenoh.CongestionControl.DROP
+        self.latched = qos.durability is Durability.TRANSIENT_LOCAL
+        self._zenoh: zenoh.Publisher | zenoh.ext.AdvancedPublisher
+        if self.latched:
+            self._zenoh = zenoh.ext.declare_advanced_publisher(
+                session, self.key, reliability=reliability, congestion_control=congestion,
+                allowed_destination=zenoh.Locality.REMOTE,
+                cache=zenoh.ext.CacheConfig(max_samples=max(qos.depth, 1)),
+                publisher_detection=True)
+        else:
+            self._zenoh = session.declare_publisher(
+                self.key, reliability=reliability, congestion_control=congestion,
+                allowed_destination=zenoh.Locality.REMOTE)
+        self._shm_publisher = session.declare_publisher(
+            self.context.shm_key(self.key), reliability=reliability,
+            congestion_control=congestion, allowed_destination=zenoh.Locality.REMOTE)
+        self._slots: SlotWriter | None = None
+        self._announce()
+
+    def publish(self, message: Any) -> None:
+        """Send ``message`` to every subscriber, choosing the cheapest path for each."""
+        if not isinstance(message, self._class):
+            raise TypeError(f"publish on {self.topic}: expected {self.type_name}, "
+                            f"got {type(message).__name__}")
+        if self._closed:
+            raise RuntimeError(f"publish on {self.topic}: the publisher was destroyed")
+        with self._lock:
+            self._sequence += 1
+            attachment = Attachment(self._sequence, time.time_ns(), self.gid)
+            delivery = (message, attachment)
+            if self.latched:
+                self.context.latch(self.topic, self, delivery)
+            for subscription in self.context.local_subscriptions(self.topic):
+                subscription.deliver_local(message, self.type_name, attachment)
+            self._publish_remote(message, attachment.encode())
+
+    def _publish_remote(self, message: Any, attachment: bytes) -> None:
+        context = self.context
+        readers = 0 if self.latched else context.shm_reader_count(self.topic)
+        if readers:
+            size = context.types.cdr_size(message, self.type_name)
+            if size >= SHM_THRESHOLD:
+                if self._slots is None:
+                    self._slots = SlotWriter()
+                ref = self._slots.write(size, lambda view: context.types.serialize_into(
+                    message, self.type_name, view))
+                if ref is not None:
+                    self._shm_publisher.put(ref.encode(), attachment=attachment)
+                    others = context.graph.count(self.topic, EntityKind.SUBSCRIPTION,
+                                                 exclude_zid=context.zid)
+                    if others <= readers:
+                        return
+        if self.latched or self._matching():
+            data = context.types.serialize(message, self.type_name)
+            self._zenoh.put(data.obj, attachment=attachment)
+
+    def _matching(self) -> bool:
+        publisher = self._zenoh
+        return not isinstance(publisher, zenoh.Publisher) or publisher.matching_status
+
+    def subscription_count(self) -> int:
+        """Subscriptions on this topic now: in this process plus elsewhere (from the graph)."""
+        local = len(self.context.local_subscriptions(self.topic))
+        remote = self.context.graph.count(self.topic, EntityKind.SUBSCRIPTION,
+                                          exclude_zid=self.context.zid)
+        return local + remote
+
+    def destroy(self) -> None:
+        if not self._withdraw():
+            return
+        self.context.unlatch(self.topic, self)
+        self._zenoh.undeclare()  # type: ignore[no-untyped-call]
+        self._shm_publisher.undeclare()
+        if self._slots is not None:
+            self._slots.close()
+
+
+class Subscription(_Endpoint):
+    """Calls ``callback(message)`` on the node's thread for each message on a topic.
+
+    Up to ``qos.depth`` messages wait in the queue (keep-last: the oldest are dropped); with
+    ``History.KEEP_ALL`` the queue is unbounded. Input that cannot be decoded is dropped and
+    counted in ``context.dropped``.
+    """
+
+    def __init__(self, node: Node, topic: str, type_name: str,
+                 callback: Callable[[Any], object], qos: Qos) -> None:
+        super().__init__(node, topic, type_name, qos, EntityKind.SUBSCRIPTION)
+        self.callback = callback
+        self.received = 0
+        depth = None if qos.history is History.KEEP_ALL else max(qos.depth, 1)
+        self._queue: deque[Any] = deque(maxlen=depth)
+        self._last_sequence: dict[bytes, int] = {}
+        self._lock = threading.Lock()
+        self._slots = SlotReader()
+        session = self.context.session
+        # Any type hash: ROS 2 Humble peers publish "TypeHashNotSupported" in its place.
+        any_hash = data_key(self.context.domain, self.topic, type_name, "*")
+        self._zenoh: Any
+        if qos.durability is Durability.TRANSIENT_LOCAL:
+            self._zenoh = zenoh.ext.declare_advanced_subscriber(
+                session, any_hash, self._on_sample, allowed_origin=zenoh.Locality.REMOTE,
+                history=zenoh.ext.HistoryConfig(detect_late_publishers=True,
+                                                max_samples=max(qos.depth, 1)))
+        else:
+            self._zenoh = session.declare_subscriber(
+                any_hash, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        self._shm_subscriber = session.declare_subscriber(
+            self.context.shm_key(self.key), self._on_slot, allowed_origin=zenoh.Locality.REMOTE)
+        self._shm_token = session.liveliness().declare_token(
+            self.context.shm_token(self.entity_id, self.topic))
+        for _publisher, (message, attachment) in self.context.add_local(self.topic, self):
+            self.deliver_local(message, type_name, attachment)
+        self._announce()
+
+    # ------------------------------------------------------------------ arrivals
+    def deliver_local(self, message: Any, type_name: str, attachment: Attachment) -> None:
+        if type_name != self.type_name:
+            self.context.drop(f"{self.topic}: type {type_name} instead of {self.type_name}")
+            return
+        if self._fresh(attachment):
+            self._enqueue(self.context.copier.copy(message, type_name))
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        if self._accept(sample):
+            self._decode(sample.payload.to_bytes())
+
+    def _on_slot(self, sample: zenoh.Sample) -> None:
+        if not self._accept(sample):
+            return
+        try:
+            ref = SlotRef.decode(sample.payload.to_bytes())
+        except ValueError as exc:
+            self.context.drop(f"{self.topic}: bad slot reference", str(exc))
+            return
+        lease = self._slots.read(ref)
+        if lease is None:
+            self.context.drop(f"{self.topic}: shared-memory slot reused before it was read")
+            return
+        self._decode(lease.data)
+
+    def _accept(self, sample: zenoh.Sample) -> bool:
+        """False for a malformed attachment (counted) or a message already delivered."""
+        if sample.attachment is None:  # not rmw_zenoh, but harmless
+            return True
+        try:
+            attachment = Attachment.decode(sample.attachment.to_bytes())
+        except ValueError as exc:
+            self.context.drop(f"{self.topic}: bad attachment", str(exc))
+            return False
+        return self._fresh(attachment)
+
+    def _fresh(self, attachment: Attachment) -> bool:
+        """False for a sequence number already seen from this publisher (via another path)."""
+        with self._lock:
+            last = self._last_sequence.get(attachment.gid, 0)
+            if attachment.sequence <= last:
+                return False
+            self._last_sequence[attachment.gid] = attachment.sequence
+            return True
+
+    def _decode(self, data: bytes | memoryview) -> None:
+        try:
+            message = self.context.types.deserialize(data, self.type_name)
+        except Exception as exc:
+            self.context.drop(f"{self.topic}: cannot decode {self.type_name}",
+                              f"{type(exc).__name__}: {exc}")
+            return
+        self._enqueue(message)
+
+    def _enqueue(self, message: Any) -> None:
+        with self._lock:
+            self._queue.append(message)
+        self.node.callbacks.submit(self._dispatch)
+
+    def _dispatch(self) -> None:
+        with self._lock:
+            if not self._queue or self._closed:
+                return
+            message = self._queue.popleft()
+        self.received += 1
+        self.callback(message)
+
+    def destroy(self) -> None:
+        if not self._withdraw():
+            return
+        self.context.remove_local(self.topic, self)
+        self._shm_token.undeclare()
+        self._shm_subscriber.undeclare()
+        self._zenoh.undeclare()
+        self._slots.close()
