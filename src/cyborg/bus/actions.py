@@ -309,6 +309,7 @@ class ActionClient:
             raise KeyError(f"{name}: unknown action type {action_type!r}")
         self.node, self.types, self.name, self.action_type = node, types, name, action_type
         self._goals: dict[bytes, ClientGoal] = {}
+        self._statuses: dict[bytes, GoalStatus] = {}
         self._closed = False
         base = f"{name}/_action/"
         self._send = node.create_client(base + "send_goal", f"{action_type}_SendGoal")
@@ -336,6 +337,7 @@ class ActionClient:
         if not response.accepted:
             raise ActionError(f"action {self.name}: the server rejected the goal")
         handle = ClientGoal(self, goal_id, True, feedback)
+        handle.status = self._statuses.get(goal_id, handle.status)  # status may come first
         self._goals[goal_id] = handle
         return handle
 
@@ -355,10 +357,12 @@ class ActionClient:
             goal.on_feedback(message.feedback)
 
     def _on_status(self, message: Any) -> None:
-        for entry in message.status_list:
-            goal = self._goals.get(bytes(entry.goal_info.goal_id.uuid))
+        self._statuses = {bytes(entry.goal_info.goal_id.uuid): GoalStatus(entry.status)
+                          for entry in message.status_list}
+        for goal_id, status in self._statuses.items():
+            goal = self._goals.get(goal_id)
             if goal is not None and not goal.done:
-                goal.status = GoalStatus(entry.status)
+                goal.status = status
 
     def destroy(self) -> None:
         self._closed = True

@@ -12,6 +12,7 @@ processes or other machines are reached through Zenoh.
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import itertools
 import logging
@@ -67,6 +68,7 @@ class Context:
         self._warned: set[str] = set()
         self._closed = False
         self.calls = ThreadPoolExecutor(max_workers=8, thread_name_prefix="cyborg-call")
+        atexit.register(self.close)  # a session left open can hang the interpreter's exit
         liveliness = self.session.liveliness()
         self._graph_sub = liveliness.declare_subscriber(
             f"{LIVELINESS_PREFIX}/{self.domain}/**", self._on_token, history=True)
@@ -172,6 +174,7 @@ class Context:
         for node in list(self._nodes):
             node.destroy()
         self._closed = True
+        atexit.unregister(self.close)
         self.calls.shutdown(wait=False, cancel_futures=True)
         for declared in (self._graph_sub, self._shm_sub):
             declared.undeclare()

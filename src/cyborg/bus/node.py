@@ -15,7 +15,6 @@ node uses the process's default context (see :func:`default_context`).
 
 from __future__ import annotations
 
-import atexit
 import re
 import threading
 from collections.abc import Callable
@@ -44,7 +43,6 @@ def default_context() -> Context:
     with _default_lock:
         if _default is None or _default.closed:
             _default = Context()
-            atexit.register(_default.close)
         return _default
 
 
@@ -80,45 +78,47 @@ class Node:
     # ------------------------------------------------------------------ topics
     def create_publisher(self, topic: str, type_name: str, qos: Qos | None = None) -> Publisher:
         """A publisher; ``Qos.latched()`` keeps the last message for late subscribers."""
-        return self._keep(Publisher(self, topic, type_name, qos or Qos(depth=10)))
+        return self._keep(Publisher, topic, type_name, qos or Qos(depth=10))
 
     def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], object],
                             qos: Qos | None = None) -> Subscription:
         """Call ``callback(message)`` for each message; use ``Qos.latched()`` for latched topics."""
-        return self._keep(Subscription(self, topic, type_name, callback, qos or Qos(depth=10)))
+        return self._keep(Subscription, topic, type_name, callback, qos or Qos(depth=10))
 
     # ------------------------------------------------------------------ services
     def create_service(self, name: str, service_type: str, handler: Callable[..., Any], *,
                        deferred: bool = False) -> ServiceServer:
         """Serve ``handler(request) -> response`` (see :class:`ServiceServer`)."""
-        return self._keep(ServiceServer(self, name, service_type, handler, deferred=deferred))
+        return self._keep(ServiceServer, name, service_type, handler, deferred=deferred)
 
     def create_client(self, name: str, service_type: str) -> ServiceClient:
-        return self._keep(ServiceClient(self, name, service_type))
+        return self._keep(ServiceClient, name, service_type)
 
     # ------------------------------------------------------------------ actions
     def create_action_server(self, name: str, action_type: str,
                              execute: Callable[[Any], Any], **options: Any) -> Any:
         """Serve an action (see :class:`cyborg.bus.actions.ActionServer`)."""
         from cyborg.bus.actions import ActionServer
-        return self._keep(ActionServer(self, name, action_type, execute, **options))
+        return self._keep(ActionServer, name, action_type, execute, **options)
 
     def create_action_client(self, name: str, action_type: str) -> Any:
         from cyborg.bus.actions import ActionClient
-        return self._keep(ActionClient(self, name, action_type))
+        return self._keep(ActionClient, name, action_type)
 
     # ------------------------------------------------------------------ timers
     def create_timer(self, period: float, callback: Callable[[], object]) -> Timer:
         """Call ``callback()`` every ``period`` seconds (wall time) on the node's thread."""
+        if self._destroyed:
+            raise RuntimeError(f"node {self.fq_name} was destroyed")
         timer = Timer(self, period, callback)
         self._timers.append(timer)
         return timer
 
     # ------------------------------------------------------------------ lifetime
-    def _keep(self, entity: _E) -> _E:
-        if self._destroyed:
-            entity.destroy()  # type: ignore[attr-defined]
+    def _keep(self, factory: Callable[..., _E], *args: Any, **options: Any) -> _E:
+        if self._destroyed or self.context.closed:
             raise RuntimeError(f"node {self.fq_name} was destroyed")
+        entity = factory(self, *args, **options)
         self._entities.append(entity)
         return entity
 

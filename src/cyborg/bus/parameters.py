@@ -62,9 +62,9 @@ def type_of(value: Any) -> int:
                      "or a list of one of them)")
 
 
-def to_message(types: MessageTypes, value: Any) -> Any:
-    """A Python value as ``rcl_interfaces/msg/ParameterValue``."""
-    code = type_of(value)
+def to_message(types: MessageTypes, value: Any, kind: int | None = None) -> Any:
+    """A Python value as ``rcl_interfaces/msg/ParameterValue`` (``kind`` for empty lists)."""
+    code = type_of(value) if kind is None else kind
     fields: dict[str, Any] = {"type": code, "bool_value": False, "integer_value": 0,
                               "double_value": 0.0, "string_value": "",
                               "string_array_value": []}
@@ -100,6 +100,8 @@ class Declared:
     description: str = ""
     read_only: bool = False
     limits: tuple[float, float] | None = None
+    kind: int = NOT_SET
+    """The ParameterType, fixed by the default (an empty list can be any array type)."""
 
 
 class Parameters:
@@ -129,7 +131,10 @@ class Parameters:
             if name in self._declared:
                 raise ValueError(f"parameter {name!r} of {self._node.fq_name} is already "
                                  "declared")
-            declared = Declared(name, default, description, read_only, limits)
+            if isinstance(default, list | tuple) and not default:
+                raise ValueError(f"parameter {name!r}: an empty list default has no type; "
+                                 "give one item")
+            declared = Declared(name, default, description, read_only, limits, type_of(default))
             if name in self._overrides:
                 declared.value = self._checked(declared, self._overrides.pop(name))
             self._declared[name] = declared
@@ -175,7 +180,7 @@ class Parameters:
             self._node.callbacks.call(listener, dict(checked))
 
     def _checked(self, declared: Declared, value: Any) -> Any:
-        wanted = type_of(declared.value)
+        wanted = declared.kind
         if isinstance(value, list | tuple) and not value and wanted in (*_ARRAYS, STRING_ARRAY):
             return []
         given = type_of(value)
@@ -183,7 +188,7 @@ class Parameters:
             value, given = float(value), DOUBLE
         if wanted == DOUBLE_ARRAY and given == INTEGER_ARRAY:
             value, given = [float(v) for v in value], DOUBLE_ARRAY
-        if declared.value is not None and given != wanted:
+        if wanted != NOT_SET and given != wanted:
             raise ValueError(f"parameter {declared.name!r} is a {TYPE_NAMES[wanted]}, "
                              f"not a {TYPE_NAMES[given]} ({value!r})")
         if declared.limits is not None and given in (INTEGER, DOUBLE):
@@ -210,12 +215,13 @@ class Parameters:
         return self._response("ListParameters", result=result)
 
     def _get(self, request: Any) -> Any:
-        values = [to_message(self._types, self._declared[n].value if n in self._declared
-                             else None) for n in request.names]
+        values = [to_message(self._types, self._declared[n].value, self._declared[n].kind)
+                  if n in self._declared else to_message(self._types, None)
+                  for n in request.names]
         return self._response("GetParameters", values=values)
 
     def _get_types(self, request: Any) -> Any:
-        codes = [type_of(self._declared[n].value) if n in self._declared else NOT_SET
+        codes = [self._declared[n].kind if n in self._declared else NOT_SET
                  for n in request.names]
         return self._response("GetParameterTypes", types=np.array(codes, dtype=np.uint8))
 
@@ -246,7 +252,7 @@ class Parameters:
         descriptors = []
         for name in request.names:
             declared = self._declared.get(name, Declared(name, None))
-            code = type_of(declared.value)
+            code = declared.kind
             floats, integers = [], []
             if declared.limits and code == DOUBLE:
                 floats = [double_range(from_value=float(declared.limits[0]),

@@ -55,7 +55,7 @@ class ServiceTimeoutError(ServiceError):
 class _ServiceEndpoint:
     def __init__(self, node: Node, name: str, service_type: str, kind: EntityKind) -> None:
         context = node.context
-        if service_type not in context.types.services:
+        if f"{service_type}_Request" not in context.types:
             raise KeyError(f"{name}: unknown service type {service_type!r}")
         self.node, self.context = node, context
         self.name = fully_qualified(node.namespace, name)
