@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -94,14 +95,14 @@ def test_graph_tracks_tokens_of_its_domain() -> None:
 
 
 # ---------------------------------------------------------------------- shared-memory slots
-def fill_with(value: int) -> object:
+def fill_with(value: int) -> Callable[[memoryview], object]:
     return lambda view: view.__setitem__(slice(None), bytes([value]) * len(view))
 
 
 def test_a_leased_slot_is_never_overwritten() -> None:
     writer, reader = SlotWriter(min_slots=2, max_slots=2), SlotReader()
     try:
-        first = writer.write(8, fill_with(1))  # type: ignore[arg-type]
+        first = writer.write(8, fill_with(1))
         assert first is not None
         lease = reader.read(SlotRef.decode(first.encode()))
         assert lease is not None and lease.tolist() == [1] * 8
@@ -109,12 +110,12 @@ def test_a_leased_slot_is_never_overwritten() -> None:
         view = lease[2:4]
         del lease
         for value in (2, 3, 4):  # the other slot takes every write while the view lives
-            written = writer.write(8, fill_with(value))  # type: ignore[arg-type]
+            written = writer.write(8, fill_with(value))
             assert written is not None and written.path != first.path
         assert view.tolist() == [1, 1]
         del view
         gc.collect()
-        reused = writer.write(8, fill_with(5))  # type: ignore[arg-type]
+        reused = writer.write(8, fill_with(5))
         assert reused is not None
         assert reader.read(first) is None or reused.path != first.path
     finally:
@@ -126,11 +127,11 @@ def test_all_slots_leased_means_no_slot() -> None:
     try:
         leases = []
         for value in range(2):
-            ref = writer.write(4, fill_with(value))  # type: ignore[arg-type]
+            ref = writer.write(4, fill_with(value))
             assert ref is not None
             leases.append(reader.read(ref))
         assert [lease.tolist() for lease in leases if lease is not None] == [[0] * 4, [1] * 4]
-        assert writer.write(4, fill_with(9)) is None  # type: ignore[arg-type]
+        assert writer.write(4, fill_with(9)) is None
     finally:
         writer.close()
 
@@ -138,7 +139,7 @@ def test_all_slots_leased_means_no_slot() -> None:
 def test_a_reused_slot_is_reported_not_read() -> None:
     writer, reader = SlotWriter(min_slots=1, max_slots=1), SlotReader()
     try:
-        old = writer.write(4, fill_with(1))  # type: ignore[arg-type]
+        old = writer.write(4, fill_with(1))
         assert writer.write(4, fill_with(2)) is not None  # nobody leased the first
         assert old is not None and reader.read(old) is None
         assert reader.read(SlotRef(old.path + "-gone", 1, 4)) is None
@@ -150,8 +151,8 @@ def test_a_reused_slot_is_reported_not_read() -> None:
 def test_a_bigger_message_gets_a_bigger_slot() -> None:
     writer, reader = SlotWriter(min_slots=1, max_slots=1), SlotReader()
     try:
-        assert writer.write(10, fill_with(1)) is not None  # type: ignore[arg-type]
-        big = writer.write(3 << 20, fill_with(7))  # type: ignore[arg-type]
+        assert writer.write(10, fill_with(1)) is not None
+        big = writer.write(3 << 20, fill_with(7))
         assert big is not None
         lease = reader.read(big)
         assert lease is not None and len(lease) == 3 << 20 and int(lease[-1]) == 7

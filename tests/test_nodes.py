@@ -812,3 +812,24 @@ def test_memsequence_does_not_retick_completed_children_while_running() -> None:
     statuses = [tree.tick().status for _ in range(4)]
     assert statuses == [RUNNING, RUNNING, RUNNING, SUCCESS]
     assert events(tree).count(("tick", "a")) == 1
+
+
+def test_halting_an_ancestor_first_halts_a_descendant_left_running_under_a_finished_child() -> None:
+    """Found by the property test: n5 stays RUNNING under n3, which succeeded this tick; the
+    Parallel's ERROR then halts n2 mid-tick. n5 must be halted before n2, not after."""
+    spec = N("Parallel",
+             N("Sequence",
+               N("Priority", N("Scripted", script="FS", id="n4"),
+                 N("Scripted", script="R", id="n5"), id="n3"),
+               N("Scripted", script="R", id="n6"), id="n2"),
+             N("Sequence", N("Scripted", script="RS", id="n9"),
+               N("Scripted", script="E", id="n10"), id="n7"),
+             successThreshold=-1, failureThreshold=-1, id="n1")
+    tree = tree_from(spec)
+    tree.tick()
+    snapshot = tree.tick()
+    assert snapshot.status is Status.ERROR
+    halted = snapshot.halted
+    assert halted.index("n5") < halted.index("n2") and halted.index("n6") < halted.index("n2")
+    assert sorted(halted) == sorted(set(halted))  # each exactly once
+    assert tree.running == []

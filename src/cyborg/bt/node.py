@@ -164,11 +164,14 @@ class Node:
         Each halted node's :meth:`on_halt` runs exactly once and its status becomes ``None``.
         Composites and decorators call this on children they stop ticking; the tree calls it
         at the end of a tick on every RUNNING node that was not reached.
+
+        Children are visited even when this node is not RUNNING: a descendant may still be
+        RUNNING under a child that completed this tick, and it must go first.
         """
-        if self.status is not RUNNING:
-            return
         for child in self.children:
             child.halt()
+        if self.status is not RUNNING:
+            return
         self.status = None
         self._record.halted.append(self)
         try:
