@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import logging
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -126,12 +128,14 @@ def test_keep_last_queue_drops_the_oldest(bus: Context) -> None:
     node.create_subscription("chatter", "std_msgs/msg/String", callback, Qos(depth=2))
     publisher = node.create_publisher("chatter", "std_msgs/msg/String")
     string = bus.types.message_class("std_msgs/msg/String")
-    publisher.publish(string(data="0"))
-    assert wait_for(lambda: True)
-    time.sleep(0.05)  # "0" is being handled; the queue holds at most two more
+    # "0" is handed over directly and blocks its publishing thread while the node is busy
+    first = threading.Thread(target=publisher.publish, args=(string(data="0"),))
+    first.start()
+    time.sleep(0.05)  # while "0" is being handled, the queue holds at most two more
     for text in "12345":
         publisher.publish(string(data=text))
     gate.set()
+    first.join(5)
     assert wait_for(lambda: len(seen) == 3)
     time.sleep(0.05)
     assert seen == ["0", "4", "5"]
@@ -186,6 +190,33 @@ def test_parameters_in_process(bus: Context) -> None:
         node.parameters.declare("model", "x")
 
 
+def test_in_process_delivery_keeps_one_callback_at_a_time(bus: Context) -> None:
+    node = Node("counter", context=bus)
+    running = [0]
+    overlaps: list[int] = []
+    seen: list[str] = []
+
+    def callback(message: Any) -> None:
+        running[0] += 1
+        overlaps.append(running[0])
+        time.sleep(0.001)
+        seen.append(message.data)
+        running[0] -= 1
+    node.create_subscription("chatter", "std_msgs/msg/String", callback, Qos(depth=1000))
+    string = bus.types.message_class("std_msgs/msg/String")
+    publishers = [Node(f"talker{i}", context=bus).create_publisher(
+        "/chatter", "std_msgs/msg/String") for i in range(4)]
+    threads = [threading.Thread(target=lambda p=p: [p.publish(string(data="x"))
+                                                    for _ in range(25)])
+               for p in publishers]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(10)
+    assert wait_for(lambda: len(seen) == 100)
+    assert set(overlaps) == {1}
+
+
 def test_timer_runs_on_the_node_thread(bus: Context) -> None:
     node = Node("ticker", context=bus)
     threads: list[str] = []
@@ -238,3 +269,15 @@ def test_plain_data_conversion(bus: Context) -> None:
         new_message(bus.types, "unique_identifier_msgs/msg/UUID", {"uuid": [1, 2]})
     with pytest.raises(MessageValueError, match="300 is out of range for uint8"):
         new_message(bus.types, "std_msgs/msg/UInt8", {"data": 300})
+
+
+def test_a_program_that_forgets_to_close_still_exits() -> None:
+    script = ("from cyborg.bus import BusConfig, Context, Node\n"
+              "context = Context(BusConfig.isolated())\n"
+              "node = Node('forgetful', context=context)\n"
+              "node.create_publisher('chatter', 'std_msgs/msg/String')\n"
+              "node.create_timer(0.01, lambda: None)\n"
+              "print('done', flush=True)\n")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            timeout=20)
+    assert result.returncode == 0 and result.stdout == "done\n", result.stderr

@@ -100,7 +100,7 @@ def fill_with(value: int) -> Callable[[memoryview], object]:
 
 
 def test_a_leased_slot_is_never_overwritten() -> None:
-    writer, reader = SlotWriter(min_slots=2, max_slots=2), SlotReader()
+    writer, reader = SlotWriter(max_slots=2), SlotReader()
     try:
         first = writer.write(8, fill_with(1))
         assert first is not None
@@ -123,7 +123,7 @@ def test_a_leased_slot_is_never_overwritten() -> None:
 
 
 def test_all_slots_leased_means_no_slot() -> None:
-    writer, reader = SlotWriter(min_slots=1, max_slots=2), SlotReader()
+    writer, reader = SlotWriter(max_slots=2), SlotReader()
     try:
         leases = []
         for value in range(2):
@@ -137,7 +137,7 @@ def test_all_slots_leased_means_no_slot() -> None:
 
 
 def test_a_reused_slot_is_reported_not_read() -> None:
-    writer, reader = SlotWriter(min_slots=1, max_slots=1), SlotReader()
+    writer, reader = SlotWriter(max_slots=1), SlotReader()
     try:
         old = writer.write(4, fill_with(1))
         assert writer.write(4, fill_with(2)) is not None  # nobody leased the first
@@ -149,7 +149,7 @@ def test_a_reused_slot_is_reported_not_read() -> None:
 
 
 def test_a_bigger_message_gets_a_bigger_slot() -> None:
-    writer, reader = SlotWriter(min_slots=1, max_slots=1), SlotReader()
+    writer, reader = SlotWriter(max_slots=1), SlotReader()
     try:
         assert writer.write(10, fill_with(1)) is not None
         big = writer.write(3 << 20, fill_with(7))

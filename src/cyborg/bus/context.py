@@ -22,6 +22,7 @@ from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
+from weakref import WeakSet
 
 import zenoh
 
@@ -35,6 +36,19 @@ log = logging.getLogger("cyborg.bus")
 
 SHM_PREFIX = "@cyborg_shm"
 """Liveliness tokens and keys of subscriptions that take large messages through shared memory."""
+
+
+_OPEN: WeakSet[Context] = WeakSet()
+
+
+def _close_open_contexts() -> None:
+    for context in list(_OPEN):
+        context.close()
+
+
+# Zenoh keeps non-daemon threads while a session is open, and Python joins those before it runs
+# atexit handlers; so open sessions are closed from the hook that runs before that join.
+getattr(threading, "_register_atexit", atexit.register)(_close_open_contexts)
 
 
 def host_id() -> str:
@@ -68,7 +82,7 @@ class Context:
         self._warned: set[str] = set()
         self._closed = False
         self.calls = ThreadPoolExecutor(max_workers=8, thread_name_prefix="cyborg-call")
-        atexit.register(self.close)  # a session left open can hang the interpreter's exit
+        _OPEN.add(self)  # closed at exit if the program forgets to
         liveliness = self.session.liveliness()
         self._graph_sub = liveliness.declare_subscriber(
             f"{LIVELINESS_PREFIX}/{self.domain}/**", self._on_token, history=True)
@@ -174,7 +188,7 @@ class Context:
         for node in list(self._nodes):
             node.destroy()
         self._closed = True
-        atexit.unregister(self.close)
+        _OPEN.discard(self)
         self.calls.shutdown(wait=False, cancel_futures=True)
         for declared in (self._graph_sub, self._shm_sub):
             declared.undeclare()

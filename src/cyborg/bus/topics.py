@@ -107,8 +107,8 @@ class Publisher(_Endpoint):
             self._zenoh = session.declare_publisher(
                 self.key, reliability=reliability, congestion_control=congestion,
                 allowed_destination=zenoh.Locality.REMOTE)
-        self._shm_publisher = session.declare_publisher(
-            self.context.shm_key(self.key), reliability=reliability,
+        self._shm_publisher = session.declare_publisher(  # slot references: small, urgent
+            self.context.shm_key(self.key), reliability=reliability, express=True,
             congestion_control=congestion, allowed_destination=zenoh.Locality.REMOTE)
         self._slots: SlotWriter | None = None
         self._announce()
@@ -123,12 +123,11 @@ class Publisher(_Endpoint):
         with self._lock:
             self._sequence += 1
             attachment = Attachment(self._sequence, time.time_ns(), self.gid)
-            delivery = (message, attachment)
             if self.latched:
-                self.context.latch(self.topic, self, delivery)
-            for subscription in self.context.local_subscriptions(self.topic):
-                subscription.deliver_local(message, self.type_name, attachment)
+                self.context.latch(self.topic, self, (message, attachment))
             self._publish_remote(message, attachment.encode())
+        for subscription in self.context.local_subscriptions(self.topic):
+            subscription.deliver_local(message, self.type_name, attachment)
 
     def _publish_remote(self, message: Any, attachment: bytes) -> None:
         context = self.context
@@ -152,7 +151,11 @@ class Publisher(_Endpoint):
 
     def _matching(self) -> bool:
         publisher = self._zenoh
-        return not isinstance(publisher, zenoh.Publisher) or publisher.matching_status
+        if not isinstance(publisher, zenoh.Publisher):
+            return True
+        # zenoh's stub says bool, but the binding returns a MatchingStatus
+        status: Any = publisher.matching_status
+        return bool(status.matching)
 
     def subscription_count(self) -> int:
         """Subscriptions on this topic now: in this process plus elsewhere (from the graph)."""
@@ -214,8 +217,16 @@ class Subscription(_Endpoint):
         if type_name != self.type_name:
             self.context.drop(f"{self.topic}: type {type_name} instead of {self.type_name}")
             return
-        if self._fresh(attachment):
-            self._enqueue(self.context.copier.copy(message, type_name))
+        if not self._fresh(attachment):
+            return
+        copy = self.context.copier.copy(message, type_name)
+        if not self.node.callbacks.try_inline(self._deliver_now, copy):
+            self._enqueue(copy)
+
+    def _deliver_now(self, message: Any) -> None:
+        if not self._closed:
+            self.received += 1
+            self.callback(message)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
         if self._accept(sample):
