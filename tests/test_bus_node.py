@@ -20,6 +20,7 @@ from cyborg.bus import (
     Node,
     Qos,
     ServiceError,
+    ServiceTimeoutError,
     new_message,
     to_plain,
 )
@@ -281,3 +282,28 @@ def test_a_program_that_forgets_to_close_still_exits() -> None:
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                             timeout=20)
     assert result.returncode == 0 and result.stdout == "done\n", result.stderr
+
+
+def test_a_call_without_reply_times_out(bus: Context) -> None:
+    node = Node("silent", context=bus)
+    node.create_service("never", "std_srvs/srv/Trigger", lambda request, responder: None,
+                        deferred=True)
+    client = node.create_client("never", "std_srvs/srv/Trigger")
+    request = bus.types.message_class("std_srvs/srv/Trigger_Request")
+    started = time.monotonic()
+    with pytest.raises(ServiceTimeoutError, match=r"/never: no reply within 0.3 s"):
+        client.call(request(structure_needs_at_least_one_member=0), timeout=0.3)
+    assert 0.25 < time.monotonic() - started < 3
+
+
+def test_detections_and_parameter_services_are_registered(bus: Context) -> None:
+    detections = new_message(bus.types, "vision_msgs/msg/Detection2DArray", {"detections": [
+        {"results": [{"hypothesis": {"class_id": "person", "score": 0.9}}],
+         "bbox": {"center": {"position": {"x": 320.0, "y": 240.0}}, "size_x": 50.0,
+                  "size_y": 120.0}}]})
+    data = bus.types.serialize(detections, "vision_msgs/msg/Detection2DArray")
+    back = bus.types.deserialize(data, "vision_msgs/msg/Detection2DArray")
+    assert to_plain(back) == to_plain(detections)
+    for name in ("rcl_interfaces/srv/GetParameters", "action_msgs/srv/CancelGoal",
+                 "cyborg_msgs/action/MoveToGoal"):
+        assert bus.types.hash(name).startswith("RIHS01_")

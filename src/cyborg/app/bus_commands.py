@@ -19,6 +19,7 @@ import itertools
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import yaml
@@ -42,20 +43,14 @@ def add_parser(commands: Any) -> None:
     router.set_defaults(handler=router_command)
 
     node = _group(commands, "node", "nodes on the bus")
-    listing = node.add_parser("list", help="list live nodes")
-    _connection(listing)
-    listing.set_defaults(handler=node_list)
-    info = node.add_parser("info", help="a node's publishers, subscriptions and services")
-    info.add_argument("name")
-    _connection(info)
-    info.set_defaults(handler=node_info)
+    _command(node, "list", "list live nodes", node_list)
+    _command(node, "info", "a node's publishers, subscriptions and services",
+             node_info).add_argument("name")
 
     topic = _group(commands, "topic", "topics on the bus")
-    listing = topic.add_parser("list", help="list topics")
-    listing.add_argument("-t", "--show-types", action="store_true")
-    _connection(listing)
-    listing.set_defaults(handler=topic_list)
-    echo = topic.add_parser("echo", help="print messages of a topic as YAML")
+    _command(topic, "list", "list topics", topic_list).add_argument(
+        "-t", "--show-types", action="store_true")
+    echo = _command(topic, "echo", "print messages of a topic as YAML", topic_echo)
     echo.add_argument("topic")
     echo.add_argument("type", nargs="?", help="message type (default: from the graph)")
     echo.add_argument("--once", action="store_true", help="print one message and exit")
@@ -63,9 +58,7 @@ def add_parser(commands: Any) -> None:
     echo.add_argument("--timeout", type=float, default=0.0, help="give up after S seconds")
     echo.add_argument("--latched", action="store_true", help="also get the latched message")
     echo.add_argument("--full", action="store_true", help="print long arrays in full")
-    _connection(echo)
-    echo.set_defaults(handler=topic_echo)
-    pub = topic.add_parser("pub", help="publish a message given as YAML")
+    pub = _command(topic, "pub", "publish a message given as YAML", topic_pub)
     pub.add_argument("topic")
     pub.add_argument("type")
     pub.add_argument("values", nargs="?", default="{}", help="fields as YAML, e.g. '{data: hi}'")
@@ -73,29 +66,22 @@ def add_parser(commands: Any) -> None:
     pub.add_argument("--once", action="store_true", help="publish once, then exit")
     pub.add_argument("--times", type=int, default=0, help="publish this many times, then exit")
     pub.add_argument("--latched", action="store_true", help="latched (transient local)")
-    _connection(pub)
-    pub.set_defaults(handler=topic_pub)
-    hz = topic.add_parser("hz", help="print the rate of a topic")
+    hz = _command(topic, "hz", "print the rate of a topic", topic_hz)
     hz.add_argument("topic")
     hz.add_argument("type", nargs="?")
     hz.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
-    _connection(hz)
-    hz.set_defaults(handler=topic_hz)
 
     service = _group(commands, "service", "services on the bus")
-    listing = service.add_parser("list", help="list services")
-    listing.add_argument("-t", "--show-types", action="store_true")
-    _connection(listing)
-    listing.set_defaults(handler=service_list)
-    call = service.add_parser("call", help="call a service with a request given as YAML")
+    _command(service, "list", "list services", service_list).add_argument(
+        "-t", "--show-types", action="store_true")
+    call = _command(service, "call", "call a service with a request given as YAML",
+                    service_call)
     call.add_argument("name")
     call.add_argument("type", nargs="?", help="service type (default: from the graph)")
     call.add_argument("values", nargs="?", default="{}")
     call.add_argument("--timeout", type=float, default=5.0)
-    _connection(call)
-    call.set_defaults(handler=service_call)
 
-    add_param_parser(_group(commands, "param", "parameters of a node"), _connection)
+    add_param_parser(_group(commands, "param", "parameters of a node"), _command)
 
 
 def _group(commands: Any, name: str, text: str) -> Any:
@@ -103,11 +89,16 @@ def _group(commands: Any, name: str, text: str) -> Any:
     return parser.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND", required=True)
 
 
-def _connection(parser: argparse.ArgumentParser) -> None:
+def _command(group: Any, name: str, text: str,
+             handler: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
+    """A subcommand that joins the bus: ``--connect`` and ``--wait`` come with it."""
+    parser: argparse.ArgumentParser = group.add_parser(name, help=text)
+    parser.set_defaults(handler=handler)
     parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                         help="router to join (default $CYBORG_CONNECT or tcp/127.0.0.1:7447)")
     parser.add_argument("--wait", type=float, default=1.0, metavar="S",
                         help="seconds to wait for the graph to fill (default 1)")
+    return parser
 
 
 def open_context(args: argparse.Namespace) -> Context:
@@ -173,16 +164,19 @@ def node_info(args: argparse.Namespace) -> int:
 
 def topic_list(args: argparse.Namespace) -> int:
     with open_context(args) as context:
-        for topic, type_names in sorted(context.graph.topics().items()):
-            print(f"{topic} [{', '.join(sorted(type_names))}]" if args.show_types else topic)
+        _print_names(context.graph.topics(), args.show_types)
     return 0
 
 
 def service_list(args: argparse.Namespace) -> int:
     with open_context(args) as context:
-        for name, type_names in sorted(context.graph.services().items()):
-            print(f"{name} [{', '.join(sorted(type_names))}]" if args.show_types else name)
+        _print_names(context.graph.services(), args.show_types)
     return 0
+
+
+def _print_names(found: dict[str, set[str]], show_types: bool) -> None:
+    for name, type_names in sorted(found.items()):
+        print(f"{name} [{', '.join(sorted(type_names))}]" if show_types else name)
 
 
 def _absolute(name: str) -> str:

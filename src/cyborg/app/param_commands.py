@@ -13,22 +13,16 @@ from cyborg.bus import Node, ServiceError
 from cyborg.bus.parameter_client import ParameterClient, ParameterError
 
 
-def add_param_parser(param: Any, connection: Callable[[argparse.ArgumentParser], None]) -> None:
-    listing = param.add_parser("list", help="a node's parameters")
-    listing.add_argument("node")
-    connection(listing)
-    listing.set_defaults(handler=param_list)
-    get = param.add_parser("get", help="a parameter's value")
+def add_param_parser(param: Any, command: Callable[..., argparse.ArgumentParser]) -> None:
+    """The ``param`` subcommands; ``command`` makes a subcommand that joins the bus."""
+    command(param, "list", "a node's parameters", param_list).add_argument("node")
+    get = command(param, "get", "a parameter's value", param_get)
     get.add_argument("node")
     get.add_argument("name")
-    connection(get)
-    get.set_defaults(handler=param_get)
-    set_ = param.add_parser("set", help="set a parameter (the value is read as YAML)")
+    set_ = command(param, "set", "set a parameter (the value is read as YAML)", param_set)
     set_.add_argument("node")
     set_.add_argument("name")
     set_.add_argument("value")
-    connection(set_)
-    set_.set_defaults(handler=param_set)
 
 
 def _client(args: argparse.Namespace, run: Callable[[ParameterClient], None]) -> int:

@@ -142,8 +142,9 @@ class Context:
             if subscription in subscribers:
                 subscribers.remove(subscription)
 
-    def local_subscriptions(self, topic: str) -> list[Any]:
-        return self._local.get(topic, [])
+    def local_subscriptions(self, topic: str) -> tuple[Any, ...]:
+        with self._lock:
+            return tuple(self._local.get(topic, ()))
 
     def latch(self, topic: str, publisher: Any, delivery: Any) -> None:
         """Remember the last message of a latched publisher for late in-process subscribers."""

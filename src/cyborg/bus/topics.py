@@ -282,11 +282,10 @@ class Subscription(_Endpoint):
 
     def _dispatch(self) -> None:
         with self._lock:
-            if not self._queue or self._closed:
+            if not self._queue:
                 return
             message = self._queue.popleft()
-        self.received += 1
-        self.callback(message)
+        self._deliver_now(message)
 
     def destroy(self) -> None:
         if not self._withdraw():
