@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from cyborg.bus.conversion import new_message
 from cyborg.bus.services import Responder, ServiceError
 from cyborg.bus.wire import Qos
 
@@ -162,7 +163,7 @@ class ActionServer:
                 log.error("action %s: execute returned %s, not %s_Result", self.name,
                           type(result).__name__, self.action_type)
                 status = GoalStatus.ABORTED
-            result = _default(self.types, f"{self.action_type}_Result")
+            result = new_message(self.types, f"{self.action_type}_Result")
         self._finish(goal, status, result)
 
     def _finish(self, goal: ServerGoal, status: GoalStatus, result: Any) -> None:
@@ -191,7 +192,7 @@ class ActionServer:
         if finished is None:  # unknown goal: ROS answers UNKNOWN with an empty result
             result_type = f"{self.action_type}_Result"
             responder.reply(self._result_response(GoalStatus.UNKNOWN,
-                                                  _default(self.types, result_type)))
+                                                  new_message(self.types, result_type)))
             return
         responder.reply(self._result_response(*finished))
 
@@ -247,11 +248,6 @@ class ActionServer:
             goal._cancel.set()
         for entity in (*self._entities, self._feedback_pub, self._status_pub):
             entity.destroy()
-
-
-def _default(types: Any, type_name: str) -> Any:
-    from cyborg.bus.conversion import new_message
-    return new_message(types, type_name)
 
 
 class ClientGoal:
