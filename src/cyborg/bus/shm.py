@@ -5,11 +5,11 @@ send, it serialises the message straight into a free slot (the one copy the tran
 publishes a :class:`SlotRef` — path, generation, length — over Zenoh. A subscriber maps the slot
 read-only and deserialises in place: numpy fields of the message are views on the shared memory.
 
-Who may write a slot is decided by ``flock`` locks, one open file per lease:
+Who may write a slot is decided by ``flock`` locks:
 
 * the writer takes an exclusive lock while it fills a slot and releases it before announcing;
-* a reader takes a shared lock before reading and holds it as long as any view made from the
-  slot is alive (a ``weakref.finalize`` on the lease array closes the file);
+* a reader process takes a shared lock before reading and holds it as long as any view made
+  from the slot is alive (a ``weakref.finalize`` on each lease array counts them down);
 * the writer skips slots it cannot lock and makes new ones up to ``max_slots``; when every slot
   is leased, :meth:`SlotWriter.write` returns ``None`` and the caller sends the bytes inline.
 
@@ -30,6 +30,7 @@ import re
 import secrets
 import struct
 import tempfile
+import threading
 import weakref
 from collections import OrderedDict
 from collections.abc import Callable
@@ -152,12 +153,73 @@ class SlotWriter:
         self._slots.clear()
 
 
+class _MappedSlot:
+    """A slot as a reader sees it: one descriptor, one read-only mapping, a counted lease.
+
+    ``flock`` locks belong to an open file, so one shared lock per slot serves every lease this
+    process holds on it: the first lease takes it, the last one to be collected releases it.
+    The mapping is made through a descriptor of its own: mmap keeps a duplicate of the
+    descriptor it maps, and that duplicate would otherwise hold the lock as long as the mapping.
+    """
+
+    def __init__(self, path: str) -> None:
+        self.fd = os.open(path, os.O_RDONLY)
+        try:
+            mapping_fd = os.open(path, os.O_RDONLY)
+            try:
+                self.map = mmap.mmap(mapping_fd, 0, prot=mmap.PROT_READ)
+            finally:
+                os.close(mapping_fd)
+        except BaseException:
+            os.close(self.fd)
+            raise
+        self.leases = 0
+        self.retired = False  # evicted from the cache: close once the last lease ends
+        self._lock = threading.Lock()
+
+    def lease(self, ref: SlotRef) -> np.ndarray | None:
+        with self._lock:
+            if self.leases == 0:
+                try:
+                    fcntl.flock(self.fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+                except BlockingIOError:  # the writer is filling it again
+                    return None
+            self.leases += 1
+        generation, length = _HEADER.unpack_from(self.map, 0)
+        fits = length <= len(self.map) - _HEADER.size
+        if generation != ref.generation or length != ref.length or not fits:
+            self._release()
+            return None
+        view = np.frombuffer(self.map, np.uint8, count=length, offset=_HEADER.size)
+        weakref.finalize(view, self._release)
+        return view
+
+    def _release(self) -> None:
+        with self._lock:
+            self.leases -= 1
+            if self.leases:
+                return
+            if self.retired:
+                os.close(self.fd)
+                self.fd = -1
+            else:
+                fcntl.flock(self.fd, fcntl.LOCK_UN)
+
+    def retire(self) -> None:
+        with self._lock:
+            self.retired = True
+            if self.leases == 0 and self.fd >= 0:
+                os.close(self.fd)
+                self.fd = -1
+
+
 class SlotReader:
     """Maps publishers' slots (read-only) and leases them for as long as views live."""
 
     def __init__(self, cache_size: int = 64) -> None:
-        self._maps: OrderedDict[str, mmap.mmap] = OrderedDict()
+        self._slots: OrderedDict[str, _MappedSlot] = OrderedDict()
         self._cache_size = cache_size
+        self._lock = threading.Lock()
 
     def read(self, ref: SlotRef) -> np.ndarray | None:
         """A read-only byte array over the message, or None if the slot was reused or gone.
@@ -166,40 +228,27 @@ class SlotReader:
         view made from it have been garbage-collected.
         """
         try:
-            fd = os.open(ref.path, os.O_RDONLY)
-        except FileNotFoundError:
+            slot = self._slot(ref.path)
+        except (OSError, ValueError):  # gone, or empty
             return None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-            mapped = self._map(ref.path)
-            generation, length = _HEADER.unpack_from(mapped, 0)
-            if generation != ref.generation or length != ref.length:
-                raise BlockingIOError("slot reused")
-            lease = np.frombuffer(mapped, np.uint8, count=length, offset=_HEADER.size)
-        except (BlockingIOError, ValueError, OSError):
-            os.close(fd)
-            return None
-        weakref.finalize(lease, os.close, fd)
-        return lease
+        return slot.lease(ref)
 
-    def _map(self, path: str) -> mmap.mmap:
-        mapped = self._maps.get(path)
-        if mapped is None:
-            # mmap keeps a duplicate of the descriptor it maps; map through a descriptor of
-            # its own, or the duplicate would hold the lease's lock for as long as the mapping.
-            fd = os.open(path, os.O_RDONLY)
-            try:
-                mapped = mmap.mmap(fd, 0, prot=mmap.PROT_READ)
-            finally:
-                os.close(fd)
-            self._maps[path] = mapped
-            while len(self._maps) > self._cache_size:
-                self._maps.popitem(last=False)  # unmapped once no view uses it
-        self._maps.move_to_end(path)
-        return mapped
+    def _slot(self, path: str) -> _MappedSlot:
+        with self._lock:
+            slot = self._slots.get(path)
+            if slot is None:
+                slot = self._slots[path] = _MappedSlot(path)
+                while len(self._slots) > self._cache_size:
+                    self._slots.popitem(last=False)[1].retire()
+            else:
+                self._slots.move_to_end(path)
+            return slot
 
     def close(self) -> None:
-        self._maps.clear()
+        with self._lock:
+            for slot in self._slots.values():
+                slot.retire()
+            self._slots.clear()
 
 
 def remove_stale_slots(folder: Path = SHM_DIR) -> int:
