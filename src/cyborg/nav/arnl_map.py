@@ -1,0 +1,247 @@
+"""Reading ARNL ``.map`` files (the "2D-Map" format of MobileRobots' ARIA, ARNL and MobileSim).
+
+A map file is text, one record per line::
+
+    2D-Map
+    MinPos: -41360 -88140                      header keys, kept verbatim
+    MapInfo: GoalType "Name=Goal" ...          declared object types
+    Cairn: GoalWithHeading -33768 -32545 12.5 "The lecture hall." ICON "el5"
+    Cairn: ForbiddenArea 0 0 90.000000 "" ICON "" -67552 5362 -55700 13464
+    LINES                                      vector walls: x1 y1 x2 y2
+    -39981 -90275 -35580 -90278
+    DATA                                       laser-scanned points: x y
+    -41360 1460
+
+Files store millimetres and degrees; :func:`read_map` converts to metres and radians, so nothing
+beyond this module ever sees a millimetre. Errors are :class:`MapError` naming file and line.
+
+Map objects (cairns) are :class:`MapObject`; see :mod:`cyborg.nav.map_objects` for what each
+kind means (goals, docks, forbidden lines and areas, simulator boxes).
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from cyborg.nav.map_objects import MapObject
+
+MAP_INTROS = ("2D-Map", "2D-Map-Ex", "2D-Map-Ex2", "2D-Map-Ex3", "2D-Map-Ex4")
+
+
+class MapError(ValueError):
+    """A map file that cannot be read; the message names the file and the line."""
+
+    def __init__(self, source: str, line: int, message: str) -> None:
+        super().__init__(f"{source}:{line}: {message}" if line else f"{source}: {message}")
+        self.source, self.line, self.reason = source, line, message
+
+
+@dataclass(frozen=True)
+class MapType:
+    """A ``MapInfo:`` declaration, e.g. ``GoalType`` named ``Goal`` or ``DockPioneer``."""
+
+    category: str  # GoalType, DockType, SectorType, BoundaryType, LocationType, ArgDesc, ...
+    settings: dict[str, str]
+    line: int
+
+    @property
+    def name(self) -> str:
+        return self.settings.get("Name", "")
+
+
+@dataclass
+class ArnlMap:
+    """One map: header, declared types, objects, walls (``lines``) and scanned ``points``.
+
+    ``lines`` is an (N, 4) array of ``x1 y1 x2 y2`` and ``points`` an (M, 2) array, both in
+    metres in the map frame. Sensor sections of 2D-Map-Ex files (``<Sensor>_LINES``,
+    ``<Sensor>_DATA``) are in ``sensor_lines`` and ``sensor_points``; header keys the reader does
+    not interpret are kept, in order, in ``header``.
+    """
+
+    source: str
+    intro: str
+    header: dict[str, list[str]] = field(default_factory=dict)
+    types: list[MapType] = field(default_factory=list)
+    objects: list[MapObject] = field(default_factory=list)
+    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    sensor_lines: dict[str, np.ndarray] = field(default_factory=dict)
+    sensor_points: dict[str, np.ndarray] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ objects by kind
+    def goals(self) -> list[MapObject]:
+        """Goals and docks, in file order: everything a robot can be sent to by name."""
+        return [item for item in self.objects if item.is_goal or item.is_dock]
+
+    def docks(self) -> list[MapObject]:
+        return [item for item in self.objects if item.is_dock]
+
+    def goal(self, name: str) -> MapObject:
+        """The goal or dock called ``name``; KeyError listing the names otherwise."""
+        for item in self.goals():
+            if item.name == name:
+                return item
+        known = ", ".join(repr(item.name) for item in self.goals()) or "none"
+        raise KeyError(f"{self.source}: no goal named {name!r} (goals: {known})")
+
+    def homes(self) -> list[MapObject]:
+        return [item for item in self.objects if item.kind == "RobotHome"]
+
+    def forbidden_lines(self) -> list[MapObject]:
+        return [item for item in self.objects if item.is_forbidden_line]
+
+    def forbidden_areas(self) -> list[MapObject]:
+        return [item for item in self.objects if item.is_forbidden_area]
+
+    def sim_obstacles(self) -> list[MapObject]:
+        """Boxes that only the simulator puts into the world (``Sim.BoxObstacle`` sectors)."""
+        return [item for item in self.objects if item.is_sim_obstacle]
+
+    # ------------------------------------------------------------------ extent
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(min_x, min_y, max_x, max_y)`` over walls, points and objects, in metres."""
+        xs: list[np.ndarray] = [self.points[:, 0], self.lines[:, 0], self.lines[:, 2]]
+        ys: list[np.ndarray] = [self.points[:, 1], self.lines[:, 1], self.lines[:, 3]]
+        for item in self.objects:
+            corners = item.corners()
+            if corners is not None:
+                xs.append(corners[:, 0])
+                ys.append(corners[:, 1])
+            xs.append(np.array([item.x]))
+            ys.append(np.array([item.y]))
+        all_x, all_y = np.concatenate(xs), np.concatenate(ys)
+        if all_x.size == 0:
+            return (0.0, 0.0, 0.0, 0.0)
+        return (float(all_x.min()), float(all_y.min()), float(all_x.max()), float(all_y.max()))
+
+
+# ---------------------------------------------------------------------- reading
+def read_map(path: str | Path) -> ArnlMap:
+    """Read an ARNL map file; :class:`MapError` (file and line) if it is not one."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError as exc:
+        raise MapError(str(path), 0, f"cannot read the map: {exc.strerror or exc}") from exc
+    return parse_map(text, str(path))
+
+
+def parse_map(text: str, source: str = "<map>") -> ArnlMap:
+    """Parse the text of a map file; ``source`` names it in error messages."""
+    rows = text.splitlines()
+    first = next((index for index, row in enumerate(rows) if row.strip()), None)
+    if first is None:
+        raise MapError(source, 0, "empty file, expected a '2D-Map' line")
+    intro = rows[first].strip()
+    if intro not in MAP_INTROS:
+        raise MapError(source, first + 1, f"expected '2D-Map' (an ARNL map), found {intro[:40]!r}")
+    result = ArnlMap(source=source, intro=intro)
+    section: str | None = None  # e.g. "LINES", "DATA", "Laser2_LINES"
+    section_rows: list[str] = []
+    section_lines: list[int] = []
+    for index in range(first + 1, len(rows)):
+        row = rows[index].strip()
+        if not row:
+            continue
+        if row == "LINES" or row == "DATA" or row.endswith(("_LINES", "_DATA")):
+            _store_section(result, section, section_rows, section_lines, source)
+            section, section_rows, section_lines = row, [], []
+            continue
+        if section is not None and (row[0].isdigit() or row[0] in "-+."):
+            section_rows.append(row)
+            section_lines.append(index + 1)
+            continue
+        if section is not None:
+            _store_section(result, section, section_rows, section_lines, source)
+            section, section_rows, section_lines = None, [], []
+        _header_line(result, row, index + 1, source)
+    _store_section(result, section, section_rows, section_lines, source)
+    result.objects = [item.classified(result.types) for item in result.objects]
+    return result
+
+
+def _header_line(result: ArnlMap, row: str, line: int, source: str) -> None:
+    key, colon, rest = row.partition(":")
+    if not colon or not key or " " in key:
+        raise MapError(source, line, f"expected 'Key: values', LINES or DATA, found {row[:60]!r}")
+    try:
+        tokens = shlex.split(rest, posix=True)
+    except ValueError as exc:
+        raise MapError(source, line, f"{key}: {exc} (an unbalanced quote?)") from exc
+    if key == "Cairn":
+        result.objects.append(_cairn(tokens, line, source))
+    elif key == "MapInfo":
+        if not tokens:
+            raise MapError(source, line, "MapInfo without a category")
+        settings = dict(token.partition("=")[::2] for token in tokens[1:])
+        result.types.append(MapType(tokens[0], settings, line))
+    else:
+        result.header.setdefault(key, []).extend(tokens)
+
+
+def _cairn(tokens: list[str], line: int, source: str) -> MapObject:
+    """``Type x y th "desc" icon "name" [fromX fromY toX toY]`` (mm, degrees)."""
+    if len(tokens) < 7:
+        raise MapError(source, line, f"Cairn needs at least 7 fields (type x y heading "
+                                     f"\"description\" icon \"name\"), found {len(tokens)}")
+    kind = tokens[0]
+    try:
+        x, y, heading = (float(value) for value in tokens[1:4])
+        region = None
+        if len(tokens) >= 11:
+            fx, fy, tx, ty = (float(value) / 1000 for value in tokens[7:11])
+            region = (fx, fy, tx, ty)
+    except ValueError as exc:
+        raise MapError(source, line, f"Cairn {kind}: a coordinate is not a number ({exc})") from exc
+    if not all(math.isfinite(value) for value in (x, y, heading)):
+        raise MapError(source, line, f"Cairn {kind}: coordinates must be finite")
+    return MapObject(kind=kind, x=x / 1000, y=y / 1000, theta=math.radians(heading),
+                     description=tokens[4], icon=tokens[5], name=tokens[6], region=region,
+                     line=line)
+
+
+def _store_section(result: ArnlMap, section: str | None, rows: list[str], lines: list[int],
+                   source: str) -> None:
+    if section is None:
+        return
+    width = 4 if section.endswith("LINES") else 2
+    array = _numbers(rows, width, lines, source, section) / 1000.0
+    if section == "LINES":
+        result.lines = array
+    elif section == "DATA":
+        result.points = array
+    elif width == 4:
+        result.sensor_lines[section.removesuffix("_LINES")] = array
+    else:
+        result.sensor_points[section.removesuffix("_DATA")] = array
+
+
+def _numbers(rows: list[str], width: int, lines: list[int], source: str,
+             section: str) -> np.ndarray:
+    """Rows of ``width`` numbers as an array; a bad row is named by its line."""
+    if not rows:
+        return np.zeros((0, width))
+    split = [row.split() for row in rows]
+    for tokens, line, row in zip(split, lines, rows, strict=True):
+        if len(tokens) != width:
+            raise MapError(source, line, f"{section}: expected {width} numbers, found {row[:60]!r}")
+    try:
+        values = np.array([token for tokens in split for token in tokens], dtype=np.float64)
+    except ValueError:
+        values = None
+    if values is not None and np.isfinite(values).all():
+        return values.reshape(-1, width)
+    for tokens, line, row in zip(split, lines, rows, strict=True):  # find the culprit
+        try:
+            ok = all(math.isfinite(float(token)) for token in tokens)
+        except ValueError:
+            ok = False
+        if not ok:
+            raise MapError(source, line, f"{section}: expected {width} numbers, found {row[:60]!r}")
+    raise AssertionError("unreachable: every row parsed")

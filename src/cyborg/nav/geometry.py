@@ -1,0 +1,232 @@
+"""Poses and paths in the map frame (metres, radians), convertible to and from ROS messages.
+
+:class:`Point`, :class:`Quaternion` and :class:`Pose` mirror ``geometry_msgs``; :class:`Pose2D`
+is what a ground robot mostly needs (x, y, heading). :class:`Path` is a polyline with a length,
+the distance still to go from a position, and a point a given distance ahead ("carrot").
+
+``from_message`` accepts any object with the ROS fields (a bus message or a plain namespace);
+``to_message(types)`` builds the bus message with a :class:`cyborg.bus.MessageTypes` registry.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+def normalize_angle(angle: float) -> float:
+    """The same angle in [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+@dataclass(frozen=True)
+class Point:
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+
+    def distance_to(self, other: Point) -> float:
+        return math.dist((self.x, self.y, self.z), (other.x, other.y, other.z))
+
+    @classmethod
+    def from_message(cls, message: Any) -> Point:
+        return cls(float(message.x), float(message.y), float(message.z))
+
+    def to_message(self, types: Any) -> Any:
+        return types.message_class("geometry_msgs/msg/Point")(x=self.x, y=self.y, z=self.z)
+
+
+@dataclass(frozen=True)
+class Quaternion:
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    w: float = 1.0
+
+    @classmethod
+    def from_yaw(cls, yaw: float) -> Quaternion:
+        """A rotation about the vertical axis by ``yaw`` radians."""
+        return cls(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+    @property
+    def yaw(self) -> float:
+        """The heading in radians (rotation about z), in [-pi, pi)."""
+        siny = 2 * (self.w * self.z + self.x * self.y)
+        cosy = 1 - 2 * (self.y * self.y + self.z * self.z)
+        return normalize_angle(math.atan2(siny, cosy))
+
+    @classmethod
+    def from_message(cls, message: Any) -> Quaternion:
+        return cls(float(message.x), float(message.y), float(message.z), float(message.w))
+
+    def to_message(self, types: Any) -> Any:
+        return types.message_class("geometry_msgs/msg/Quaternion")(
+            x=self.x, y=self.y, z=self.z, w=self.w)
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """A ground robot's pose: position in metres, heading in radians."""
+
+    x: float = 0.0
+    y: float = 0.0
+    theta: float = 0.0
+
+    def distance_to(self, other: Pose2D | Point) -> float:
+        return math.hypot(self.x - other.x, self.y - other.y)
+
+    def to_pose(self) -> Pose:
+        return Pose(Point(self.x, self.y), Quaternion.from_yaw(self.theta))
+
+    @classmethod
+    def from_message(cls, message: Any) -> Pose2D:
+        """From ``geometry_msgs/Pose2D`` or ``geometry_msgs/Pose``."""
+        if hasattr(message, "position"):
+            return Pose.from_message(message).to_pose2d()
+        return cls(float(message.x), float(message.y), float(message.theta))
+
+    def to_message(self, types: Any) -> Any:
+        return types.message_class("geometry_msgs/msg/Pose2D")(
+            x=self.x, y=self.y, theta=self.theta)
+
+
+@dataclass(frozen=True)
+class Pose:
+    position: Point = Point()
+    orientation: Quaternion = Quaternion()
+
+    def to_pose2d(self) -> Pose2D:
+        return Pose2D(self.position.x, self.position.y, self.orientation.yaw)
+
+    @classmethod
+    def from_message(cls, message: Any) -> Pose:
+        return cls(Point.from_message(message.position),
+                   Quaternion.from_message(message.orientation))
+
+    def to_message(self, types: Any) -> Any:
+        return types.message_class("geometry_msgs/msg/Pose")(
+            position=self.position.to_message(types),
+            orientation=self.orientation.to_message(types))
+
+
+class Path:
+    """A polyline of waypoints (metres) from start to goal, with an optional final heading."""
+
+    def __init__(self, points: Sequence[Sequence[float]] | np.ndarray,
+                 final_heading: float | None = None) -> None:
+        array = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        if len(array) == 0:
+            raise ValueError("a path needs at least one point")
+        self.points = array
+        self.final_heading = final_heading
+        steps = np.hypot(*np.diff(array, axis=0).T) if len(array) > 1 else np.zeros(0)
+        self._cumulative = np.concatenate([[0.0], np.cumsum(steps)])
+
+    @property
+    def length(self) -> float:
+        """Length in metres along the polyline."""
+        return float(self._cumulative[-1])
+
+    @property
+    def start(self) -> Pose2D:
+        return Pose2D(float(self.points[0, 0]), float(self.points[0, 1]), self.heading_at(0.0))
+
+    @property
+    def goal(self) -> Pose2D:
+        heading = self.final_heading if self.final_heading is not None else self.heading_at(
+            self.length)
+        return Pose2D(float(self.points[-1, 0]), float(self.points[-1, 1]), heading)
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def project(self, x: float, y: float) -> tuple[float, float]:
+        """``(distance along the path, distance from it)`` of the nearest point of the path."""
+        if len(self.points) == 1:
+            return 0.0, math.hypot(x - self.points[0, 0], y - self.points[0, 1])
+        a, b = self.points[:-1], self.points[1:]
+        segment = b - a
+        squared = np.einsum("ij,ij->i", segment, segment)
+        t = np.clip(np.einsum("ij,ij->i", np.array([x, y]) - a, segment)
+                    / np.where(squared > 0, squared, 1.0), 0.0, 1.0)
+        nearest = a + segment * t[:, None]
+        gaps = np.hypot(nearest[:, 0] - x, nearest[:, 1] - y)
+        index = int(np.argmin(gaps))
+        along = self._cumulative[index] + t[index] * math.sqrt(squared[index])
+        return float(along), float(gaps[index])
+
+    def remaining_from(self, x: float, y: float) -> float:
+        """Metres left to the goal from the point of the path nearest to ``(x, y)``."""
+        along, _gap = self.project(x, y)
+        return self.length - along
+
+    def point_at(self, distance: float) -> tuple[float, float]:
+        """The point ``distance`` metres along the path (clamped to its ends)."""
+        distance = min(max(distance, 0.0), self.length)
+        index = int(np.searchsorted(self._cumulative, distance, side="right")) - 1
+        index = min(index, len(self.points) - 2)
+        if index < 0:
+            return float(self.points[0, 0]), float(self.points[0, 1])
+        span = self._cumulative[index + 1] - self._cumulative[index]
+        t = 0.0 if span == 0 else (distance - self._cumulative[index]) / span
+        point = self.points[index] + t * (self.points[index + 1] - self.points[index])
+        return float(point[0]), float(point[1])
+
+    def sample(self, start: float, stop: float, step: float) -> np.ndarray:
+        """Points every ``step`` metres along the path from ``start`` up to ``stop``."""
+        distances = np.arange(max(start, 0.0), min(stop, self.length), step)
+        return np.column_stack([np.interp(distances, self._cumulative, self.points[:, 0]),
+                                np.interp(distances, self._cumulative, self.points[:, 1])])
+
+    def heading_at(self, distance: float) -> float:
+        """Direction of travel at ``distance`` along the path (0 for a single point)."""
+        if len(self.points) < 2:
+            return self.final_heading or 0.0
+        index = int(np.searchsorted(self._cumulative, min(distance, self.length), side="right"))
+        index = min(max(index - 1, 0), len(self.points) - 2)
+        dx, dy = self.points[index + 1] - self.points[index]
+        return math.atan2(dy, dx)
+
+    def advance_to(self, x: float, y: float) -> Path:
+        """The rest of the path from the point nearest to ``(x, y)`` onwards."""
+        along, _gap = self.project(x, y)
+        index = int(np.searchsorted(self._cumulative, along, side="right"))
+        rest = np.vstack([self.point_at(along), self.points[index:]])
+        return Path(rest, self.final_heading)
+
+    def poses(self) -> list[Pose2D]:
+        """Waypoints as poses heading along the path; the last one takes the final heading."""
+        result = [Pose2D(float(x), float(y), self.heading_at(float(d)))
+                  for (x, y), d in zip(self.points, self._cumulative, strict=True)]
+        result[-1] = self.goal
+        return result
+
+    def to_message(self, types: Any, frame_id: str = "map", stamp: Any = None) -> Any:
+        """As ``nav_msgs/Path``."""
+        header = types.message_class("std_msgs/msg/Header")(
+            stamp=stamp if stamp is not None else types.message_class(
+                "builtin_interfaces/msg/Time")(sec=0, nanosec=0), frame_id=frame_id)
+        stamped = types.message_class("geometry_msgs/msg/PoseStamped")
+        return types.message_class("nav_msgs/msg/Path")(header=header, poses=[
+            stamped(header=header, pose=pose.to_pose().to_message(types))
+            for pose in self.poses()])
+
+    @classmethod
+    def from_message(cls, message: Any) -> Path:
+        poses = [Pose.from_message(stamped.pose) for stamped in message.poses]
+        if not poses:
+            raise ValueError("nav_msgs/Path without poses")
+        return cls([(pose.position.x, pose.position.y) for pose in poses],
+                   poses[-1].orientation.yaw)
+
+    @classmethod
+    def through(cls, poses: Iterable[Pose2D]) -> Path:
+        items = list(poses)
+        return cls([(pose.x, pose.y) for pose in items], items[-1].theta if items else None)
+
+    def __repr__(self) -> str:
+        return f"Path({len(self.points)} points, {self.length:.2f} m)"

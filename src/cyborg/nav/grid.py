@@ -1,0 +1,144 @@
+"""Rasterising a map: walls, forbidden zones and clearance on a regular grid.
+
+A :class:`MapGrid` covers the map's extent (plus a margin) with square cells; row ``r`` and
+column ``c`` hold the cell whose lower-left corner is ``origin + (c, r) * resolution``. Layers:
+
+* ``walls``: cells holding a scanned point or crossed by a wall line (and the simulator's boxes
+  when asked for);
+* ``forbidden``: cells crossed by a forbidden line or inside a forbidden area;
+* :meth:`clearance`: metres from each cell's centre to the nearest blocked cell — what the
+  planner inflates by and the simulator checks collisions with.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.map_objects import MapObject
+
+
+@dataclass
+class MapGrid:
+    """Walls and forbidden cells of a map at one resolution (metres per cell)."""
+
+    origin_x: float
+    origin_y: float
+    resolution: float
+    walls: np.ndarray
+    forbidden: np.ndarray
+
+    @classmethod
+    def from_map(cls, arnl_map: ArnlMap, resolution: float = 0.1, *,
+                 sim_obstacles: bool = False, margin: float = 1.0) -> MapGrid:
+        """Rasterise ``arnl_map``; ``sim_obstacles`` adds the simulator's boxes to the walls."""
+        if resolution <= 0:
+            raise ValueError(f"grid resolution must be positive, not {resolution}")
+        min_x, min_y, max_x, max_y = arnl_map.bounds()
+        origin_x, origin_y = min_x - margin, min_y - margin
+        columns = math.ceil((max_x - origin_x + margin) / resolution) + 1
+        rows = math.ceil((max_y - origin_y + margin) / resolution) + 1
+        grid = cls(origin_x, origin_y, resolution, np.zeros((rows, columns), bool),
+                   np.zeros((rows, columns), bool))
+        grid.mark_points(grid.walls, arnl_map.points)
+        grid.mark_segments(grid.walls, arnl_map.lines)
+        for item in arnl_map.forbidden_lines():
+            corners = item.corners()
+            assert corners is not None
+            grid.mark_segments(grid.forbidden, corners.reshape(1, 4))
+        for item in arnl_map.forbidden_areas():
+            grid.fill_area(grid.forbidden, item)
+        if sim_obstacles:
+            for item in arnl_map.sim_obstacles():
+                grid.fill_area(grid.walls, item)
+        return grid
+
+    # ------------------------------------------------------------------ coordinates
+    @property
+    def shape(self) -> tuple[int, int]:
+        rows, columns = self.walls.shape
+        return rows, columns
+
+    def cell(self, x: float, y: float) -> tuple[int, int]:
+        """``(row, column)`` of the cell holding ``(x, y)`` (may lie outside the grid)."""
+        return (math.floor((y - self.origin_y) / self.resolution),
+                math.floor((x - self.origin_x) / self.resolution))
+
+    def inside(self, row: int, column: int) -> bool:
+        rows, columns = self.shape
+        return 0 <= row < rows and 0 <= column < columns
+
+    def center(self, row: int, column: int) -> tuple[float, float]:
+        return (self.origin_x + (column + 0.5) * self.resolution,
+                self.origin_y + (row + 0.5) * self.resolution)
+
+    def cells_of(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rows and columns of an (N, 2) array of points, clipped to the grid."""
+        rows, columns = self.shape
+        r = np.floor((points[:, 1] - self.origin_y) / self.resolution).astype(np.int64)
+        c = np.floor((points[:, 0] - self.origin_x) / self.resolution).astype(np.int64)
+        return np.clip(r, 0, rows - 1), np.clip(c, 0, columns - 1)
+
+    # ------------------------------------------------------------------ drawing
+    def mark_points(self, layer: np.ndarray, points: np.ndarray) -> None:
+        if len(points):
+            rows, columns = self.cells_of(points)
+            layer[rows, columns] = True
+
+    def mark_segments(self, layer: np.ndarray, segments: np.ndarray) -> None:
+        """Mark every cell an (N, 4) array of segments passes through (sampled finely)."""
+        if len(segments) == 0:
+            return
+        starts, ends = segments[:, :2], segments[:, 2:]
+        lengths = np.hypot(*(ends - starts).T)
+        counts = np.maximum(2, np.ceil(lengths / (self.resolution / 3)).astype(np.int64) + 1)
+        owner = np.repeat(np.arange(len(segments)), counts)
+        first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        t = (np.arange(counts.sum()) - np.repeat(first, counts)) / np.repeat(counts - 1, counts)
+        samples = starts[owner] + (ends - starts)[owner] * t[:, None]
+        self.mark_points(layer, samples)
+
+    def fill_area(self, layer: np.ndarray, area: MapObject) -> None:
+        """Mark the cells whose centres lie inside an area object (rotation included)."""
+        corners = area.corners()
+        if corners is None or len(corners) != 4:
+            return
+        low_r, low_c = self.cells_of(corners.min(axis=0, keepdims=True))
+        high_r, high_c = self.cells_of(corners.max(axis=0, keepdims=True))
+        r, c = np.mgrid[low_r[0]:high_r[0] + 1, low_c[0]:high_c[0] + 1]
+        x = self.origin_x + (c + 0.5) * self.resolution
+        y = self.origin_y + (r + 0.5) * self.resolution
+        assert area.region is not None
+        fx, fy, tx, ty = area.region
+        cos, sin = math.cos(-area.theta), math.sin(-area.theta)
+        ux, uy = x * cos - y * sin, x * sin + y * cos
+        inside = ((ux >= min(fx, tx)) & (ux <= max(fx, tx))
+                  & (uy >= min(fy, ty)) & (uy <= max(fy, ty)))
+        layer[r[inside], c[inside]] = True
+        self.mark_segments(layer, np.array([[*corners[i], *corners[(i + 1) % 4]]
+                                            for i in range(4)]))  # thin areas stay closed
+
+    # ------------------------------------------------------------------ clearance
+    def blocked(self, forbidden: bool = True) -> np.ndarray:
+        """Cells the robot's centre can never be in: walls, and forbidden cells if asked."""
+        return self.walls | self.forbidden if forbidden else self.walls.copy()
+
+    def clearance(self, blocked: np.ndarray | None = None) -> np.ndarray:
+        """Metres from each cell centre to the nearest blocked cell (float32; 0 when blocked)."""
+        if blocked is None:
+            blocked = self.blocked()
+        if not blocked.any():
+            return np.full(self.shape, np.float32(1e6))
+        distance: np.ndarray = ndimage.distance_transform_edt(~blocked)
+        return (distance * self.resolution).astype(np.float32)
+
+    def clearance_at(self, clearance: np.ndarray, x: float, y: float) -> float:
+        """Clearance at a point, 0 outside the grid."""
+        row, column = self.cell(x, y)
+        if not self.inside(row, column):
+            return 0.0
+        return float(clearance[row, column])

@@ -1,0 +1,166 @@
+"""Path planning on an ARNL map: a grid search that keeps the robot clear of walls.
+
+As ARNL does, the map (points, lines, forbidden lines and areas) is sampled into a grid (5 cm by
+default); A* finds the cheapest path whose cells keep the robot's *circumscribed* radius from
+anything blocked, with a cost that rises near walls so paths keep to the middle of corridors; then
+line-of-sight shortcuts straighten it without coming closer to walls than the search path did.
+
+Poses near walls (the dock, a goal in a niche) are reachable: around the start and the goal the
+robot may use cells that only clear its *inscribed* radius. A goal whose pose does not even
+clear that ("inside a wall"), lies in a forbidden zone, or is cut off gives a result without a
+path, whose ``code`` uses Nav2's names and whose ``length`` is infinity::
+
+    planner = Planner(read_map("columbia.map"))
+    result = planner.plan(Pose2D(0, 0), Pose2D(13.0, -12.2))
+    result.found, result.length, result.reason
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.footprint import PIONEER_LX, Footprint
+from cyborg.nav.geometry import Path, Pose2D
+from cyborg.nav.grid import MapGrid
+from cyborg.nav.search import astar, shortcut
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """Tuning of the planner; lengths in metres (ARNL's names in brackets)."""
+
+    resolution: float = 0.05  # grid cell size [PlanRes]
+    padding: float = 0.0  # clearance beyond the circumscribed radius [PlanFreeSpace]
+    cost_ramp: float = 0.4  # how far beyond that the cost of being near walls reaches
+    cost_weight: float = 3.0  # the extra cost per metre right at the lethal distance
+    smoothing_margin: float = 0.55  # clearance shortcuts keep where the grid path had it
+    escape_radius: float = 0.8  # around start and goal, cells clearing the inscribed radius
+
+
+# Result codes (Nav2's ComputePathToPose error names).
+NONE, START_OCCUPIED, GOAL_OCCUPIED, NO_VALID_PATH, OUTSIDE_MAP = (
+    "NONE", "START_OCCUPIED", "GOAL_OCCUPIED", "NO_VALID_PATH", "START_OUTSIDE_MAP")
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A path, or why there is none (``code`` and ``reason``); how long planning took."""
+
+    path: Path | None
+    code: str = NONE
+    reason: str = ""
+    planning_time: float = 0.0
+
+    @property
+    def found(self) -> bool:
+        return self.path is not None
+
+    @property
+    def length(self) -> float:
+        """Metres along the path; infinity without one."""
+        return self.path.length if self.path is not None else math.inf
+
+
+class Planner:
+    """Plans paths on one map for one robot shape."""
+
+    def __init__(self, arnl_map: ArnlMap, footprint: Footprint = PIONEER_LX,
+                 settings: PlannerSettings | None = None) -> None:
+        self.map = arnl_map
+        self.footprint = footprint
+        self.settings = settings or PlannerSettings()
+        self.grid = MapGrid.from_map(arnl_map, self.settings.resolution)
+        self.lethal = footprint.circumscribed_radius + self.settings.padding
+        self.tight = footprint.inscribed_radius
+        self.wall_clearance = self.grid.clearance(self.grid.walls)
+        self.clearance = self.grid.clearance()
+        self.cost = self._cost(self.clearance)
+
+    # ------------------------------------------------------------------ checks
+    def check(self, pose: Pose2D, role: str = "goal") -> tuple[str, str] | None:
+        """``(code, reason)`` if the robot cannot stand at ``pose``, else None."""
+        grid = self.grid
+        row, column = grid.cell(pose.x, pose.y)
+        occupied = START_OCCUPIED if role == "start" else GOAL_OCCUPIED
+        where = f"{role} ({pose.x:.2f}, {pose.y:.2f})"
+        if not grid.inside(row, column):
+            return (OUTSIDE_MAP if role == "start" else GOAL_OCCUPIED), f"{where} is off the map"
+        if grid.forbidden[row, column]:
+            return occupied, f"{where} is inside a forbidden area or on a forbidden line"
+        if self.wall_clearance[row, column] < self.tight:
+            return occupied, (f"{where} is inside a wall (clearance "
+                              f"{self.wall_clearance[row, column]:.2f} m, the robot needs "
+                              f"{self.tight:.2f} m)")
+        return None
+
+    # ------------------------------------------------------------------ planning
+    def plan(self, start: Pose2D, goal: Pose2D, *, use_heading: bool = False,
+             obstacles: np.ndarray | None = None) -> PlanResult:
+        """Plan from ``start`` to ``goal``; ``obstacles``: extra (N, 2) points (sensed ones)."""
+        began = time.perf_counter()
+        problem = self.check(start, "start") or self.check(goal, "goal")
+        if problem is not None:
+            return PlanResult(None, *problem, planning_time=time.perf_counter() - began)
+        clearance, cost = self.clearance, self.cost
+        if obstacles is not None and len(obstacles):
+            blocked = self.grid.blocked()
+            self.grid.mark_points(blocked, obstacles)
+            clearance = self.grid.clearance(blocked)
+            cost = self._cost(clearance)
+        cost = cost.copy()
+        for pose in (start, goal):
+            self._open_escape(cost, clearance, pose)
+        _rows, columns = self.grid.shape
+        start_cell = self.grid.cell(start.x, start.y)
+        goal_cell = self.grid.cell(goal.x, goal.y)
+        cells = astar(cost, start_cell[0] * columns + start_cell[1],
+                      goal_cell[0] * columns + goal_cell[1])
+        if len(cells) == 0:
+            return PlanResult(None, NO_VALID_PATH,
+                              f"no path from ({start.x:.2f}, {start.y:.2f}) to "
+                              f"({goal.x:.2f}, {goal.y:.2f}): the goal is cut off",
+                              time.perf_counter() - began)
+        path = self._smooth(cells, clearance, start, goal)
+        return PlanResult(Path(path, goal.theta if use_heading else None),
+                          planning_time=time.perf_counter() - began)
+
+    def _cost(self, clearance: np.ndarray) -> np.ndarray:
+        ramp = self.settings.cost_ramp
+        closeness = np.clip((self.lethal + ramp - clearance) / ramp, 0.0, 1.0)
+        cost = 1.0 + self.settings.cost_weight * closeness ** 2
+        return np.where(clearance >= self.lethal, cost, np.inf)
+
+    def _open_escape(self, cost: np.ndarray, clearance: np.ndarray, pose: Pose2D) -> None:
+        """Let the search use tight cells (clearing only the inscribed radius) near ``pose``."""
+        grid, radius = self.grid, self.settings.escape_radius
+        reach = math.ceil(radius / grid.resolution)
+        row, column = grid.cell(pose.x, pose.y)
+        r0, r1 = max(row - reach, 0), min(row + reach + 1, grid.shape[0])
+        c0, c1 = max(column - reach, 0), min(column + reach + 1, grid.shape[1])
+        rr, cc = np.mgrid[r0:r1, c0:c1]
+        near = np.hypot(rr - row, cc - column) * grid.resolution <= radius
+        window = clearance[r0:r1, c0:c1]
+        tight = near & (window >= self.tight) & ~np.isfinite(cost[r0:r1, c0:c1])
+        cost[r0:r1, c0:c1][tight] = 2.0 + 2.0 * self.settings.cost_weight
+
+    def _smooth(self, cells: np.ndarray, clearance: np.ndarray, start: Pose2D,
+                goal: Pose2D) -> np.ndarray:
+        grid = self.grid
+        columns = grid.shape[1]
+        rows_, cols_ = cells // columns, cells % columns
+        points = np.column_stack([grid.origin_x + (cols_ + 0.5) * grid.resolution,
+                                  grid.origin_y + (rows_ + 0.5) * grid.resolution])
+        points[0] = (start.x, start.y)
+        points[-1] = (goal.x, goal.y)
+        floors = clearance[rows_, cols_].astype(np.float64)
+        if len(points) <= 2:
+            return points
+        kept = shortcut(points, floors, clearance, grid.origin_x, grid.origin_y,
+                        grid.resolution, self.settings.smoothing_margin)
+        smoothed: np.ndarray = points[kept]
+        return smoothed

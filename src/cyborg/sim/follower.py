@@ -1,0 +1,106 @@
+"""Following a planned path: a carrot along the path, slowing near obstacles and at the goal.
+
+The robot steers towards a point ``lookahead`` metres further along the path than the point of
+the path nearest to it — a carrot on the polyline, so corners are rounded by at most the
+lookahead and never cut through walls the planner kept clear of. It turns in place when the
+carrot is far off its heading, slows where the laser sees obstacles close ahead, and brakes in
+time for the goal. On arrival it turns to the goal's heading if asked.
+
+Progress is measured *along the path* (the distance still to go), never as straight-line
+distance: a path may first lead away from a goal.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cyborg.nav.geometry import Path, Pose2D, normalize_angle
+
+
+@dataclass(frozen=True)
+class FollowerSettings:
+    """Speeds in m/s and rad/s, distances in metres (ARNL's names in brackets)."""
+
+    cruise_speed: float = 1.0  # [FastSpeed]
+    slow_speed: float = 0.25  # [SlowSpeed], near obstacles
+    turn_rate: float = 1.5
+    lookahead: float = 0.5
+    goal_tolerance: float = 0.15  # [GoalDistanceTol]
+    heading_tolerance: float = math.radians(3)  # [GoalAngleTol]
+    turn_in_place: float = math.radians(50)  # heading error above which the robot turns first
+    stop_distance: float = 0.45  # obstacle range ahead (from the scanner) where it stops
+    slow_distance: float = 1.5  # obstacle range ahead below which it slows down
+    deceleration: float = 0.5  # m/s^2 the robot can brake with
+
+
+@dataclass(frozen=True)
+class Command:
+    speed: float
+    turn_rate: float
+    arrived: bool = False
+    blocked: bool = False  # an obstacle stands in the way
+    remaining: float = math.inf
+
+
+class PathFollower:
+    """Turns a path, the robot's pose and a laser scan into speed commands."""
+
+    def __init__(self, path: Path, use_heading: bool,
+                 settings: FollowerSettings | None = None) -> None:
+        self.path, self.use_heading = path, use_heading
+        self.settings = settings or FollowerSettings()
+        self._at_goal = False
+
+    def update(self, pose: Pose2D, front_range: float) -> Command:
+        """The command for now; ``front_range``: nearest obstacle ahead of the scanner."""
+        s = self.settings
+        along, _gap = self.path.project(pose.x, pose.y)
+        remaining = self.path.length - along
+        to_goal = math.hypot(self.path.points[-1, 0] - pose.x, self.path.points[-1, 1] - pose.y)
+        if self._at_goal or (remaining <= s.goal_tolerance and to_goal <= s.goal_tolerance):
+            self._at_goal = True
+            return self._final_turn(pose)
+        carrot = self.path.point_at(along + s.lookahead)
+        if math.hypot(carrot[0] - pose.x, carrot[1] - pose.y) < 1e-6:
+            carrot = (float(self.path.points[-1, 0]), float(self.path.points[-1, 1]))
+        error = normalize_angle(math.atan2(carrot[1] - pose.y, carrot[0] - pose.x) - pose.theta)
+        turn = max(-s.turn_rate, min(s.turn_rate, 2.0 * error))
+        if abs(error) > s.turn_in_place:
+            return Command(0.0, turn, remaining=remaining)
+        speed = s.cruise_speed * math.cos(error)
+        speed = min(speed, math.sqrt(2 * s.deceleration * max(to_goal - 0.05, 0.0)) + 0.05)
+        blocked = front_range <= s.stop_distance and front_range + 0.05 < to_goal
+        if blocked:
+            speed = 0.0
+        elif front_range < s.slow_distance:
+            share = (front_range - s.stop_distance) / (s.slow_distance - s.stop_distance)
+            speed = min(speed, s.slow_speed + share * (s.cruise_speed - s.slow_speed))
+        return Command(max(speed, 0.0), turn, blocked=blocked, remaining=remaining)
+
+    def _final_turn(self, pose: Pose2D) -> Command:
+        s = self.settings
+        if not self.use_heading or self.path.final_heading is None:
+            return Command(0.0, 0.0, arrived=True, remaining=0.0)
+        error = normalize_angle(self.path.final_heading - pose.theta)
+        if abs(error) <= s.heading_tolerance:
+            return Command(0.0, 0.0, arrived=True, remaining=0.0)
+        turn = max(-s.turn_rate, min(s.turn_rate, 2.0 * error))
+        if abs(turn) < 0.15:
+            turn = math.copysign(0.15, error)
+        return Command(0.0, turn, remaining=0.0)
+
+
+def front_range(ranges: np.ndarray, angles: np.ndarray, half_width: float = 0.3,
+                range_max: float = 30.0) -> float:
+    """Distance ahead to the nearest return within a corridor as wide as the robot."""
+    valid = ranges <= range_max
+    ahead = valid & (np.abs(angles) < math.pi / 2)
+    if not ahead.any():
+        return math.inf
+    x = ranges[ahead] * np.cos(angles[ahead])
+    y = ranges[ahead] * np.sin(angles[ahead])
+    inside = np.abs(y) <= half_width
+    return float(x[inside].min()) if inside.any() else math.inf

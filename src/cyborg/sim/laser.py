@@ -1,0 +1,114 @@
+"""A simulated 2D laser scanner (SICK S300-like), raycast on an occupancy grid.
+
+Each beam walks the grid cell by cell (the exact cell traversal of Amanatides and Woo), so a
+scan costs a fraction of a millisecond even on a large campus map. Ranges beyond the scanner's
+reach read as ``range_max + 1`` ("nothing seen"), as ``sensor_msgs/LaserScan`` users expect
+values outside ``[range_min, range_max]`` to be ignored.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+
+@dataclass(frozen=True)
+class LaserSpec:
+    """Where the scanner sits on the robot and what it sees (the Pioneer LX's S300 by default)."""
+
+    beams: int = 541
+    field_of_view: float = math.radians(270.0)
+    range_min: float = 0.05
+    range_max: float = 30.0
+    mount_x: float = 0.267  # metres ahead of the robot's centre
+    noise: float = 0.006  # standard deviation of the range noise, metres
+
+    @property
+    def angle_min(self) -> float:
+        return -self.field_of_view / 2
+
+    @property
+    def angle_increment(self) -> float:
+        return self.field_of_view / (self.beams - 1)
+
+    def angles(self) -> np.ndarray:
+        """Beam angles relative to the robot's heading."""
+        return self.angle_min + np.arange(self.beams) * self.angle_increment
+
+
+@njit(cache=True)
+def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+              x: float, y: float, angles: np.ndarray, range_max: float,
+              out: np.ndarray) -> None:  # pragma: no cover - jit
+    """Distance from ``(x, y)`` to the first occupied cell along each absolute angle."""
+    rows, columns = occupied.shape
+    gx = (x - origin_x) / resolution
+    gy = (y - origin_y) / resolution
+    limit = range_max / resolution
+    for beam in range(angles.shape[0]):
+        dx, dy = math.cos(angles[beam]), math.sin(angles[beam])
+        c, r = math.floor(gx), math.floor(gy)
+        step_c = 1 if dx > 0 else -1
+        step_r = 1 if dy > 0 else -1
+        delta_c = abs(1.0 / dx) if dx != 0 else np.inf
+        delta_r = abs(1.0 / dy) if dy != 0 else np.inf
+        next_c = ((c + 1 - gx) if dx > 0 else (gx - c)) * delta_c
+        next_r = ((r + 1 - gy) if dy > 0 else (gy - r)) * delta_r
+        travelled = 0.0
+        hit = np.inf
+        while travelled <= limit:
+            if r < 0 or r >= rows or c < 0 or c >= columns:
+                break
+            if occupied[r, c]:
+                hit = travelled
+                break
+            if next_c < next_r:
+                travelled = next_c
+                next_c += delta_c
+                c += step_c
+            else:
+                travelled = next_r
+                next_r += delta_r
+                r += step_r
+        out[beam] = hit * resolution if hit <= limit else np.inf
+
+
+class Laser:
+    """Scans an occupancy grid from a robot pose."""
+
+    def __init__(self, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
+                 spec: LaserSpec | None = None, seed: int = 0) -> None:
+        self.occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
+        self.origin, self.resolution = origin, resolution
+        self.spec = spec or LaserSpec()
+        self._relative = self.spec.angles()
+        self._ranges = np.empty(self.spec.beams)
+        self._random = np.random.default_rng(seed)
+
+    def scan(self, x: float, y: float, theta: float) -> np.ndarray:
+        """Ranges in metres for each beam, from the scanner's mount on the robot at the pose;
+        ``range_max + 1`` where nothing is within reach."""
+        spec = self.spec
+        sx = x + spec.mount_x * math.cos(theta)
+        sy = y + spec.mount_x * math.sin(theta)
+        cast_rays(self.occupied, self.origin[0], self.origin[1], self.resolution, sx, sy,
+                  self._relative + theta, spec.range_max, self._ranges)
+        ranges = self._ranges.copy()
+        if spec.noise > 0:
+            ranges += self._random.normal(0.0, spec.noise, ranges.shape)
+        ranges[~np.isfinite(self._ranges)] = spec.range_max + 1.0
+        np.clip(ranges, spec.range_min, spec.range_max + 1.0, out=ranges)
+        return ranges
+
+    def points(self, x: float, y: float, theta: float, ranges: np.ndarray) -> np.ndarray:
+        """The (N, 2) map points where beams with a valid range hit."""
+        spec = self.spec
+        valid = ranges <= spec.range_max
+        sx = x + spec.mount_x * math.cos(theta)
+        sy = y + spec.mount_x * math.sin(theta)
+        angles = self._relative[valid] + theta
+        return np.column_stack([sx + ranges[valid] * np.cos(angles),
+                                sy + ranges[valid] * np.sin(angles)])

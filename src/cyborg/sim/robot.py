@@ -1,0 +1,114 @@
+"""The simulated Pioneer LX base: differential drive with speed and acceleration limits,
+a body that cannot pass through walls, and bumpers that report contact.
+
+Motion is unicycle kinematics (forward speed ``v``, turn rate ``w``) integrated exactly over each
+step. Commands are followed within the acceleration limits. A step that would make the body
+overlap a wall does not happen: the robot stalls, its speed drops to zero, and the bumper on the
+side it was moving towards reports contact until the robot moves away again.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cyborg.nav.footprint import PIONEER_LX, Footprint
+from cyborg.nav.geometry import Pose2D, normalize_angle
+
+
+@dataclass(frozen=True)
+class DriveLimits:
+    """Speed and acceleration limits (MobileSim's pioneer-lx model)."""
+
+    max_speed: float = 2.0  # m/s
+    max_turn_rate: float = 3.49  # rad/s
+    acceleration: float = 0.5  # m/s^2, speeding up and slowing down
+    turn_acceleration: float = 1.74  # rad/s^2
+
+
+@dataclass
+class Bumpers:
+    front: bool = False
+    rear: bool = False
+
+    @property
+    def any(self) -> bool:
+        return self.front or self.rear
+
+
+@dataclass
+class RobotBase:
+    """Pose, velocity and contact of the robot in a world given by a clearance grid."""
+
+    clearance: np.ndarray  # metres to the nearest wall, per cell of the world grid
+    origin: tuple[float, float]
+    resolution: float
+    pose: Pose2D = field(default_factory=Pose2D)
+    footprint: Footprint = PIONEER_LX
+    limits: DriveLimits = field(default_factory=DriveLimits)
+    speed: float = 0.0
+    turn_rate: float = 0.0
+    bumpers: Bumpers = field(default_factory=Bumpers)
+    odometer: float = 0.0  # metres driven
+    bumps: int = 0  # contacts since start
+
+    def command(self, speed: float, turn_rate: float, dt: float) -> None:
+        """Move for ``dt`` seconds towards the commanded speed and turn rate."""
+        limits = self.limits
+        speed = max(-limits.max_speed, min(limits.max_speed, speed))
+        turn_rate = max(-limits.max_turn_rate, min(limits.max_turn_rate, turn_rate))
+        self.speed += _limited(speed - self.speed, limits.acceleration * dt)
+        self.turn_rate += _limited(turn_rate - self.turn_rate, limits.turn_acceleration * dt)
+        pose = self.pose
+        theta = pose.theta + self.turn_rate * dt
+        if abs(self.turn_rate) > 1e-9:
+            radius = self.speed / self.turn_rate
+            x = pose.x + radius * (math.sin(theta) - math.sin(pose.theta))
+            y = pose.y - radius * (math.cos(theta) - math.cos(pose.theta))
+        else:
+            x = pose.x + self.speed * dt * math.cos(pose.theta)
+            y = pose.y + self.speed * dt * math.sin(pose.theta)
+        moved = Pose2D(x, y, normalize_angle(theta))
+        if self.collides(moved) and self._worse(moved):
+            if self.speed or self.turn_rate:
+                if not self.bumpers.any:
+                    self.bumps += 1
+                self.bumpers = Bumpers(front=self.speed >= 0, rear=self.speed < 0)
+            self.speed = self.turn_rate = 0.0
+            return
+        self.odometer += math.hypot(moved.x - pose.x, moved.y - pose.y)
+        self.pose = moved
+        if self.bumpers.any and not self.collides(moved):
+            self.bumpers = Bumpers()
+
+    def place(self, pose: Pose2D) -> None:
+        """Put the robot at ``pose``, standing still."""
+        self.pose, self.speed, self.turn_rate, self.bumpers = pose, 0.0, 0.0, Bumpers()
+
+    # ------------------------------------------------------------------ contact
+    def body_clearance(self, pose: Pose2D) -> float:
+        """Smallest gap (metres, negative when overlapping) between the body and a wall."""
+        offsets, radius = self.footprint.circles()
+        rows, columns = self.clearance.shape
+        lowest = math.inf
+        for offset in offsets:
+            cx = pose.x + offset * math.cos(pose.theta)
+            cy = pose.y + offset * math.sin(pose.theta)
+            r = int((cy - self.origin[1]) // self.resolution)
+            c = int((cx - self.origin[0]) // self.resolution)
+            gap = float(self.clearance[r, c]) if 0 <= r < rows and 0 <= c < columns else 0.0
+            lowest = min(lowest, gap - radius)
+        return lowest
+
+    def collides(self, pose: Pose2D) -> bool:
+        return self.body_clearance(pose) < 0.0
+
+    def _worse(self, moved: Pose2D) -> bool:
+        """Moves that increase the gap are allowed even in contact (backing off a wall)."""
+        return self.body_clearance(moved) <= self.body_clearance(self.pose)
+
+
+def _limited(change: float, most: float) -> float:
+    return max(-most, min(most, change))

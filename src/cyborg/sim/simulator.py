@@ -1,0 +1,232 @@
+"""A simulated Pioneer LX on an ARNL map: drive, laser, bumpers, battery, dock, navigation.
+
+The simulator owns simulated time. :meth:`Simulator.step` advances one physics step
+(``physics_rate``, 50 Hz by default); every ``1 / sensor_rate`` seconds it also takes a laser
+scan and lets the navigator and the docking sequence choose the next command. Nothing here waits
+for the wall clock: :class:`cyborg.sim.runner.SimulationLoop` paces it (real time, ``--speed``
+times faster, or as fast as possible)::
+
+    sim = Simulator(read_map("AMROffice.map"), start="Dock")
+    sim.go_to("room1")
+    sim.run_until(lambda: sim.navigator.state.finished, timeout=600)
+    sim.navigator.state, sim.pose, sim.battery.charge_percent
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.geometry import Pose2D
+from cyborg.nav.grid import MapGrid
+from cyborg.nav.planner import Planner, PlanResult
+from cyborg.sim.battery import Battery
+from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
+from cyborg.sim.laser import Laser, LaserSpec
+from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
+from cyborg.sim.robot import RobotBase
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    physics_rate: float = 50.0  # Hz
+    sensor_rate: float = 10.0  # Hz: laser, navigation, docking decisions
+    world_resolution: float = 0.05  # metres per cell of the simulated world
+    laser: LaserSpec = field(default_factory=LaserSpec)
+    navigator: NavigatorSettings = field(default_factory=NavigatorSettings)
+    dock: DockSettings = field(default_factory=DockSettings)
+    seed: int = 0
+
+
+class Simulator:
+    """One robot in one map; see the module docstring."""
+
+    def __init__(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
+                 settings: SimSettings | None = None, battery: Battery | None = None) -> None:
+        self.settings = settings or SimSettings()
+        self.battery = battery or Battery()
+        self.docking = Docking(self.settings.dock)
+        self.time = 0.0
+        self.scans = 0
+        self.ranges = np.zeros(0)
+        self.hits = np.zeros((0, 2))
+        self._steps = 0
+        self._sensor_every = max(1, round(self.settings.physics_rate / self.settings.sensor_rate))
+        self._command = (0.0, 0.0)
+        self._after_dock: tuple[Pose2D, bool] | None = None
+        self.load_map(arnl_map, start)
+
+    # ------------------------------------------------------------------ world
+    def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None) -> None:
+        """Switch to another map; the robot starts at ``start`` (a pose or a goal name), or at
+        the map's home, or its dock, or the middle of the map."""
+        settings = self.settings
+        world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
+        planner = Planner(arnl_map)
+        self.map, self.world, self.planner = arnl_map, world, planner
+        self.base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
+                              world.resolution)
+        self.laser = Laser(world.walls, (world.origin_x, world.origin_y), world.resolution,
+                           settings.laser, seed=settings.seed)
+        self.angles = settings.laser.angles()
+        self.navigator = Navigator(planner, settings.navigator)
+        self.docking = Docking(settings.dock)
+        self.battery.charging = False
+        self.base.place(self.start_pose(start))
+        self._sense()
+
+    def start_pose(self, start: Pose2D | str | None) -> Pose2D:
+        if isinstance(start, Pose2D):
+            return start
+        if start is not None:
+            item = self.map.goal(start)
+            return Pose2D(item.x, item.y, item.theta)
+        for item in self.map.homes():
+            if item.region is None:
+                return Pose2D(item.x, item.y, item.theta)
+        for item in self.map.docks() + self.map.goals():
+            return Pose2D(item.x, item.y, item.theta)
+        min_x, min_y, max_x, max_y = self.map.bounds()
+        return Pose2D((min_x + max_x) / 2, (min_y + max_y) / 2)
+
+    @property
+    def pose(self) -> Pose2D:
+        return self.base.pose
+
+    # ------------------------------------------------------------------ requests
+    def resolve(self, goal: Pose2D | str, use_heading: bool | None = None) -> tuple[Pose2D, bool]:
+        """A goal name or pose as ``(pose, use_heading)``; a name's kind decides the heading."""
+        if isinstance(goal, str):
+            item = self.map.goal(goal)
+            heading = item.has_heading if use_heading is None else use_heading
+            return Pose2D(item.x, item.y, item.theta), heading
+        return goal, bool(use_heading)
+
+    def go_to(self, goal: Pose2D | str, use_heading: bool | None = None) -> PlanResult:
+        """Start driving to ``goal``; when docked, undock first (ARNL does the same)."""
+        pose, heading = self.resolve(goal, use_heading)
+        if self.docking.state is not DockState.UNDOCKED:
+            self._after_dock = (pose, heading)
+            result = self.planner.plan(self.pose, pose, use_heading=heading)
+            if result.found:
+                self.undock()
+                self.navigator.state = PathState.PLANNING_PATH
+            else:
+                self.navigator.state, self.navigator.message = PathState.FAILED_PLAN, result.reason
+                self._after_dock = None
+            return result
+        return self.navigator.go_to(self.pose, pose, heading, self.time)
+
+    def cancel(self) -> None:
+        """Stop: abandon the goal (and a docking in progress)."""
+        self._after_dock = None
+        self.navigator.cancel()
+        if self.docking.state is DockState.DOCKING:
+            self.docking.enter(DockState.UNDOCKED, DockPhase.NONE, self.time)
+            self.docking.message = "docking cancelled"
+
+    def dock(self) -> bool:
+        """Drive to the map's dock and dock; False (with ``docking.message``) without a dock."""
+        if self.docking.state in (DockState.DOCKED, DockState.DOCKING):
+            return True
+        docks = self.map.docks()
+        if not docks:
+            self.docking.message = f"{self.map.source} has no Dock"
+            return False
+        item = docks[0]
+        result = self.navigator.go_to(self.pose, Pose2D(item.x, item.y, item.theta), True,
+                                      self.time)
+        if not result.found:
+            self.docking.message = f"cannot reach the dock: {result.reason}"
+            return False
+        self.docking.message = ""
+        self.docking.enter(DockState.DOCKING, DockPhase.APPROACH, self.time)
+        return True
+
+    def undock(self) -> bool:
+        if self.docking.state is not DockState.DOCKED:
+            return self.docking.state is DockState.UNDOCKING
+        self.battery.charging = False
+        self.docking.enter(DockState.UNDOCKING, DockPhase.WAIT, self.time)
+        return True
+
+    # ------------------------------------------------------------------ time
+    def step(self) -> None:
+        """Advance one physics step."""
+        dt = 1.0 / self.settings.physics_rate
+        if self._steps % self._sensor_every == 0:
+            self._sense()
+            self._command = self._decide()
+        self._steps += 1
+        self.base.command(*self._command, dt)
+        self.battery.step(dt, self.base.speed)
+        self.time = self._steps * dt
+
+    def run(self, seconds: float) -> None:
+        for _ in range(round(seconds * self.settings.physics_rate)):
+            self.step()
+
+    def run_until(self, done: Callable[[], bool], timeout: float) -> bool:
+        """Step until ``done()`` or ``timeout`` simulated seconds; whether it got done."""
+        end = self.time + timeout
+        while not done():
+            if self.time >= end:
+                return False
+            self.step()
+        return True
+
+    def _sense(self) -> None:
+        pose = self.base.pose
+        self.ranges = self.laser.scan(pose.x, pose.y, pose.theta)
+        self.hits = self.laser.points(pose.x, pose.y, pose.theta, self.ranges)
+        self.scans += 1
+
+    def _decide(self) -> tuple[float, float]:
+        if self.docking.state is not DockState.UNDOCKED:
+            return self._dock_step()
+        return self.navigator.update(self.time, self.base.pose, self.ranges, self.angles,
+                                     self.hits)
+
+    def _dock_step(self) -> tuple[float, float]:
+        docking, settings, now = self.docking, self.settings.dock, self.time
+        pose = self.base.pose
+        travelled = math.hypot(pose.x - docking.travelled_from[0],
+                               pose.y - docking.travelled_from[1])
+        if docking.phase is DockPhase.APPROACH:
+            command = self.navigator.update(now, pose, self.ranges, self.angles, self.hits)
+            state = self.navigator.state
+            if state is PathState.REACHED_GOAL:
+                docking.enter(DockState.DOCKING, DockPhase.DRIVE_IN, now, (pose.x, pose.y))
+            elif state.finished:
+                docking.message = f"docking failed: {self.navigator.message or state.value}"
+                docking.enter(DockState.UNDOCKED, DockPhase.NONE, now)
+            return command
+        if docking.phase is DockPhase.DRIVE_IN:
+            if travelled >= settings.depth or self.base.bumpers.front:
+                docking.enter(DockState.DOCKING, DockPhase.POWER, now, docking.travelled_from)
+                return 0.0, 0.0
+            return settings.creep_speed, 0.0
+        if docking.phase is DockPhase.POWER:
+            if now - docking.phase_started >= settings.power_delay:
+                self.battery.charging = True
+                docking.docks += 1
+                docking.enter(DockState.DOCKED, DockPhase.NONE, now)
+            return 0.0, 0.0
+        if docking.phase is DockPhase.WAIT:
+            if now - docking.phase_started >= settings.undock_wait:
+                docking.enter(DockState.UNDOCKING, DockPhase.BACK_OUT, now, (pose.x, pose.y))
+            return 0.0, 0.0
+        if docking.phase is DockPhase.BACK_OUT:
+            if travelled >= settings.back_out or self.base.bumpers.rear:
+                docking.enter(DockState.UNDOCKED, DockPhase.NONE, now)
+                if self._after_dock is not None:
+                    goal, heading = self._after_dock
+                    self._after_dock = None
+                    self.navigator.go_to(pose, goal, heading, now)
+                return 0.0, 0.0
+            return -settings.creep_speed, 0.0
+        return 0.0, 0.0  # DOCKED
