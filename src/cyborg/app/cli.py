@@ -11,6 +11,8 @@
     cyborg topic list|echo|pub|hz  topics on the bus
     cyborg service list|call       services on the bus
     cyborg param list|get|set      parameters of a node
+    cyborg sim --map FILE          the simulated robot on an ARNL map, on the bus
+    cyborg nav goals|plan FILE     goals of a map; plan a path and print its length
 
 Exit codes: 0 success, 1 the input has errors, 2 wrong usage, 130 interrupted.
 """
@@ -23,7 +25,7 @@ import sys
 from collections.abc import Sequence
 
 from cyborg import __version__
-from cyborg.app import bt_commands, bus_commands, up
+from cyborg.app import bt_commands, bus_commands, sim_commands, up
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     up.add_parser(commands)
     bt_commands.add_parser(commands)
     bus_commands.add_parser(commands)
+    sim_commands.add_parser(commands)
     return parser
 
 

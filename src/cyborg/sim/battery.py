@@ -49,7 +49,7 @@ class Battery:
 
     @property
     def empty(self) -> bool:
-        return self.charge_percent <= 0.0
+        return self.charge_percent < 0.01
 
     def step(self, dt: float, speed: float) -> None:
         """Advance ``dt`` seconds of use at ``speed`` m/s (charging if ``charging``)."""

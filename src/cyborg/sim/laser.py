@@ -55,8 +55,8 @@ def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution
         step_r = 1 if dy > 0 else -1
         delta_c = abs(1.0 / dx) if dx != 0 else np.inf
         delta_r = abs(1.0 / dy) if dy != 0 else np.inf
-        next_c = ((c + 1 - gx) if dx > 0 else (gx - c)) * delta_c
-        next_r = ((r + 1 - gy) if dy > 0 else (gy - r)) * delta_r
+        next_c = ((c + 1 - gx) if dx > 0 else (gx - c)) * delta_c if dx != 0 else np.inf
+        next_r = ((r + 1 - gy) if dy > 0 else (gy - r)) * delta_r if dy != 0 else np.inf
         travelled = 0.0
         hit = np.inf
         while travelled <= limit:

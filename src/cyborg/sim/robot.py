@@ -80,8 +80,8 @@ class RobotBase:
             return
         self.odometer += math.hypot(moved.x - pose.x, moved.y - pose.y)
         self.pose = moved
-        if self.bumpers.any and not self.collides(moved):
-            self.bumpers = Bumpers()
+        if self.bumpers.any and self.body_clearance(moved) >= self.resolution:
+            self.bumpers = Bumpers()  # clear of the wall again (by more than the grid's step)
 
     def place(self, pose: Pose2D) -> None:
         """Put the robot at ``pose``, standing still."""

@@ -55,18 +55,19 @@ class Simulator:
         self.ranges = np.zeros(0)
         self.hits = np.zeros((0, 2))
         self._steps = 0
-        self._sensor_every = max(1, round(self.settings.physics_rate / self.settings.sensor_rate))
+        self.steps_per_sensor = max(1, round(self.settings.physics_rate / self.settings.sensor_rate))
         self._command = (0.0, 0.0)
         self._after_dock: tuple[Pose2D, bool] | None = None
         self.load_map(arnl_map, start)
 
     # ------------------------------------------------------------------ world
-    def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None) -> None:
+    def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
+                 planner: Planner | None = None) -> None:
         """Switch to another map; the robot starts at ``start`` (a pose or a goal name), or at
         the map's home, or its dock, or the middle of the map."""
         settings = self.settings
         world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
-        planner = Planner(arnl_map)
+        planner = planner or Planner(arnl_map)
         self.map, self.world, self.planner = arnl_map, world, planner
         self.base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
                               world.resolution)
@@ -158,7 +159,7 @@ class Simulator:
     def step(self) -> None:
         """Advance one physics step."""
         dt = 1.0 / self.settings.physics_rate
-        if self._steps % self._sensor_every == 0:
+        if self._steps % self.steps_per_sensor == 0:
             self._sense()
             self._command = self._decide()
         self._steps += 1

@@ -1,0 +1,149 @@
+"""``cyborg sim`` (the simulated robot as a bus node) and ``cyborg nav`` (maps offline).
+
+    cyborg sim --map AMROffice.map [--speed 10] [--start Dock] [--namespace /cyborg]
+    cyborg nav goals AMROffice.map
+    cyborg nav plan AMROffice.map Dock room1        # names, or x,y[,heading] in metres/degrees
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from cyborg.app.bt_commands import CommandError
+from cyborg.bus import BusConfig, BusConfigError, Context, Node
+from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
+from cyborg.nav.geometry import Pose2D
+from cyborg.nav.planner import Planner
+from cyborg.sim.node import SimulatorNode
+from cyborg.sim.runner import SimulationLoop
+from cyborg.sim.simulator import Simulator
+
+DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
+
+
+def add_parser(commands: Any) -> None:
+    sim = commands.add_parser("sim", help="run the simulated robot on an ARNL map",
+                              description="Simulate the Pioneer LX on a map and serve it on "
+                                          "the bus with an ARNL-like interface.")
+    sim.add_argument("--map", type=Path, required=True, metavar="FILE", help="ARNL .map file")
+    sim.add_argument("--speed", type=float, default=1.0, metavar="X",
+                     help="simulated seconds per wall-clock second (0: as fast as possible)")
+    sim.add_argument("--start", default=None, metavar="NAME",
+                     help="goal or dock to start at (default: the map's home, else its dock)")
+    sim.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
+    sim.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                     help=f"join a router there instead of being one at {DEFAULT_ROUTER}")
+    sim.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                     help="stop after this much simulated time")
+    sim.set_defaults(handler=sim_command)
+
+    nav = commands.add_parser("nav", help="goals and paths of an ARNL map")
+    actions = nav.add_subparsers(dest="nav_command", metavar="COMMAND", required=True)
+    goals = actions.add_parser("goals", help="list the goals and docks of a map")
+    goals.add_argument("map", type=Path)
+    goals.set_defaults(handler=goals_command)
+    plan = actions.add_parser("plan", help="plan a path and print its length")
+    plan.add_argument("map", type=Path)
+    plan.add_argument("start", help="a goal name, or x,y[,heading] (metres, degrees)")
+    plan.add_argument("goal", help="a goal name, or x,y[,heading] (metres, degrees)")
+    plan.add_argument("--waypoints", action="store_true", help="print the path's points too")
+    plan.set_defaults(handler=plan_command)
+
+
+def load(path: Path) -> ArnlMap:
+    try:
+        return read_map(path)
+    except MapError as exc:
+        raise CommandError(str(exc)) from exc
+
+
+def pose_argument(arnl_map: ArnlMap, text: str) -> Pose2D:
+    """A goal name, or ``x,y[,heading]`` in metres and degrees."""
+    parts = text.split(",")
+    if len(parts) in (2, 3):
+        try:
+            numbers = [float(part) for part in parts]
+        except ValueError:
+            numbers = []
+        if numbers:
+            return Pose2D(numbers[0], numbers[1], math.radians(numbers[2]) if len(parts) == 3
+                          else 0.0)
+    try:
+        item = arnl_map.goal(text)
+    except KeyError as exc:
+        raise CommandError(str(exc).strip("\"'")) from exc
+    return Pose2D(item.x, item.y, item.theta)
+
+
+def goals_command(args: argparse.Namespace) -> int:
+    arnl_map = load(args.map)
+    print(f"{'name':24} {'kind':16} {'x m':>9} {'y m':>9} {'heading':>8}  description")
+    for item in arnl_map.goals():
+        heading = f"{math.degrees(item.theta):7.1f}°" if item.has_heading else "       -"
+        print(f"{item.name:24} {item.kind:16} {item.x:9.3f} {item.y:9.3f} {heading}  "
+              f"{item.description}")
+    return 0
+
+
+def plan_command(args: argparse.Namespace) -> int:
+    arnl_map = load(args.map)
+    start, goal = pose_argument(arnl_map, args.start), pose_argument(arnl_map, args.goal)
+    result = Planner(arnl_map).plan(start, goal)
+    if result.path is None:
+        print(f"no path: {result.code}: {result.reason}")
+        return 1
+    print(f"{result.length:.2f} m ({len(result.path)} waypoints, planned in "
+          f"{result.planning_time * 1000:.1f} ms)")
+    if args.waypoints:
+        for x, y in result.path.points:
+            print(f"  {x:9.3f} {y:9.3f}")
+    return 0
+
+
+def bus_context(connect: list[str]) -> tuple[Context, str]:
+    """Join the given router, or be the router at the default address (or join the one there)."""
+    try:
+        if connect:
+            return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"
+        try:
+            return Context(BusConfig.router([DEFAULT_ROUTER])), f"router at {DEFAULT_ROUTER}"
+        except Exception:  # the address is taken: a router already runs there
+            return Context(BusConfig.from_environment([DEFAULT_ROUTER])), (
+                f"connected to {DEFAULT_ROUTER}")
+    except BusConfigError as exc:
+        raise CommandError(str(exc)) from exc
+
+
+def sim_command(args: argparse.Namespace) -> int:
+    if args.speed < 0:
+        print("cyborg sim: --speed must be positive (or 0 for as fast as possible)",
+              file=sys.stderr)
+        return 2
+    arnl_map = load(args.map)
+    try:
+        simulator = Simulator(arnl_map, start=args.start)
+    except KeyError as exc:
+        raise CommandError(str(exc).strip("\"'")) from exc
+    context, where = bus_context(args.connect)
+    loop = SimulationLoop(simulator, args.speed)
+    try:
+        node = Node("arnl", args.namespace, context=context)
+        SimulatorNode(node, loop)
+        loop.start()
+        print(f"cyborg sim: {arnl_map.source} at {'full' if args.speed == 0 else args.speed}x, "
+              f"namespace {args.namespace}, {where}; Ctrl-C stops")
+        while loop.running:
+            if args.duration is not None and simulator.time >= args.duration:
+                break
+            time.sleep(0.1)
+        if loop.error is not None:
+            raise CommandError(f"the simulation stopped: {loop.error}")
+    finally:
+        loop.stop()
+        context.close()
+    return 0

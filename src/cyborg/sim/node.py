@@ -1,0 +1,216 @@
+"""The simulated robot on the bus, with an ARNL-like interface (as rosarnl offered in 2018).
+
+Under the robot's namespace (``/cyborg`` by default), node ``arnl``:
+
+==========================  ==================================  ==================================
+name                        type                                what
+==========================  ==================================  ==================================
+``/clock``                  rosgraph_msgs/Clock                 simulated time (for use_sim_time)
+``pose``                    geometry_msgs/Pose2D                the robot's pose in the map frame
+``odom``                    nav_msgs/Odometry                   pose and velocity
+``scan``                    sensor_msgs/LaserScan               541 beams over 270 degrees
+``bumper_state``            cyborg_msgs/BumperState             latched, on change
+``battery_status``          cyborg_msgs/BatteryStatus           latched, every simulated second
+``arnl_path_state``         std_msgs/String                     latched, on change
+``path``                    nav_msgs/Path                       latched: the path being followed
+``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose
+``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
+``stop``
+==========================  ==================================  ==================================
+
+plus the navigation services of :mod:`cyborg.nav.services` (goals, distances, make_plan,
+load_map_file), answered on the simulator's own map. Sensor topics are published at most
+``max_publish_rate`` times per wall-clock second, so a simulation running hundreds of times
+faster than real time does not flood the bus; ``/clock`` follows every sensor step.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from typing import Any
+
+import numpy as np
+
+from cyborg.bus import Node, Qos, ServerGoal
+from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.geometry import Pose2D
+from cyborg.nav.planner import Planner
+from cyborg.nav.services import NavigationMap, NavigationServices
+from cyborg.sim.docking import DockState
+from cyborg.sim.navigator import PathState
+from cyborg.sim.runner import SimulationLoop
+from cyborg.sim.simulator import Simulator
+
+SUCCEEDED, FAILED, CANCELED = 1, 2, 3  # MoveToGoal result outcomes
+
+
+class SimulatorNode:
+    """Publishes a running simulation and serves its actions and services."""
+
+    def __init__(self, node: Node, loop: SimulationLoop, max_publish_rate: float = 30.0) -> None:
+        self.node, self.loop, self.sim = node, loop, loop.simulator
+        types = node.types
+        self.types = types
+        self._min_period = 1.0 / max_publish_rate
+        self._published_at = 0.0
+        self._last_state: tuple[Any, ...] = ()
+        self._battery_at = -math.inf
+        self._path_shown: object = None
+        self._goal_generation = 0
+        self.clock = node.create_publisher("/clock", "rosgraph_msgs/msg/Clock")
+        self.pose = node.create_publisher("pose", "geometry_msgs/msg/Pose2D")
+        self.odom = node.create_publisher("odom", "nav_msgs/msg/Odometry")
+        self.scan = node.create_publisher("scan", "sensor_msgs/msg/LaserScan")
+        latched = Qos.latched()
+        self.bumpers = node.create_publisher("bumper_state", "cyborg_msgs/msg/BumperState", latched)
+        self.battery = node.create_publisher("battery_status", "cyborg_msgs/msg/BatteryStatus",
+                                             latched)
+        self.path_state = node.create_publisher("arnl_path_state", "std_msgs/msg/String", latched)
+        self.path = node.create_publisher("path", "nav_msgs/msg/Path", latched)
+        self.maps = NavigationMap(self.sim.map, self.sim.planner)
+        self.maps.listeners.append(self._map_changed)
+        self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
+        trigger = "std_srvs/srv/Trigger"
+        node.create_service("dock", trigger, self._dock)
+        node.create_service("undock", trigger, self._undock)
+        node.create_service("stop", trigger, self._stop)
+        node.create_action_server("move_to_goal", "cyborg_msgs/action/MoveToGoal", self._move)
+        loop.on_sensor.append(self._publish)
+
+    # ------------------------------------------------------------------ publishing
+    def _stamp(self) -> Any:
+        seconds = self.sim.time
+        return self.types.message_class("builtin_interfaces/msg/Time")(
+            sec=int(seconds), nanosec=int(round((seconds % 1.0) * 1e9)) % 1_000_000_000)
+
+    def _header(self, frame: str) -> Any:
+        return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
+
+    def _publish(self, sim: Simulator) -> None:
+        message = self.types.message_class
+        self.clock.publish(message("rosgraph_msgs/msg/Clock")(clock=self._stamp()))
+        if sim.time - self._battery_at >= 1.0:
+            self._battery_at = sim.time
+            self._publish_battery(sim)
+        state = (sim.base.bumpers.front, sim.base.bumpers.rear, sim.navigator.state)
+        if state != self._last_state:
+            self._last_state = state
+            self.bumpers.publish(message("cyborg_msgs/msg/BumperState")(
+                header=self._header("base_link"), front_bumpers=np.array([state[0]]),
+                rear_bumpers=np.array([state[1]])))
+            self.path_state.publish(message("std_msgs/msg/String")(data=state[2].value))
+        follower = sim.navigator.follower
+        if follower is not None and follower.path is not self._path_shown:
+            self._path_shown = follower.path
+            self.path.publish(follower.path.to_message(self.types, stamp=self._stamp()))
+        now = time.monotonic()
+        if now - self._published_at < self._min_period:
+            return
+        self._published_at = now
+        pose = sim.pose
+        self.pose.publish(pose.to_message(self.types))
+        self.odom.publish(self._odometry(sim))
+        self.scan.publish(self._scan(sim))
+
+    def _publish_battery(self, sim: Simulator) -> None:
+        battery = sim.battery
+        self.battery.publish(self.types.message_class("cyborg_msgs/msg/BatteryStatus")(
+            header=self._header("base_link"), charging_state=int(battery.state),
+            charge_percent=battery.charge_percent, voltage=battery.voltage,
+            charging=battery.charging, dock_state=sim.docking.state.value))
+
+    def _odometry(self, sim: Simulator) -> Any:
+        message = self.types.message_class
+        pose = sim.pose.to_pose().to_message(self.types)
+        covariance = np.zeros(36)
+        return message("nav_msgs/msg/Odometry")(
+            header=self._header("map"), child_frame_id="base_link",
+            pose=message("geometry_msgs/msg/PoseWithCovariance")(pose=pose, covariance=covariance),
+            twist=message("geometry_msgs/msg/TwistWithCovariance")(
+                twist=message("geometry_msgs/msg/Twist")(
+                    linear=message("geometry_msgs/msg/Vector3")(x=sim.base.speed, y=0.0, z=0.0),
+                    angular=message("geometry_msgs/msg/Vector3")(x=0.0, y=0.0,
+                                                                 z=sim.base.turn_rate)),
+                covariance=covariance))
+
+    def _scan(self, sim: Simulator) -> Any:
+        spec = sim.laser.spec
+        return self.types.message_class("sensor_msgs/msg/LaserScan")(
+            header=self._header("laser"), angle_min=spec.angle_min,
+            angle_max=spec.angle_min + spec.angle_increment * (spec.beams - 1),
+            angle_increment=spec.angle_increment, time_increment=0.0,
+            scan_time=1.0 / sim.settings.sensor_rate, range_min=spec.range_min,
+            range_max=spec.range_max, ranges=sim.ranges.astype(np.float32),
+            intensities=np.zeros(0, np.float32))
+
+    def _map_changed(self, arnl_map: ArnlMap, planner: Planner) -> None:
+        with self.loop.lock:
+            self.sim.load_map(arnl_map, planner=planner)
+
+    # ------------------------------------------------------------------ services
+    def _trigger(self, success: bool, message: str) -> Any:
+        return self.types.message_class("std_srvs/srv/Trigger_Response")(
+            success=success, message=message)
+
+    def _dock(self, _request: Any) -> Any:
+        with self.loop.lock:
+            self._goal_generation += 1
+            ok = self.sim.dock()
+            return self._trigger(ok, "docking" if ok else self.sim.docking.message)
+
+    def _undock(self, _request: Any) -> Any:
+        with self.loop.lock:
+            ok = self.sim.undock()
+            return self._trigger(ok, "undocking" if ok else
+                                 f"not docked ({self.sim.docking.state.value})")
+
+    def _stop(self, _request: Any) -> Any:
+        with self.loop.lock:
+            self._goal_generation += 1
+            self.sim.cancel()
+        return self._trigger(True, "stopped")
+
+    # ------------------------------------------------------------------ move_to_goal
+    def _move(self, goal: ServerGoal) -> Any:
+        request = goal.request
+        result = self.types.message_class("cyborg_msgs/action/MoveToGoal_Result")
+        with self.loop.lock:
+            self._goal_generation += 1
+            generation = self._goal_generation
+            try:
+                target = request.goal_name or Pose2D.from_message(request.pose)
+                # a named goal's kind decides unless the request asks for the heading
+                heading = True if request.use_heading else (None if request.goal_name else False)
+                plan = self.sim.go_to(target, heading)
+            except KeyError as exc:
+                goal.abort()
+                return result(outcome=FAILED, message=str(exc).strip("'\""))
+        if not plan.found:
+            goal.abort()
+            return result(outcome=FAILED, message=f"{plan.code}: {plan.reason}")
+        feedback = self.types.message_class("cyborg_msgs/action/MoveToGoal_Feedback")
+        while True:
+            with self.loop.lock:
+                state, message = self.sim.navigator.state, self.sim.navigator.message
+                pose, remaining = self.sim.pose, self.sim.navigator.remaining
+                busy = self.sim.docking.state is not DockState.UNDOCKED
+                if generation != self._goal_generation:
+                    goal.abort()
+                    return result(outcome=FAILED, message="preempted by another goal")
+                if goal.cancel_requested:
+                    self.sim.cancel()
+                    goal.canceled()
+                    return result(outcome=CANCELED, message="cancelled")
+            if not busy and state is PathState.REACHED_GOAL:
+                return result(outcome=SUCCEEDED, message="reached the goal")
+            if not busy and state.finished and state is not PathState.NOT_INITIALIZED:
+                goal.abort()
+                return result(outcome=FAILED, message=f"{state.value}: {message}")
+            if self.loop.error is not None or not self.loop.running:
+                goal.abort()
+                return result(outcome=FAILED, message="the simulation stopped")
+            goal.publish_feedback(feedback(current_pose=pose.to_message(self.types),
+                                           distance_remaining=min(remaining, 1e9)))
+            threading.Event().wait(0.05)
