@@ -1,6 +1,7 @@
 """``cyborg sim`` (the simulated robot as a bus node) and ``cyborg nav`` (maps offline).
 
     cyborg sim --map AMROffice.map [--speed 10] [--start Dock] [--namespace /cyborg]
+    cyborg sim --map AMROffice.map --speed 0 --duration 3600   # an hour, flat out
     cyborg nav goals AMROffice.map
     cyborg nav plan AMROffice.map Dock room1        # names, or x,y[,heading] in metres/degrees
 """
@@ -37,7 +38,10 @@ def add_parser(commands: Any) -> None:
                      help="goal or dock to start at (default: the map's home, else its dock)")
     sim.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
     sim.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                     help=f"join a router there instead of being one at {DEFAULT_ROUTER}")
+                     help="join the router there instead of being one")
+    sim.add_argument("--listen", default=DEFAULT_ROUTER, metavar="ENDPOINT",
+                     help=f"be the bus's router there (default {DEFAULT_ROUTER}); if a router "
+                          "already runs there, join it")
     sim.add_argument("--duration", type=float, default=None, metavar="SECONDS",
                      help="stop after this much simulated time")
     sim.set_defaults(handler=sim_command)
@@ -105,16 +109,17 @@ def plan_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def bus_context(connect: list[str]) -> tuple[Context, str]:
-    """Join the given router, or be the router at the default address (or join the one there)."""
+def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
+    """Join the given router, or be the router at ``listen`` (or join the one already there)."""
     try:
         if connect:
             return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"
         try:
-            return Context(BusConfig.router([DEFAULT_ROUTER])), f"router at {DEFAULT_ROUTER}"
+            return Context(BusConfig.router([listen])), f"router at {listen}"
+        except BusConfigError:
+            raise
         except Exception:  # the address is taken: a router already runs there
-            return Context(BusConfig.from_environment([DEFAULT_ROUTER])), (
-                f"connected to {DEFAULT_ROUTER}")
+            return Context(BusConfig.from_environment([listen])), f"connected to {listen}"
     except BusConfigError as exc:
         raise CommandError(str(exc)) from exc
 
@@ -129,14 +134,15 @@ def sim_command(args: argparse.Namespace) -> int:
         simulator = Simulator(arnl_map, start=args.start)
     except KeyError as exc:
         raise CommandError(str(exc).strip("\"'")) from exc
-    context, where = bus_context(args.connect)
+    context, where = bus_context(args.connect, args.listen)
     loop = SimulationLoop(simulator, args.speed)
     try:
         node = Node("arnl", args.namespace, context=context)
         SimulatorNode(node, loop)
         loop.start()
-        print(f"cyborg sim: {arnl_map.source} at {'full' if args.speed == 0 else args.speed}x, "
-              f"namespace {args.namespace}, {where}; Ctrl-C stops")
+        pace = "full speed" if args.speed == 0 else f"{args.speed:g}x real time"
+        print(f"cyborg sim: {arnl_map.source} at {pace}, namespace {args.namespace}, {where}; "
+              "Ctrl-C stops", flush=True)
         while loop.running:
             if args.duration is not None and simulator.time >= args.duration:
                 break

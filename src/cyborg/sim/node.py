@@ -83,7 +83,7 @@ class SimulatorNode:
     def _stamp(self) -> Any:
         seconds = self.sim.time
         return self.types.message_class("builtin_interfaces/msg/Time")(
-            sec=int(seconds), nanosec=int(round((seconds % 1.0) * 1e9)) % 1_000_000_000)
+            sec=int(seconds), nanosec=round((seconds % 1.0) * 1e9) % 1_000_000_000)
 
     def _header(self, frame: str) -> Any:
         return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)

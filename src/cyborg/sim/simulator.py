@@ -55,7 +55,8 @@ class Simulator:
         self.ranges = np.zeros(0)
         self.hits = np.zeros((0, 2))
         self._steps = 0
-        self.steps_per_sensor = max(1, round(self.settings.physics_rate / self.settings.sensor_rate))
+        rates = self.settings.physics_rate / self.settings.sensor_rate
+        self.steps_per_sensor = max(1, round(rates))
         self._command = (0.0, 0.0)
         self._after_dock: tuple[Pose2D, bool] | None = None
         self.load_map(arnl_map, start)
