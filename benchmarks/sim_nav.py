@@ -60,7 +60,7 @@ def patrol_speed(arnl_map: ArnlMap, minutes: float, numpy_laser: bool) -> tuple[
     """Simulated seconds per wall second, and goals reached."""
     sim = Simulator(arnl_map)
     if numpy_laser:
-        sim.laser.scan = numpy_laser_scan(sim.laser)  # type: ignore[method-assign]
+        sim.laser.scan = numpy_laser_scan(sim.laser)  # type: ignore[method-assign, assignment]
     names = [item.name for item in arnl_map.goals()]
     reached = 0
     sim.run(1.0)  # compiled kernels loaded, caches warm
