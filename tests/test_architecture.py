@@ -34,3 +34,14 @@ def test_modules_stay_small() -> None:
     for path in sorted(SOURCE.rglob("*.py")):
         lines = len(path.read_text().splitlines())
         assert lines <= 420, f"{path} has {lines} lines; split it"
+
+
+ALLOWED = {"nav": ("cyborg.nav", "cyborg.bus"), "sim": ("cyborg.sim", "cyborg.nav", "cyborg.bus")}
+"""Navigation may use the bus (its services); the simulator builds on navigation and the bus."""
+
+
+@pytest.mark.parametrize("package", sorted(ALLOWED))
+def test_layered_packages_import_only_what_they_build_on(package: str) -> None:
+    for path in sorted((SOURCE / package).rglob("*.py")):
+        for name in _cyborg_imports(path):
+            assert name.startswith(ALLOWED[package]), f"{path} imports {name}"
