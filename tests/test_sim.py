@@ -139,3 +139,23 @@ def test_battery_lasts_thirteen_hours_idle_and_charges_in_stages() -> None:
 def test_dock_needs_a_dock() -> None:
     sim = Simulator(parse_map(room_map([])), start=Pose2D(2.0, 3.0))
     assert not sim.dock() and "has no Dock" in sim.docking.message
+
+
+def test_loop_paces_simulated_time_by_the_speed_factor() -> None:
+    import time
+
+    from cyborg.sim.runner import SimulationLoop
+    sim = Simulator(parse_map(room_map([])), start=Pose2D(2.0, 3.0))
+    with pytest.raises(ValueError, match="speed must be positive"):
+        SimulationLoop(sim, speed=-1)
+    loop = SimulationLoop(sim, speed=10.0)
+    loop.start()
+    time.sleep(1.0)
+    loop.stop()
+    assert 7.0 <= sim.time <= 11.0  # ten simulated seconds per wall second
+    flat_out = SimulationLoop(sim, speed=0)
+    begin = sim.time
+    flat_out.start()
+    time.sleep(0.5)
+    flat_out.stop()
+    assert sim.time - begin > 20.0 and flat_out.error is None
