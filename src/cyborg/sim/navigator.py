@@ -65,10 +65,6 @@ class Navigator:
         self._replanned_at = -math.inf
         self._blocked_since: float | None = None
 
-    @property
-    def path(self) -> object:
-        return self.follower.path if self.follower is not None else None
-
     def go_to(self, start: Pose2D, goal: Pose2D, use_heading: bool, now: float) -> PlanResult:
         """Plan and start moving; the result says whether a path was found."""
         self.goal, self.use_heading = goal, use_heading

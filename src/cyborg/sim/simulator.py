@@ -49,7 +49,6 @@ class Simulator:
                  settings: SimSettings | None = None, battery: Battery | None = None) -> None:
         self.settings = settings or SimSettings()
         self.battery = battery or Battery()
-        self.docking = Docking(self.settings.dock)
         self.time = 0.0
         self.scans = 0
         self.ranges = np.zeros(0)
