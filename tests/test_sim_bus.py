@@ -105,10 +105,17 @@ def test_move_to_goal_feedback_cancel_and_failure(
 def test_topics_battery_and_docking(robot: tuple[Node, Simulator, SimulationLoop]) -> None:
     node, _sim, _loop = robot
     got: dict[str, threading.Event] = {name: threading.Event() for name in (
-        "clock", "pose", "scan", "battery", "state")}
+        "clock", "pose", "odom", "scan", "battery", "state")}
     batteries: list[Any] = []
     node.create_subscription("/clock", "rosgraph_msgs/msg/Clock", lambda _m: got["clock"].set())
     node.create_subscription("pose", "geometry_msgs/msg/Pose2D", lambda _m: got["pose"].set())
+
+    def odometry(message: Any) -> None:
+        at_dock = (message.pose.pose.position.x, message.pose.pose.position.y) == pytest.approx(
+            (-2.822, -2.937), abs=0.5)
+        if message.header.frame_id == "map" and at_dock and len(message.pose.covariance) == 36:
+            got["odom"].set()
+    node.create_subscription("odom", "nav_msgs/msg/Odometry", odometry)
 
     def scan(message: Any) -> None:
         if len(message.ranges) == 541:

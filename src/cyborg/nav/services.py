@@ -27,7 +27,7 @@ from collections.abc import Callable
 from pathlib import Path as FilePath
 from typing import Any
 
-from cyborg.bus import Node
+from cyborg.bus import Node, new_message
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose, Pose2D
 from cyborg.nav.planner import Planner, PlanResult
@@ -112,10 +112,8 @@ class NavigationServices:
         result = self.maps.plan(start, goal)
         response = self._classes["MakePlan"]
         if result.path is None:
-            empty = self.node.types.message_class("nav_msgs/msg/Path")(
-                header=self.node.types.message_class("std_msgs/msg/Header")(
-                    stamp=self.node.types.message_class("builtin_interfaces/msg/Time")(
-                        sec=0, nanosec=0), frame_id="map"), poses=[])
+            empty = new_message(self.node.types, "nav_msgs/msg/Path",
+                                {"header": {"frame_id": "map"}})
             return response(found=False, message=f"{result.code}: {result.reason}", path=empty,
                             length=math.inf)
         return response(found=True, message="", path=result.path.to_message(self.node.types),

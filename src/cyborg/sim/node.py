@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from cyborg.bus import Node, Qos, ServerGoal
+from cyborg.bus import Node, Qos, ServerGoal, new_message
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
@@ -121,18 +121,16 @@ class SimulatorNode:
             charging=battery.charging, dock_state=sim.docking.state.value))
 
     def _odometry(self, sim: Simulator) -> Any:
-        message = self.types.message_class
-        pose = sim.pose.to_pose().to_message(self.types)
-        covariance = np.zeros(36)
-        return message("nav_msgs/msg/Odometry")(
-            header=self._header("map"), child_frame_id="base_link",
-            pose=message("geometry_msgs/msg/PoseWithCovariance")(pose=pose, covariance=covariance),
-            twist=message("geometry_msgs/msg/TwistWithCovariance")(
-                twist=message("geometry_msgs/msg/Twist")(
-                    linear=message("geometry_msgs/msg/Vector3")(x=sim.base.speed, y=0.0, z=0.0),
-                    angular=message("geometry_msgs/msg/Vector3")(x=0.0, y=0.0,
-                                                                 z=sim.base.turn_rate)),
-                covariance=covariance))
+        pose = sim.pose.to_pose()
+        odometry = new_message(self.types, "nav_msgs/msg/Odometry", {
+            "child_frame_id": "base_link",
+            "pose": {"pose": {"position": {"x": pose.position.x, "y": pose.position.y},
+                              "orientation": {"z": pose.orientation.z,
+                                              "w": pose.orientation.w}}},
+            "twist": {"twist": {"linear": {"x": sim.base.speed},
+                                "angular": {"z": sim.base.turn_rate}}}})
+        odometry.header = self._header("map")
+        return odometry
 
     def _scan(self, sim: Simulator) -> Any:
         spec = sim.laser.spec
