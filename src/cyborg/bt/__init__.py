@@ -33,6 +33,7 @@ from cyborg.bt.decorators import (
     Timeout,
 )
 from cyborg.bt.editor_format import ProjectSpec, parse_project, read_project, render_title
+from cyborg.bt.hooks import Hook, HookError, HookMode, TreeHooks
 from cyborg.bt.leaves import Error, Failer, Runner, Succeeder, Wait
 from cyborg.bt.loader import check_file, load_tree, loads_tree
 from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
@@ -46,11 +47,13 @@ from cyborg.bt.tree import Tree
 __all__ = [
     "ERROR", "FAILURE", "RUNNING", "SUCCESS",
     "Action", "Blackboard", "Category", "Clock", "Composite", "Condition", "Decorator",
-    "Delay", "Error", "Failer", "ForceFailure", "ForceSuccess", "Inverter", "Limiter",
+    "Delay", "Error", "Failer", "ForceFailure", "ForceSuccess", "Hook", "HookError",
+    "HookMode", "Inverter", "Limiter",
     "ManualClock", "MaxTime", "MemPriority", "MemSequence", "MonotonicClock", "Node",
     "NodeRegistry", "NodeType", "Parallel", "Priority", "Problem", "ProjectSpec",
     "RepeatUntilFailure", "RepeatUntilSuccess", "Repeater", "Retry", "RunOnce", "Runner",
     "Sequence", "Severity", "Status", "Subtree", "Succeeder", "TickSnapshot", "Timeout", "Tree",
-    "TreeLoadError", "TreeRunner", "TreeStructure", "Wait", "check_file", "default_registry",
-    "load_tree", "loads_tree", "parse_project", "read_project", "register", "render_title",
+    "TreeHooks", "TreeLoadError", "TreeRunner", "TreeStructure", "Wait", "check_file",
+    "default_registry", "load_tree", "loads_tree", "parse_project", "read_project", "register",
+    "render_title",
 ]

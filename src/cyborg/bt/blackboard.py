@@ -6,6 +6,10 @@
 * **node** — one dict per node, keyed by the node's stable id; stock nodes keep their state here
   (MemSequence's ``running_child``, Wait's ``start``, Limiter's ``completed``).
 
+Beside the scopes, :attr:`Blackboard.resources` holds handles to the outside world that nodes
+need but that are not data (a connection to the robot, a camera). They are given by whoever
+runs the tree, never shown in :meth:`Blackboard.as_dict`, and survive a reload.
+
 Nodes reach the scopes as ``self.blackboard``, ``self.tree_memory`` and ``self.memory``.
 :meth:`Blackboard.as_dict` returns all three for inspection.
 """
@@ -19,10 +23,13 @@ from typing import Any
 class Blackboard(MutableMapping[str, Any]):
     """Global scope as a mapping, with tree and node scopes beside it."""
 
-    def __init__(self, initial: dict[str, Any] | None = None) -> None:
+    def __init__(self, initial: dict[str, Any] | None = None, *,
+                 resources: dict[str, Any] | None = None) -> None:
         self.globals: dict[str, Any] = dict(initial or {})
         self.trees: dict[str, dict[str, Any]] = {}
         self.nodes: dict[str, dict[str, Any]] = {}
+        self.resources: dict[str, Any] = dict(resources or {})
+        """Handles for nodes to act through (``"robot"``: the robot's interface); not data."""
 
     # Global scope: the mapping interface.
     def __getitem__(self, key: str) -> Any:
@@ -67,11 +74,14 @@ class Blackboard(MutableMapping[str, Any]):
         return scope
 
     def as_dict(self) -> dict[str, Any]:
-        """A copy of all three scopes, for inspection; empty node scopes are left out."""
+        """A copy of all three scopes, for inspection; empty node scopes are left out.
+
+        Safe to call from another thread while the tree ticks: each dict is copied in one step.
+        """
         return {
             "global": dict(self.globals),
-            "trees": {uid: dict(scope) for uid, scope in self.trees.items() if scope},
-            "nodes": {uid: dict(scope) for uid, scope in self.nodes.items() if scope},
+            "trees": {uid: dict(scope) for uid, scope in dict(self.trees).items() if scope},
+            "nodes": {uid: dict(scope) for uid, scope in dict(self.nodes).items() if scope},
         }
 
     def _scope(self, tree: str | None, node: str | None) -> dict[str, Any]:

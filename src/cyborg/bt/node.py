@@ -34,6 +34,7 @@ from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
+    from cyborg.bt.hooks import NodeHook
 
 log = logging.getLogger("cyborg.bt")
 
@@ -110,6 +111,9 @@ class Node:
     last_error: BaseException | None = None
     """The last exception the node's code raised, if any."""
     error_count: int = 0
+    hook: NodeHook | None = None
+    """Set by :class:`~cyborg.bt.hooks.TreeHooks` while the node is disabled, forced or has a
+    breakpoint; ``None`` otherwise."""
     _record: TickRecord
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -194,6 +198,29 @@ class Node:
         return f"<{type(self).__name__} {self.label or self.name!r} uid={self.uid!r}>"
 
     # ----------------------------------------------------------------- internals
+    def _skip(self, status: Status) -> Status:
+        """Return ``status`` without ticking (a disabled node); a RUNNING subtree is halted."""
+        self.halt()
+        self.status = status
+        self._record.visits.append((self, status))
+        return status
+
+    def _replace_result(self, original: Status, forced: Status) -> None:
+        """Make ``forced`` the result of the execute that just returned ``original``.
+
+        This node's entries are the last ones appended to the tick record (children finish
+        first), so they are patched in place; a RUNNING node forced to finish ends normally.
+        """
+        record = self._record
+        self.status = forced
+        record.visits[-1] = (self, forced)
+        if original is RUNNING:
+            record.running.pop()
+            if self._ends:
+                self._end(forced)
+        elif forced is RUNNING:
+            record.running.append(self)
+
     def _end(self, status: Status) -> None:
         try:
             self.on_end(status)

@@ -71,6 +71,7 @@ class TreeRunner:
         with self._state:
             self._paused = True
             self._wake.set()
+        self.tree.hooks.release()  # a tick waiting at a breakpoint ends before the pause
         if halt:
             with self._tick_lock:
                 self.tree.halt()
@@ -91,12 +92,30 @@ class TreeRunner:
             self._stopped = True
             self._wake.set()
             self._state.notify_all()
+        self.tree.hooks.release()
         thread = self._thread
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout)
         if thread is None:
             with self._tick_lock:
                 self.tree.halt()
+
+    def replace_tree(self, tree: Tree) -> Tree:
+        """Tick ``tree`` from the next tick on, and return the old one, halted.
+
+        The old tree's RUNNING nodes are halted (their actions cancel) and its hooks move to
+        the new tree where the node ids still exist. Used to reload a tree file in place.
+        """
+        old = self.tree
+        old.hooks.release()
+        with self._tick_lock:
+            old.halt()
+            old.hooks.carry_to(tree.hooks)
+            self.tree = tree
+            if self.clock is old.clock:
+                self.clock = tree.clock
+        self._wake.set()
+        return old
 
     # ------------------------------------------------------------------ loops
     def start(self, *, max_ticks: int | None = None, until_done: bool = False) -> None:

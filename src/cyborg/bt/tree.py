@@ -17,6 +17,7 @@ from time import perf_counter
 
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.clock import Clock, MonotonicClock
+from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.node import Node, TickRecord
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
 from cyborg.bt.status import RUNNING, Status
@@ -45,6 +46,8 @@ class Tree:
             node.index = index
         self.by_uid: dict[str, Node] = {node.uid: node for node in self.nodes}
         self._structure: TreeStructure | None = None
+        self.hooks = TreeHooks(self.nodes)
+        """Per-node control: disable, force, breakpoints (see :mod:`cyborg.bt.hooks`)."""
 
     def __iter__(self) -> Iterator[Node]:
         return iter(self.nodes)
