@@ -12,7 +12,8 @@ import pytest
 
 from cyborg.bus import BusConfig, Context, GoalStatus, Node, new_message
 from cyborg.nav.arnl_map import read_map
-from cyborg.sim.node import CANCELED, FAILED, SUCCEEDED, SimulatorNode
+from cyborg.bus.clock import SimClock
+from cyborg.sim.node import CANCELED, FEEDBACK_PERIOD, NO_PATH, SUCCEEDED, SimulatorNode
 from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
@@ -85,6 +86,9 @@ def test_move_to_goal_feedback_cancel_and_failure(
     status, result = goal.result(timeout=60)
     assert (status, result.outcome) == (GoalStatus.SUCCEEDED, SUCCEEDED)
     assert feedback and feedback[0].distance_remaining > feedback[-1].distance_remaining
+    # feedback follows simulated time: one per FEEDBACK_PERIOD, whatever the speed
+    driven = feedback[0].distance_remaining
+    assert len(feedback) >= driven / 2.0 / FEEDBACK_PERIOD  # at most 2 m/s
     assert sim.pose.distance_to(sim.map.goal("room1")) < 0.2  # type: ignore[arg-type]
     loop.speed = 2.0  # slow enough to cancel on the way
     moving = threading.Event()
@@ -98,7 +102,7 @@ def test_move_to_goal_feedback_cancel_and_failure(
         assert sim.navigator.state.value == "ABORTED_PATHPLAN"
     unknown = action.send_goal(new_message(node.types, goal_type, {"goal_name": "kitchen"}))
     status, result = unknown.result(timeout=10)
-    assert (status, result.outcome) == (GoalStatus.ABORTED, FAILED)
+    assert (status, result.outcome) == (GoalStatus.ABORTED, NO_PATH)
     assert "no goal named 'kitchen'" in result.message
 
 
@@ -140,3 +144,18 @@ def test_topics_battery_and_docking(robot: tuple[Node, Simulator, SimulationLoop
     last = batteries[-1]
     assert last.dock_state == "DOCKED" and last.charging
     assert last.charging_state in (1, 2, 3)  # bulk, overcharge or float
+
+
+def test_sim_clock_follows_the_simulation(robot: tuple[Node, Simulator, SimulationLoop]) -> None:
+    node, sim, _loop = robot
+    clock = SimClock(node)
+    assert clock.wait_for_time(10) and clock.started
+    start = clock.now()
+    assert start > 0
+    stop = threading.Event()
+    clock.sleep_until(start + 2.0, stop)  # 2 simulated seconds: 0.1 s of wall time at 20x
+    assert clock.now() >= start + 2.0
+    assert abs(clock.now() - sim.time) < 1.0
+    stop.set()
+    clock.sleep_until(clock.now() + 1e6, stop)  # returns at once when woken
+    clock.destroy()

@@ -12,6 +12,7 @@ This package imports nothing else of cyborg.
 """
 
 from cyborg.bus.actions import ActionError, ClientGoal, GoalStatus, ServerGoal
+from cyborg.bus.clock import SimClock
 from cyborg.bus.config import BusConfig, BusConfigError
 from cyborg.bus.context import Context
 from cyborg.bus.conversion import MessageValueError, new_message, to_plain
@@ -23,4 +24,4 @@ from cyborg.bus.wire import Durability, History, Qos, Reliability
 __all__ = ["BUNDLED_INTERFACES", "ActionError", "BusConfig", "BusConfigError", "ClientGoal",
            "Context", "Durability", "GoalStatus", "History", "InterfaceError", "MessageTypes",
            "MessageValueError", "Node", "Qos", "Reliability", "ServerGoal", "ServiceError",
-           "ServiceTimeoutError", "default_context", "new_message", "to_plain"]
+           "ServiceTimeoutError", "SimClock", "default_context", "new_message", "to_plain"]

@@ -27,6 +27,7 @@ faster than real time does not flood the bus; ``/clock`` follows every sensor st
 from __future__ import annotations
 
 import math
+import threading
 import time
 from typing import Any
 
@@ -42,7 +43,9 @@ from cyborg.sim.navigator import PathState
 from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
-SUCCEEDED, FAILED, CANCELED = 1, 2, 3  # MoveToGoal result outcomes
+SUCCEEDED, FAILED, CANCELED, NO_PATH = 1, 2, 3, 4  # MoveToGoal result outcomes
+FEEDBACK_PERIOD = 0.25
+"""Simulated seconds between move_to_goal feedback messages (and checks of the goal)."""
 
 
 class SimulatorNode:
@@ -58,6 +61,7 @@ class SimulatorNode:
         self._battery_at = -math.inf
         self._path_shown: object = None
         self._goal_generation = 0
+        self._stepped = threading.Condition()  # notified after every sensor step
         self.clock = node.create_publisher("/clock", "rosgraph_msgs/msg/Clock")
         self.pose = node.create_publisher("pose", "geometry_msgs/msg/Pose2D")
         self.odom = node.create_publisher("odom", "nav_msgs/msg/Odometry")
@@ -88,6 +92,8 @@ class SimulatorNode:
         return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
 
     def _publish(self, sim: Simulator) -> None:
+        with self._stepped:
+            self._stepped.notify_all()
         message = self.types.message_class
         self.clock.publish(message("rosgraph_msgs/msg/Clock")(clock=self._stamp()))
         if sim.time - self._battery_at >= 1.0:
@@ -183,12 +189,17 @@ class SimulatorNode:
                 plan = self.sim.go_to(target, heading)
             except KeyError as exc:
                 goal.abort()
-                return result(outcome=FAILED, message=str(exc).strip("'\""))
+                return result(outcome=NO_PATH, message=str(exc).strip("'\""))
         if not plan.found:
             goal.abort()
-            return result(outcome=FAILED, message=f"{plan.code}: {plan.reason}")
+            return result(outcome=NO_PATH, message=f"{plan.code}: {plan.reason}")
         feedback = self.types.message_class("cyborg_msgs/action/MoveToGoal_Feedback")
+        next_check = -math.inf
         while True:
+            with self._stepped:  # feedback follows simulated time, whatever the speed
+                while self.sim.time < next_check and self.loop.running and \
+                        not goal.cancel_requested:
+                    self._stepped.wait(0.05)
             with self.loop.lock:
                 state, message = self.sim.navigator.state, self.sim.navigator.message
                 pose, remaining = self.sim.pose, self.sim.navigator.remaining
@@ -210,4 +221,4 @@ class SimulatorNode:
                 return result(outcome=FAILED, message="the simulation stopped")
             goal.publish_feedback(feedback(current_pose=pose.to_message(self.types),
                                            distance_remaining=min(remaining, 1e9)))
-            time.sleep(0.05)
+            next_check = self.sim.time + FEEDBACK_PERIOD
