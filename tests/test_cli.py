@@ -52,11 +52,28 @@ def test_validate_json_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert problem["severity"] == "error" and problem["line"] == 1 and problem["column"] == 12
 
 
-def test_validate_unknown_custom_nodes_and_stubs(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["bt", "validate", str(PATROL)]) == 1
+def _teleporting(tmp_path: Path) -> Path:
+    """The patrol tree with MoveTo renamed to a node nobody implements."""
+    return _write(tmp_path, PATROL.read_text().replace("MoveTo", "Teleport"))
+
+
+def test_the_robot_nodes_are_known(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "validate", str(PATROL)]) == 0
+    assert main(["bt", "nodes"]) == 0
     out = capsys.readouterr().out
-    assert "unknown node name 'MoveTo' (declared in custom_nodes" in out
-    assert main(["bt", "validate", str(PATROL), "--stub-missing", "success"]) == 0
+    for name in ("MoveTo", "CheckBattery", "Charge", "Dock", "Undock", "ClosestGoal",
+                 "DistanceToGoal", "BlackboardCompare"):
+        assert f"\n{name} " in out or f"{name}  " in out, name
+    assert "entry point cyborg" in out or "cyborg.nodes" in out
+
+
+def test_validate_unknown_custom_nodes_and_stubs(tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    path = _teleporting(tmp_path)
+    assert main(["bt", "validate", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "unknown node name 'Teleport' (declared in custom_nodes" in out
+    assert main(["bt", "validate", str(path), "--stub-missing", "success"]) == 0
 
 
 def test_validate_with_user_node_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -104,13 +121,14 @@ def test_run_shows_status_line(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert "done after 4 ticks; last root status SUCCESS" in out
 
 
-def test_run_by_tree_title_and_ticks(capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["bt", "run", str(PATROL), "--tree", "Recharge tree", "--stub-missing",
-                 "running", "--ticks", "3", "--rate", "50"])
+def test_run_by_tree_title_and_ticks(tmp_path: Path,
+                                     capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["bt", "run", str(_teleporting(tmp_path)), "--tree", "Recharge tree",
+                 "--stub-missing", "running", "--ticks", "3", "--rate", "50"])
     assert code == 0
     out = capsys.readouterr().out
     assert "running 'Recharge tree'" in out
-    assert "Recharge tree > MemSequence > MoveTo Dock" in out
+    assert "Recharge tree > MemSequence > Teleport Dock" in out
     assert "done after 3 ticks" in out
 
 

@@ -103,9 +103,10 @@ def test_nested_packages_and_relative_names(tmp_path: Path) -> None:
 
 def test_cyborg_msgs_are_registered(types: MessageTypes) -> None:
     for name in ("BehaviorTree", "BehaviorTreeNodes", "BehaviorTreeStatus", "GoalWithHeading",
-                 "Prediction", "Predictions", "BatteryStatus"):
+                 "Prediction", "Predictions", "BatteryStatus", "BehaviorTreeHooks"):
         assert f"cyborg_msgs/msg/{name}" in types
-    for name in ("AvailableGoals", "ClosestGoal", "DistanceToGoal", "MakePlan", "LoadMapFile"):
+    for name in ("AvailableGoals", "ClosestGoal", "DistanceToGoal", "MakePlan", "LoadMapFile",
+                 "ControlNode", "ReloadTree", "GetBlackboard"):
         assert f"cyborg_msgs/srv/{name}" in types.services
         assert f"cyborg_msgs/srv/{name}_Request" in types
         assert f"cyborg_msgs/srv/{name}_Event" in types
@@ -114,7 +115,7 @@ def test_cyborg_msgs_are_registered(types: MessageTypes) -> None:
                  "SendGoal_Response", "GetResult_Request", "GetResult_Response"):
         assert f"cyborg_msgs/action/MoveToGoal_{part}" in types
     fields = [name for name, _ in types.fields("cyborg_msgs/msg/GoalWithHeading")]
-    assert fields == ["name", "comment", "position"]
+    assert fields == ["name", "comment", "position", "has_heading"]  # the 2018 fields first
     assert [n for n, _ in types.fields("cyborg_msgs/msg/Prediction")] == [
         "label", "confidence", "distance", "bounding_box"]
 

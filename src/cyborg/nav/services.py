@@ -88,7 +88,7 @@ class NavigationServices:
     def available_goals(self, _request: Any) -> Any:
         goals = [self._goal_type(name=item.name, comment=item.description,
                                  position=Pose2D(item.x, item.y, item.theta).to_message(
-                                     self.node.types))
+                                     self.node.types), has_heading=item.has_heading)
                  for item in self.maps.map.goals()]
         return self._classes["AvailableGoals"](goals=goals)
 

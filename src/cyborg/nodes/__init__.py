@@ -1,0 +1,27 @@
+"""The robot's behaviour nodes, registered under the names trees use in behavior3editor.
+
+========================  ==========  =====================================================
+name                      category    what it does
+========================  ==========  =====================================================
+MoveTo{location,radius}   action      drive to a map goal; stall detection, retries, cancel
+CheckBattery{threshold}   decorator   latching guard: tick the child while the battery is low
+Charge{target}            action      dock if needed; RUNNING until charged to ``target`` %
+Dock, Undock              action      dock / undock and wait until done
+ClosestGoal{key}          action      closest goal by path length into the blackboard
+DistanceToGoal{location}  condition   path length to a goal into the blackboard
+BlackboardCompare{key,    decorator   tick the child when a blackboard entry matches
+value,equal}
+========================  ==========  =====================================================
+
+They act on the robot through :class:`~cyborg.nodes.robot.Robot` (see that module); the tree
+runner (:mod:`cyborg.nodes.tree_runner`) provides one on the bus. This package is an entry
+point of the group ``cyborg.nodes``, so every registry built with
+:func:`cyborg.bt.default_registry` knows these nodes — a user's own package adds nodes the same
+way (see the README).
+"""
+
+from cyborg.nodes import battery, blackboard_compare, docking, goals, move_to
+from cyborg.nodes.robot import ROBOT, Robot, RobotError, robot_of
+
+__all__ = ["ROBOT", "Robot", "RobotError", "battery", "blackboard_compare", "docking", "goals",
+           "move_to", "robot_of"]

@@ -1,0 +1,196 @@
+"""The robot over the bus: its ARNL-like interface, as the simulator and the real robot offer it.
+
+Under the robot's namespace (``/cyborg`` by default) it uses the topics ``pose`` and
+``battery_status``, the services ``nav/get_available_goals``, ``nav/get_distance_to_goal``,
+``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action
+(see :mod:`cyborg.sim.node` for the full interface)::
+
+    robot = BusRobot(Node("bt", "/cyborg"), "/cyborg")
+    move = robot.move_to("room1")
+    ...
+    move.done, move.outcome, move.remaining
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from concurrent.futures import Future
+from typing import Any
+
+from cyborg.bus import ActionError, ClientGoal, Node, Qos, ServiceError, new_message
+from cyborg.nav.geometry import Pose2D
+from cyborg.nodes.robot import BatteryReading, DockState, Goal, MoveOutcome, RobotError
+
+log = logging.getLogger("cyborg.nodes")
+
+GOAL = "cyborg_msgs/action/MoveToGoal_Goal"
+
+
+class BusMove:
+    """A move_to_goal goal in progress."""
+
+    def __init__(self, handle: ClientGoal | None, goal: str, error: str = "") -> None:
+        self.goal = goal
+        self._handle = handle
+        self._error = error
+        self._remaining = math.inf
+        self._cancel_sent = False
+
+    def on_feedback(self, feedback: Any) -> None:
+        self._remaining = float(feedback.distance_remaining)
+
+    @property
+    def done(self) -> bool:
+        return self._handle is None or self._handle.done
+
+    @property
+    def outcome(self) -> MoveOutcome | None:
+        if self._handle is None:
+            return MoveOutcome.FAILED
+        if not self._handle.done:
+            return None
+        try:
+            _status, result = self._handle.result(0)
+        except (ActionError, ServiceError) as exc:
+            self._error = str(exc)
+            return MoveOutcome.FAILED
+        try:
+            return MoveOutcome(int(result.outcome))
+        except ValueError:
+            return MoveOutcome.FAILED
+
+    @property
+    def message(self) -> str:
+        if self._handle is None or not self._handle.done:
+            return self._error
+        try:
+            return str(self._handle.result(0)[1].message)
+        except (ActionError, ServiceError) as exc:
+            return str(exc)
+
+    @property
+    def remaining(self) -> float:
+        return self._remaining
+
+    def cancel(self) -> None:
+        handle = self._handle
+        if handle is None or handle.done or self._cancel_sent:
+            return
+        self._cancel_sent = True
+        future = handle.client.node.context.calls.submit(handle.cancel)
+        future.add_done_callback(self._cancelled)
+
+    def _cancelled(self, future: Future[bool]) -> None:
+        error = future.exception()
+        if error is not None:
+            log.warning("cancelling the move to %r failed: %s", self.goal, error)
+
+
+class BusRobot:
+    """:class:`~cyborg.nodes.robot.Robot` on the bus, for the robot under ``namespace``."""
+
+    def __init__(self, node: Node, namespace: str = "/cyborg", *, timeout: float = 5.0) -> None:
+        self.node, self.timeout = node, timeout
+        prefix = "/" + namespace.strip("/") if namespace.strip("/") else ""
+        self.namespace = prefix or "/"
+        self._pose: Pose2D | None = None
+        self._battery: BatteryReading | None = None
+        self._goals: dict[str, Goal] | None = None
+        self._lock = threading.Lock()
+        latched = Qos.latched()
+        node.create_subscription(f"{prefix}/pose", "geometry_msgs/msg/Pose2D", self._on_pose)
+        node.create_subscription(f"{prefix}/battery_status", "cyborg_msgs/msg/BatteryStatus",
+                                 self._on_battery, latched)
+        self._clients = {name: node.create_client(f"{prefix}/{name}", kind) for name, kind in (
+            ("nav/get_available_goals", "cyborg_msgs/srv/AvailableGoals"),
+            ("nav/get_distance_to_goal", "cyborg_msgs/srv/DistanceToGoal"),
+            ("nav/get_closest_goal", "cyborg_msgs/srv/ClosestGoal"),
+            ("dock", "std_srvs/srv/Trigger"),
+            ("undock", "std_srvs/srv/Trigger"),
+            ("stop", "std_srvs/srv/Trigger"))}
+        self._action = node.create_action_client(f"{prefix}/move_to_goal",
+                                                 "cyborg_msgs/action/MoveToGoal")
+
+    # ------------------------------------------------------------------ state
+    def _on_pose(self, message: Any) -> None:
+        self._pose = Pose2D.from_message(message)
+
+    def _on_battery(self, message: Any) -> None:
+        try:
+            state = DockState(message.dock_state)
+        except ValueError:
+            state = DockState.UNKNOWN
+        stamp = message.header.stamp
+        self._battery = BatteryReading(float(message.charge_percent), bool(message.charging),
+                                       state, stamp.sec + stamp.nanosec * 1e-9)
+
+    @property
+    def pose(self) -> Pose2D | None:
+        return self._pose
+
+    @property
+    def battery(self) -> BatteryReading | None:
+        return self._battery
+
+    def wait_until_ready(self, timeout: float = 10.0) -> bool:
+        """Wait (wall time) until the robot's services answer and its pose is known."""
+        client = self._clients["nav/get_available_goals"]
+        if not client.wait_for_service(timeout):
+            return False
+        return bool(self._action.wait_for_server(timeout))
+
+    # ------------------------------------------------------------------ requests
+    def _call(self, name: str, **fields: Any) -> Any:
+        client = self._clients[name]
+        request = new_message(self.node.types, f"{client.service_type}_Request", fields)
+        try:
+            return client.call(request, timeout=self.timeout)
+        except ServiceError as exc:
+            raise RobotError(str(exc)) from exc
+
+    def goals(self, refresh: bool = False) -> dict[str, Goal]:
+        with self._lock:
+            if self._goals is None or refresh:
+                reply = self._call("nav/get_available_goals")
+                self._goals = {goal.name: Goal(goal.name, Pose2D.from_message(goal.position),
+                                               goal.comment, bool(goal.has_heading))
+                               for goal in reply.goals}
+            return dict(self._goals)
+
+    def move_to(self, goal: str) -> BusMove:
+        message = new_message(self.node.types, GOAL, {"goal_name": goal})
+        move = BusMove(None, goal)
+        try:
+            move._handle = self._action.send_goal(message, feedback=move.on_feedback,
+                                                  timeout=self.timeout)
+        except ActionError as exc:
+            raise RobotError(f"cannot send the robot to {goal!r}: {exc}") from exc
+        return move
+
+    def _trigger(self, name: str) -> tuple[bool, str]:
+        reply = self._call(name)
+        return bool(reply.success), str(reply.message)
+
+    def dock(self) -> tuple[bool, str]:
+        return self._trigger("dock")
+
+    def undock(self) -> tuple[bool, str]:
+        return self._trigger("undock")
+
+    def stop(self) -> None:
+        self._trigger("stop")
+
+    def distance_to(self, goal: Pose2D) -> Future[float]:
+        pose = goal.to_pose()
+        fields = {"goal": {"position": {"x": pose.position.x, "y": pose.position.y},
+                           "orientation": {"z": pose.orientation.z, "w": pose.orientation.w}}}
+        return self.node.context.calls.submit(
+            lambda: float(self._call("nav/get_distance_to_goal", **fields).distance))
+
+    def closest_goal(self) -> Future[tuple[str, float]]:
+        def ask() -> tuple[str, float]:
+            reply = self._call("nav/get_closest_goal")
+            return str(reply.name), float(reply.distance)
+        return self.node.context.calls.submit(ask)
