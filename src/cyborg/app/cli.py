@@ -1,11 +1,14 @@
 """Entry point of the ``cyborg`` command.
 
-    cyborg up                      run the robot's main job on built-in defaults
+    cyborg up                      the simulated robot, navigation and the patrol tree
+    cyborg launch FILE             start the nodes a TOML/YAML launch file lists
     cyborg bt validate FILE        report every problem in a behavior3editor export
     cyborg bt run FILE             tick a tree with a live status line
     cyborg bt dot FILE             the tree as a Graphviz DOT graph
     cyborg bt json FILE            the tree's structure as JSON
     cyborg bt nodes                list the node types trees can use
+    cyborg bt serve FILE           run a tree on the bus (topics, enable, control services)
+    cyborg bt reload|enable|disable   control a running tree runner
     cyborg router                  run a Zenoh router (the bus's meeting point)
     cyborg node list|info          nodes on the bus (ours and ROS 2 peers)
     cyborg topic list|echo|pub|hz  topics on the bus

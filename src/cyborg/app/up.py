@@ -1,56 +1,136 @@
-"""``cyborg up``: start the robot's main job on built-in defaults.
+"""``cyborg up`` and ``cyborg launch``: start the robot's system with one command.
 
-Today this runs the bundled demo mission (``data/demo.b3.json``, a behavior3editor project made
-of stock nodes and nested subtrees) in the tree runner with a live status line. As the
-simulator, navigation, monitor and detector arrive, ``cyborg up`` starts them too, so the same
-command keeps bringing up the whole system.
+``cyborg up`` with no arguments runs the whole system on built-in defaults, in one process:
+the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn by the project in
+ARNL format) with its navigation services, and the tree runner with the bundled
+patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
+time. ``--map``, ``--tree`` and ``--speed`` swap the inputs. It prints what runs and where, then
+a live line of what the tree does; Ctrl-C stops everything cleanly.
+
+``cyborg launch FILE`` starts what a launch description lists (see :mod:`cyborg.app.launch`).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from importlib.resources import as_file, files
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
-from cyborg.app.bt_commands import (
-    add_run_options,
-    print_problems,
-    run_clock,
-    run_options_problem,
-    run_tree,
-)
-from cyborg.bt import TreeLoadError, default_registry, load_tree
+from cyborg.app.bt_commands import CommandError
+from cyborg.app.launch import Launch, LaunchDescription, read_launch
+from cyborg.app.launchables import LaunchError, NodeSpec, RunningTree
+from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
+from cyborg.app.status_line import StatusLine
 
-DEMO_TREE = "demo.b3.json"
+DATA = files("cyborg.app").joinpath("data")
+CAMPUS_MAP = "campus.map"
+CAMPUS_TREE = "campus_patrol.b3.json"
 
 
 def add_parser(commands: Any) -> None:
-    up = commands.add_parser("up", help="run the main job on built-in defaults",
-                             description="Start the robot's main job. With no options: the "
-                                         "bundled demo mission in the tree runner.")
+    up = commands.add_parser("up", help="run the robot's system on built-in defaults",
+                             description="Start the simulated robot on the bundled campus map, "
+                                         "its navigation services and the tree runner with the "
+                                         "bundled patrol-and-recharge tree.")
+    up.add_argument("--map", type=Path, default=None, metavar="FILE",
+                    help="ARNL .map file (default: the bundled campus)")
     up.add_argument("--tree", type=Path, default=None, metavar="FILE",
-                    help="behavior3editor export to run instead of the bundled demo")
-    add_run_options(up)
+                    help="behavior3editor export to run (default: the bundled patrol)")
+    up.add_argument("--speed", type=float, default=1.0, metavar="X",
+                    help="simulated seconds per wall-clock second (0: as fast as possible)")
+    up.add_argument("--start", default=None, metavar="NAME",
+                    help="goal or dock to start at (default: the map's home, else its dock)")
+    up.add_argument("--battery", type=float, default=100.0, metavar="PERCENT",
+                    help="battery charge at the start (default 100)")
+    up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
+    _bus_options(up)
     up.set_defaults(handler=up_command)
+
+    launch = commands.add_parser("launch", help="start the nodes a launch file lists",
+                                 description="Start the nodes of a TOML or YAML launch file, "
+                                             "in one process or several.")
+    launch.add_argument("file", type=Path, help="launch file (.toml, .yaml)")
+    launch.add_argument("--process", default="main", help=argparse.SUPPRESS)
+    _bus_options(launch)
+    launch.set_defaults(handler=launch_command)
+
+
+def _bus_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="join the router there instead of being one")
+    parser.add_argument("--listen", default=None, metavar="ENDPOINT",
+                        help=f"be the bus's router there (default {DEFAULT_ROUTER})")
+    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                        help="stop after this many wall-clock seconds")
+
+
+def up_description(args: argparse.Namespace) -> LaunchDescription:
+    """The system ``cyborg up`` starts, as a launch description."""
+    if args.speed < 0:
+        raise CommandError("--speed must be positive, or 0 for as fast as possible")
+    map_path = args.map or Path(str(DATA.joinpath(CAMPUS_MAP)))
+    tree_path = args.tree or Path(str(DATA.joinpath(CAMPUS_TREE)))
+    namespace = "/" + args.namespace.strip("/")
+    sim = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
+    if args.start:
+        sim["start"] = args.start
+    return LaunchDescription([
+        NodeSpec("simulator", "arnl", namespace, sim, where="simulator"),
+        NodeSpec("tree_runner", "tree_runner", f"{namespace}/bt",
+                 {"tree_file": str(tree_path), "use_sim_time": True,
+                  "robot_namespace": namespace}, where="tree runner"),
+    ], list(args.connect), args.listen or DEFAULT_ROUTER)
 
 
 def up_command(args: argparse.Namespace) -> int:
-    problem = run_options_problem(args)
-    if problem is not None:
-        print(problem, file=sys.stderr)
-        return 2
-    clock = run_clock(args)
-    resource = files("cyborg.app").joinpath("data", DEMO_TREE)
-    with as_file(resource) as demo:
-        path = args.tree or demo
-        try:
-            tree = load_tree(path, registry=default_registry(), clock=clock)
-        except TreeLoadError as exc:
-            print_problems(exc.problems, sys.stderr)
-            return 1
-        print("cyborg up:")
-        print(f"  tree runner  {tree.title!r} ({len(tree)} nodes) from "
-              f"{'the bundled demo' if args.tree is None else path}")
-        return run_tree(tree, rate_hz=args.rate, max_ticks=args.ticks)
+    return run(up_description(args), args, title="cyborg up")
+
+
+def launch_command(args: argparse.Namespace) -> int:
+    try:
+        description = read_launch(args.file)
+    except LaunchError as exc:
+        raise CommandError(str(exc)) from exc
+    if args.process not in description.processes():
+        raise CommandError(f"{args.file}: no node runs in process {args.process!r}")
+    if args.listen:
+        description.listen = args.listen
+    if args.connect:
+        description.connect = list(args.connect)
+    return run(description, args, title=f"cyborg launch {args.file}", process=args.process)
+
+
+def run(description: LaunchDescription, args: argparse.Namespace, *, title: str,
+        process: str = "main") -> int:
+    context, where = bus_context(description.connect, description.listen)
+    launch = Launch(description, context)
+    code = 0
+    try:
+        children = [name for name in description.processes() if name != "main"] \
+            if process == "main" else []
+        connect = description.connect[0] if description.connect else description.listen
+        launch.start(process, children=children, connect=connect)
+        print(f"{title}: bus {where}; Ctrl-C stops everything", flush=True)
+        for line in launch.describe():
+            print(f"  {line}", flush=True)
+        _follow_tree(launch)
+        code = launch.wait(args.duration)
+    except LaunchError as exc:
+        raise CommandError(str(exc)) from exc
+    finally:
+        launch.stop()
+        context.close()
+    if code == 130:
+        print(f"{title}: stopped", file=sys.stderr)
+    return code
+
+
+def _follow_tree(launch: Launch) -> None:
+    """Print a live status line for the first tree runner of this process."""
+    for item in launch.running:
+        if isinstance(item, RunningTree):
+            line = StatusLine(item.runner.tree, sys.stdout)
+            item.runner.runner.add_listener(line.update)
+            return

@@ -106,9 +106,13 @@ class Graph:
             self._changed.notify_all()
         self._notify()
 
-    def on_change(self, listener: Callable[[], None]) -> None:
-        """Call ``listener()`` (on a Zenoh thread) whenever a token appears or vanishes."""
+    def on_change(self, listener: Callable[[], None]) -> Callable[[], None]:
+        """Call ``listener()`` (on a Zenoh thread) whenever a token appears or vanishes.
+
+        Returns a function that removes the listener.
+        """
         self._listeners.append(listener)
+        return lambda: self._listeners.remove(listener) if listener in self._listeners else None
 
     def _notify(self) -> None:
         for listener in list(self._listeners):

@@ -87,6 +87,12 @@ class Responder:
         self._server, self._query, self._attachment = server, query, attachment
         self._done = threading.Lock()
 
+    @property
+    def caller_gid(self) -> bytes:
+        """The calling client's 16-byte GID (from the request's attachment): which client
+        asked, e.g. to release what it set up once its liveliness token is gone."""
+        return self._attachment.gid
+
     def reply(self, response: Any) -> None:
         server = self._server
         if not isinstance(response, server.response_class):

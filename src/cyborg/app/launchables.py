@@ -1,0 +1,204 @@
+"""The kinds of node a launch file can start, and how each one starts.
+
+Every kind is a function ``start(context, spec) -> Running``: it creates its bus node(s) in the
+given context from the spec's name, namespace and parameters, starts working, and returns a
+handle that can describe itself and stop. Parameters become the node's bus parameters, so
+``cyborg param list`` shows them and the changeable ones (the simulator's ``speed``) can be set
+at runtime.
+
+==============  ================================================================================
+kind            parameters (default)
+==============  ================================================================================
+``simulator``   ``map`` (required), ``start`` (the map's home or dock), ``speed`` (1.0; 0 = as
+                fast as possible), ``battery`` (start charge, 100 %)
+``tree_runner`` ``tree_file`` (required), ``tree`` (the file's selected tree), ``rate`` (10 Hz),
+                ``use_sim_time`` (false), ``robot_namespace`` (/cyborg), ``enabled`` (true),
+                ``nodes`` (modules of node classes to import, [])
+==============  ================================================================================
+
+A user's own kind is given as ``"package.module:function"`` with the same signature.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
+from cyborg.bus import Context, Node, SimClock
+from cyborg.nav.arnl_map import MapError, read_map
+from cyborg.nodes.bus_robot import BusRobot
+from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.sim.battery import Battery
+from cyborg.sim.node import SimulatorNode
+from cyborg.sim.runner import SimulationLoop
+from cyborg.sim.simulator import Simulator
+
+
+class LaunchError(ValueError):
+    """A launch description that cannot be started; the message says where and why."""
+
+
+@dataclass
+class NodeSpec:
+    """One entry of a launch description."""
+
+    kind: str
+    name: str
+    namespace: str = "/"
+    parameters: dict[str, Any] = field(default_factory=dict)
+    process: str = "main"
+    base: Path = Path(".")
+    """Folder that relative paths in parameters are relative to (the launch file's)."""
+    where: str = ""
+    """Where the entry was written (``file: node 2``), for error messages."""
+
+    def path(self, value: str) -> Path:
+        path = Path(value).expanduser()
+        return path if path.is_absolute() else self.base / path
+
+    def error(self, message: str) -> LaunchError:
+        return LaunchError(f"{self.where or self.name}: {message}")
+
+
+class Running(Protocol):
+    def describe(self) -> str: ...
+    def stop(self) -> None: ...
+
+
+Starter = Callable[[Context, NodeSpec], Running]
+
+
+# ---------------------------------------------------------------------------------- simulator
+class RunningSimulator:
+    def __init__(self, node: Node, loop: SimulationLoop, map_path: Path) -> None:
+        self.node, self.loop, self.map_path = node, loop, map_path
+
+    def describe(self) -> str:
+        speed = self.loop.speed
+        pace = "as fast as possible" if math.isinf(speed) else f"{speed:g}x real time"
+        return (f"simulator    {self.node.fq_name}: {self.map_path.name} at {pace}; "
+                f"ARNL-like interface under {self.node.namespace}, /clock")
+
+    def stop(self) -> None:
+        self.loop.stop()
+        self.node.destroy()
+
+
+def start_simulator(context: Context, spec: NodeSpec) -> RunningSimulator:
+    node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
+    try:
+        params = node.parameters
+        map_value = params.declare("map", "", "ARNL .map file", read_only=True)
+        if not map_value:
+            raise spec.error("the simulator needs a `map` parameter (an ARNL .map file)")
+        start = params.declare("start", "", "goal or dock to start at", read_only=True)
+        speed = params.declare("speed", 1.0, "simulated seconds per second (0: flat out)")
+        charge = params.declare("battery", 100.0, "battery charge at the start, percent",
+                                read_only=True, limits=(0.0, 100.0))
+        map_path = spec.path(str(map_value))
+        try:
+            arnl_map = read_map(map_path)
+            simulator = Simulator(arnl_map, start=start or None,
+                                  battery=Battery(charge_percent=float(charge)))
+            loop = SimulationLoop(simulator, float(speed))
+        except (MapError, KeyError, ValueError) as exc:
+            raise spec.error(str(exc).strip("\"'")) from exc
+
+        def check(changes: dict[str, Any]) -> None:
+            if "speed" in changes and float(changes["speed"]) < 0:
+                raise ValueError("speed must be positive, or 0 for as fast as possible")
+        params.on_set(check)
+        params.on_change(lambda changes: setattr(
+            loop, "speed", math.inf if float(changes.get("speed", loop.speed)) == 0
+            else float(changes.get("speed", loop.speed))))
+        SimulatorNode(node, loop)
+        loop.start()
+    except BaseException:
+        node.destroy()
+        raise
+    return RunningSimulator(node, loop, map_path)
+
+
+# ---------------------------------------------------------------------------------- tree runner
+class RunningTree:
+    def __init__(self, runner: TreeRunnerNode, robot_node: Node) -> None:
+        self.runner, self.robot_node = runner, robot_node
+
+    def describe(self) -> str:
+        tree, node = self.runner.tree, self.runner.node
+        clock = "simulated time (/clock)" if isinstance(self.runner.clock, SimClock) \
+            else "wall-clock time"
+        return (f"tree runner  {node.fq_name}: {tree.title!r} ({len(tree)} nodes) from "
+                f"{self.runner.path.name} at {self.runner.runner.rate_hz:g} Hz on {clock}; "
+                f"topics {node.namespace}/behavior_tree, .../status; enable: "
+                f"{node.namespace}/enable")
+
+    def stop(self) -> None:
+        self.runner.stop()
+        self.runner.destroy()
+        self.robot_node.destroy()
+
+
+def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
+    node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
+    robot_node: Node | None = None
+    try:
+        params = node.parameters
+        tree_file = params.declare("tree_file", "", "behavior3editor export", read_only=True)
+        if not tree_file:
+            raise spec.error("the tree runner needs a `tree_file` parameter")
+        choice = params.declare("tree", "", "tree id or title (default: selectedTree)",
+                                read_only=True)
+        rate = params.declare("rate", 10.0, "ticks per second", read_only=True)
+        sim_time = params.declare("use_sim_time", False, "tick on /clock", read_only=True)
+        robot_ns = params.declare("robot_namespace", "/cyborg", "the robot's namespace",
+                                  read_only=True)
+        enabled = params.declare("enabled", True, "tick from the start", read_only=True)
+        modules = params.declare("nodes", [""], "modules of node classes to import",
+                                 read_only=True)
+        registry = default_registry()
+        try:
+            registry.import_modules([module for module in modules if module])
+        except ImportError as exc:
+            raise spec.error(str(exc)) from exc
+        clock: Clock = SimClock(node) if sim_time else MonotonicClock()
+        robot_node = Node(f"{spec.name}_robot", spec.namespace, context=context)
+        robot = BusRobot(robot_node, str(robot_ns))
+        try:
+            runner = TreeRunnerNode(node, spec.path(str(tree_file)), tree=choice or None,
+                                    rate_hz=float(rate), clock=clock, robot=robot,
+                                    registry=registry, enabled=bool(enabled))
+        except TreeLoadError as exc:
+            problems = "\n".join(f"  {problem}" for problem in exc.problems)
+            raise spec.error(f"the tree file has errors:\n{problems}") from exc
+        runner.start()
+    except BaseException:
+        node.destroy()
+        if robot_node is not None:
+            robot_node.destroy()
+        raise
+    return RunningTree(runner, robot_node)
+
+
+KINDS: dict[str, Starter] = {"simulator": start_simulator, "tree_runner": start_tree_runner}
+
+
+def starter_for(spec: NodeSpec) -> Starter:
+    """The start function of ``spec.kind``: a known kind or ``module:function``."""
+    if spec.kind in KINDS:
+        return KINDS[spec.kind]
+    module_name, _, function = spec.kind.partition(":")
+    if not function:
+        raise spec.error(f"unknown kind {spec.kind!r}; known: {', '.join(sorted(KINDS))}, "
+                         "or 'package.module:function'")
+    try:
+        module = importlib.import_module(module_name)
+        starter: Starter = getattr(module, function)
+    except (ImportError, AttributeError) as exc:
+        raise spec.error(f"cannot load kind {spec.kind!r}: {type(exc).__name__}: {exc}") from exc
+    return starter

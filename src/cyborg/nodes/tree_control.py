@@ -1,0 +1,186 @@
+"""Per-node control of a running tree over the bus, for monitors and tools.
+
+Services under the tree runner's namespace:
+
+=================  ============================  ===============================================
+name               type                          what
+=================  ============================  ===============================================
+``control``        cyborg_msgs/ControlNode       disable a subtree, force a result, set or clear
+                                                 a breakpoint on one node
+``resume``         std_srvs/Trigger              let a tick waiting at a breakpoint go on
+``step``           std_srvs/Trigger              go on to the next node about to tick, and stop
+``get_blackboard`` cyborg_msgs/GetBlackboard     the blackboard's three scopes as JSON
+``hooks``          cyborg_msgs/BehaviorTreeHooks latched topic: the hooks set, where a tick waits
+=================  ============================  ===============================================
+
+**Hooks follow their client.** Each hook remembers the service client that set it (by the GID in
+the request, which names the client's liveliness token). When that client leaves the bus — the
+monitor is closed, its machine drops off — its hooks are released within the liveliness timeout
+(about 2 s), so a forgotten breakpoint or a disabled branch never outlives whoever set it.
+A request with ``keep`` set survives its client; so does one from a client the runner cannot
+see on the bus (reported in the reply).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from cyborg.bt import FAILURE, RUNNING, SUCCESS, Hook, HookError, HookMode, Tree
+from cyborg.bus import Node, Qos
+from cyborg.bus.services import Responder
+from cyborg.bus.wire import EntityKind, gid
+
+log = logging.getLogger("cyborg.nodes")
+
+ACTIONS = {1: HookMode.DISABLE, 2: HookMode.FORCE, 3: HookMode.BREAKPOINT}
+CODES = {mode: code for code, mode in ACTIONS.items()}
+STATUSES = {1: SUCCESS, 2: FAILURE, 3: RUNNING}
+SEE_CALLER = 1.0
+"""Seconds to wait for a caller's liveliness token to show up in the graph."""
+
+
+class TreeControl:
+    """The control services of one tree runner; ``current()`` is the tree being ticked."""
+
+    def __init__(self, node: Node, current: Callable[[], Tree]) -> None:
+        self.node, self.current = node, current
+        self.graph = node.context.graph
+        self._owners: dict[str, str] = {}  # owner (client GID hex) -> its node's name
+        self._lock = threading.Lock()
+        self._hooks = node.create_publisher("hooks", "cyborg_msgs/msg/BehaviorTreeHooks",
+                                            Qos.latched())
+        self._classes = {name: node.types.message_class(name) for name in (
+            "cyborg_msgs/msg/BehaviorTreeHooks", "cyborg_msgs/srv/ControlNode_Response",
+            "std_srvs/srv/Trigger_Response", "cyborg_msgs/srv/GetBlackboard_Response")}
+        node.create_service("control", "cyborg_msgs/srv/ControlNode", self._on_control,
+                            deferred=True)
+        node.create_service("resume", "std_srvs/srv/Trigger", self._on_resume)
+        node.create_service("step", "std_srvs/srv/Trigger", self._on_step)
+        node.create_service("get_blackboard", "cyborg_msgs/srv/GetBlackboard",
+                            self._on_blackboard)
+        current().hooks.listeners.append(self.publish)
+        self._stop_watching = self.graph.on_change(self._release_departed)
+        self.publish()
+
+    # ------------------------------------------------------------------ hooks topic
+    def publish(self) -> None:
+        hooks = self.current().hooks
+        entries = hooks.hooks()
+        self._hooks.publish(self._classes["cyborg_msgs/msg/BehaviorTreeHooks"](
+            node_ids=[hook.node for hook in entries],
+            actions=np.array([CODES[hook.mode] for hook in entries], np.uint8),
+            statuses=np.array([int(hook.status) for hook in entries], np.uint8),
+            owners=[self._owners.get(hook.owner, "") for hook in entries],
+            paused_at=hooks.paused_at or ""))
+
+    def tree_replaced(self, old: Tree, new: Tree) -> None:
+        """Follow the runner to a reloaded tree (its hooks were carried over already)."""
+        if self.publish in old.hooks.listeners:
+            old.hooks.listeners.remove(self.publish)
+        new.hooks.listeners.append(self.publish)
+        self.publish()
+
+    # ------------------------------------------------------------------ owners
+    def _caller(self, caller: bytes) -> str | None:
+        """The node name of the client with GID ``caller``, if it is on the bus."""
+        found: list[str] = []
+
+        def look(graph: Any) -> bool:
+            for entity in graph.entities([EntityKind.SERVICE_CLIENT]):
+                if gid(entity.key) == caller:
+                    found.append(entity.node_name)
+                    return True
+            return False
+        self.graph.wait_for(look, SEE_CALLER)
+        return found[0] if found else None
+
+    def _release_departed(self) -> None:
+        with self._lock:
+            if not self._owners:
+                return
+            present = {gid(entity.key).hex()
+                       for entity in self.graph.entities([EntityKind.SERVICE_CLIENT])}
+            gone = [owner for owner in self._owners if owner not in present]
+            for owner in gone:
+                name = self._owners.pop(owner)
+                released = self.current().hooks.clear_owner(owner)
+                if released:
+                    log.info("released %d hook(s) of %s, which left the bus", len(released),
+                             name)
+
+    # ------------------------------------------------------------------ services
+    def _on_control(self, request: Any, responder: Responder) -> None:
+        response = self._classes["cyborg_msgs/srv/ControlNode_Response"]
+        hooks = self.current().hooks
+        uid, action = str(request.node_id), int(request.action)
+        note = ""
+        try:
+            if action == 0:
+                cleared = hooks.clear(uid)
+                responder.reply(response(success=True, message="cleared" if cleared else
+                                         f"node {uid} had no hook"))
+                return
+            mode = ACTIONS.get(action)
+            if mode is None:
+                raise HookError(f"unknown action {action}: use 0 clear, 1 disable, 2 force, "
+                                "3 breakpoint")
+            status = SUCCESS
+            if mode is not HookMode.BREAKPOINT:
+                if int(request.status) not in STATUSES:
+                    raise HookError(f"status {request.status} is not 1 success, 2 failure or "
+                                    "3 running")
+                status = STATUSES[int(request.status)]
+            owner = ""
+            if not request.keep:
+                name = self._caller(responder.caller_gid)
+                if name is None:
+                    note = "; kept: the caller is not visible on the bus"
+                else:
+                    owner = responder.caller_gid.hex()
+                    with self._lock:
+                        self._owners[owner] = name
+            hooks.set(Hook(uid, mode, status, once=bool(request.once), owner=owner))
+        except HookError as exc:
+            responder.reply(response(success=False, message=str(exc)))
+            return
+        responder.reply(response(success=True, message=f"{mode.value} set on {uid}{note}"))
+
+    def _trigger(self, success: bool, message: str) -> Any:
+        return self._classes["std_srvs/srv/Trigger_Response"](success=success, message=message)
+
+    def _on_resume(self, _request: Any) -> Any:
+        resumed = self.current().hooks.resume()
+        return self._trigger(resumed, "resumed" if resumed else "no tick is waiting")
+
+    def _on_step(self, _request: Any) -> Any:
+        stepped = self.current().hooks.step()
+        return self._trigger(stepped, "stepping" if stepped else "no tick is waiting")
+
+    def _on_blackboard(self, _request: Any) -> Any:
+        scopes = self.current().blackboard.as_dict()
+        return self._classes["cyborg_msgs/srv/GetBlackboard_Response"](
+            json=json.dumps(jsonable(scopes), sort_keys=True))
+
+    def destroy(self) -> None:
+        self._stop_watching()
+
+
+def jsonable(value: Any) -> Any:
+    """``value`` made into strict JSON: keys as strings, inf/nan as strings, other objects as
+    their repr, so any blackboard can be shown."""
+    if isinstance(value, dict):
+        return {str(key): jsonable(item) for key, item in value.items()}
+    if isinstance(value, list | tuple | set | frozenset):
+        return [jsonable(item) for item in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if value is None or isinstance(value, str | int | float):
+        return value
+    return repr(value)
