@@ -94,7 +94,8 @@ def parse_launch(data: Any, path: Path) -> LaunchDescription:
     entries = data.get("node", [])
     if not isinstance(entries, list) or not entries:
         raise LaunchError(f"{path}: no [[node]] entries: nothing to launch")
-    nodes, seen = [], set()
+    nodes: list[NodeSpec] = []
+    seen: set[str] = set()
     for index, entry in enumerate(entries, 1):
         where = f"{path}: node {index}"
         if not isinstance(entry, dict):
@@ -113,11 +114,10 @@ def parse_launch(data: Any, path: Path) -> LaunchDescription:
                         namespace=str(entry.get("namespace", "/")), parameters=parameters,
                         process=str(entry.get("process", "main")), base=path.parent,
                         where=f"{where} ({entry['name']})")
-        key = (spec.namespace.rstrip("/"), spec.name)
-        if key in seen:
-            raise LaunchError(f"{spec.where}: another node is already called "
-                              f"{spec.namespace.rstrip('/')}/{spec.name}")
-        seen.add(key)
+        full_name = f"{spec.namespace.rstrip('/')}/{spec.name}"
+        if full_name in seen:
+            raise LaunchError(f"{spec.where}: another node is already called {full_name}")
+        seen.add(full_name)
         starter_for(spec)  # unknown kinds fail now, before anything starts
         nodes.append(spec)
     return LaunchDescription(nodes, list(connect), str(bus.get("listen", DEFAULT_LISTEN)),
