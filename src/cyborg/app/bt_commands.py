@@ -59,6 +59,9 @@ def add_parser(commands: Any) -> None:
                        help="also import this module of node classes (repeatable)")
     nodes.set_defaults(handler=nodes_command)
 
+    from cyborg.app import runner_commands
+    runner_commands.add_parsers(sub)
+
 
 def _file_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, help="behavior3editor export (project, tree, "

@@ -1,0 +1,99 @@
+"""``cyborg bt serve|reload|enable|disable``: a tree runner on the bus, and its controls.
+
+    cyborg bt serve patrol.b3.json --use-sim-time      # tick it; topics under /cyborg/bt
+    cyborg bt reload                                   # load the same file again
+    cyborg bt reload other.b3.json                     # or another one
+    cyborg bt disable                                  # halt: the robot stops
+    cyborg bt enable                                   # start afresh
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from cyborg.app.bt_commands import CommandError
+from cyborg.app.bus_commands import open_context
+from cyborg.app.launch import LaunchDescription
+from cyborg.app.launchables import NodeSpec
+from cyborg.app.sim_commands import DEFAULT_ROUTER
+from cyborg.bus import Node, ServiceError, new_message
+
+RUNNER_NAMESPACE = "/cyborg/bt"
+
+
+def add_parsers(sub: Any) -> None:
+    serve = sub.add_parser("serve", help="run a tree on the bus, with its topics and services",
+                           description="Tick a tree as the robot's tree runner: latched "
+                                       "structure, active ids, enabled flag, per-tick status, "
+                                       "enable/reload/control services.")
+    serve.add_argument("file", type=Path, help="behavior3editor export")
+    serve.add_argument("--tree", metavar="ID|TITLE", default="",
+                       help="the tree to run (default: the file's selectedTree)")
+    serve.add_argument("--rate", type=float, default=10.0, metavar="HZ", help="ticks per second")
+    serve.add_argument("--namespace", default=RUNNER_NAMESPACE,
+                       help=f"the runner's namespace (default {RUNNER_NAMESPACE})")
+    serve.add_argument("--robot-namespace", default="/cyborg",
+                       help="the robot's namespace (default /cyborg)")
+    serve.add_argument("--use-sim-time", action="store_true",
+                       help="tick on simulated time from /clock")
+    serve.add_argument("--disabled", action="store_true", help="start disabled")
+    serve.add_argument("--nodes", action="append", default=[], metavar="MODULE",
+                       help="import this module of node classes first (repeatable)")
+    serve.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                       help="join the router there instead of being one")
+    serve.add_argument("--listen", default=None, metavar="ENDPOINT",
+                       help=f"be the bus's router there (default {DEFAULT_ROUTER})")
+    serve.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                       help="stop after this many wall-clock seconds")
+    serve.set_defaults(handler=serve_command)
+
+    for name, text in (("reload", "load the running tree's file again (or another file)"),
+                       ("enable", "run the tree (from its root)"),
+                       ("disable", "halt the tree: running actions stop")):
+        parser = sub.add_parser(name, help=text)
+        if name == "reload":
+            parser.add_argument("file", nargs="?", type=Path, default=None,
+                                help="another file to run (default: the same file)")
+        parser.add_argument("--namespace", default=RUNNER_NAMESPACE,
+                            help=f"the runner's namespace (default {RUNNER_NAMESPACE})")
+        parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                            help="router to join (default $CYBORG_CONNECT or "
+                                 "tcp/127.0.0.1:7447)")
+        parser.add_argument("--wait", type=float, default=0.5, help=argparse.SUPPRESS)
+        parser.set_defaults(handler=control_command, action=name)
+
+
+def serve_command(args: argparse.Namespace) -> int:
+    from cyborg.app.up import run
+    parameters: dict[str, Any] = {
+        "tree_file": str(args.file.resolve()), "tree": args.tree, "rate": args.rate,
+        "use_sim_time": args.use_sim_time, "robot_namespace": args.robot_namespace,
+        "enabled": not args.disabled}
+    if args.nodes:
+        parameters["nodes"] = list(args.nodes)
+    description = LaunchDescription(
+        [NodeSpec("tree_runner", "tree_runner", args.namespace, parameters, where=str(args.file))],
+        list(args.connect), args.listen or DEFAULT_ROUTER)
+    return run(description, args, title="cyborg bt serve")
+
+
+def control_command(args: argparse.Namespace) -> int:
+    namespace = "/" + args.namespace.strip("/")
+    if args.action == "reload":
+        service, kind = f"{namespace}/reload", "cyborg_msgs/srv/ReloadTree"
+        fields: dict[str, Any] = {"path": str(args.file.resolve()) if args.file else ""}
+    else:
+        service, kind = f"{namespace}/enable", "std_srvs/srv/SetBool"
+        fields = {"data": args.action == "enable"}
+    with open_context(args) as context:
+        node = Node("cyborg_bt", context=context)
+        client = node.create_client(service, kind)
+        try:
+            reply = client.call(new_message(context.types, f"{kind}_Request", fields),
+                                timeout=10.0)
+        except ServiceError as exc:
+            raise CommandError(f"{exc} (is a tree runner serving {namespace}?)") from exc
+    print(reply.message)
+    return 0 if reply.success else 1

@@ -1,0 +1,105 @@
+"""Start the robot's system in-process for tests: simulator + tree runner on an isolated bus."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cyborg.app.launch import Launch, LaunchDescription
+from cyborg.app.launchables import NodeSpec, RunningSimulator, RunningTree
+from cyborg.bus import BusConfig, Context, Node, new_message
+from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.sim.simulator import Simulator
+
+
+@dataclass
+class System:
+    context: Context
+    launch: Launch
+    client: Node
+
+    @property
+    def sim(self) -> Simulator:
+        return self._simulator().loop.simulator
+
+    def _simulator(self) -> RunningSimulator:
+        return next(item for item in self.launch.running if isinstance(item, RunningSimulator))
+
+    @property
+    def runner(self) -> TreeRunnerNode:
+        return next(item for item in self.launch.running
+                    if isinstance(item, RunningTree)).runner
+
+    def call(self, name: str, service: str, **fields: Any) -> Any:
+        client = self.client.create_client(name, service)
+        return client.call(new_message(self.client.types, f"{service}_Request", fields),
+                           timeout=10)
+
+    def uid(self, label: str) -> str:
+        """The id of the one node with this label."""
+        found = [node.uid for node in self.runner.tree if node.label == label]
+        assert len(found) == 1, (label, found)
+        return found[0]
+
+
+def wait_until(predicate: Callable[[], object], timeout: float = 30.0,
+               what: str = "condition") -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(0.01)
+
+
+@contextmanager
+def running_system(map_path: Path, tree_path: Path, *, speed: float = 20.0,
+                   battery: float = 100.0, start: str = "", rate: float = 10.0,
+                   registry_modules: list[str] | None = None) -> Iterator[System]:
+    with Context(BusConfig.isolated()) as context:
+        sim: dict[str, Any] = {"map": str(map_path), "speed": speed, "battery": battery}
+        if start:
+            sim["start"] = start
+        tree: dict[str, Any] = {"tree_file": str(tree_path), "use_sim_time": True,
+                                "robot_namespace": "/cyborg", "rate": rate}
+        if registry_modules:
+            tree["nodes"] = registry_modules
+        launch = Launch(LaunchDescription([
+            NodeSpec("simulator", "arnl", "/cyborg", sim),
+            NodeSpec("tree_runner", "tree_runner", "/cyborg/bt", tree)]), context)
+        launch.start()
+        try:
+            yield System(context, launch, Node("tester", "/test", context=context))
+        finally:
+            launch.stop()
+
+
+def write_tree(folder: Path, root: dict[str, Any], name: str = "tree.b3.json") -> Path:
+    """A one-tree behavior3editor project from nested ``{"name", "props", "children"}``."""
+    nodes: dict[str, Any] = {}
+
+    def add(spec: dict[str, Any]) -> str:
+        uid = f"n{len(nodes) + 1}"
+        entry: dict[str, Any] = {"id": uid, "name": spec["name"],
+                                 "title": spec.get("title", spec["name"]), "description": "",
+                                 "properties": spec.get("props", {}), "display": {"x": 0, "y": 0}}
+        nodes[uid] = entry
+        children = [add(child) for child in spec.get("children", [])]
+        if spec.get("decorator"):
+            entry["child"] = children[0]
+        elif children or spec.get("composite"):
+            entry["children"] = children
+        return uid
+
+    root_id = add(root)
+    tree = {"version": "0.3.0", "scope": "tree", "id": "main", "title": "Test tree",
+            "description": "", "root": root_id, "properties": {}, "nodes": nodes}
+    project = {"version": "0.3.0", "scope": "project", "selectedTree": "main",
+               "trees": [tree], "custom_nodes": []}
+    path = folder / name
+    path.write_text(json.dumps(project, indent=2))
+    return path
