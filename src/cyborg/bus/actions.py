@@ -77,8 +77,12 @@ def _uuid(types: Any, raw: bytes) -> Any:
 class ServerGoal:
     """One goal on the server: the request, its status, feedback and cancel flag."""
 
-    def __init__(self, server: ActionServer, goal_id: bytes, request: Any) -> None:
+    def __init__(self, server: ActionServer, goal_id: bytes, request: Any,
+                 sequence: int = 0) -> None:
         self.server, self.id, self.request = server, goal_id, request
+        self.sequence = sequence
+        """Order of acceptance on this server, from 1: a goal with a higher number came later
+        (goal threads may start in any order)."""
         self.status = GoalStatus.ACCEPTED
         self.accepted_at = time.time()
         self._cancel = threading.Event()
@@ -121,6 +125,8 @@ class ActionServer:
         self._results: dict[bytes, tuple[GoalStatus, Any]] = {}
         self._waiting: dict[bytes, list[Responder]] = {}
         self._lock = threading.Lock()
+        self._accepted = 0
+        self._closed = False
         base = f"{name}/_action/"
         self._entities: list[Any] = [
             node.create_service(base + "send_goal", f"{action_type}_SendGoal", self._on_goal),
@@ -140,8 +146,9 @@ class ActionServer:
         response = self.types.message_class(f"{self.action_type}_SendGoal_Response")(
             accepted=bool(accepted), stamp=_stamp(self.types))
         if accepted:
-            goal = ServerGoal(self, goal_id, request.goal)
             with self._lock:
+                self._accepted += 1
+                goal = ServerGoal(self, goal_id, request.goal, self._accepted)
                 self._goals[goal_id] = goal
             self._publish_status()
             threading.Thread(target=self._run, args=(goal,), daemon=True,
@@ -220,6 +227,8 @@ class ActionServer:
                 for g in canceling])
 
     def _feedback(self, goal: ServerGoal, feedback: Any) -> None:
+        if self._closed:
+            return
         message = self.types.message_class(f"{self.action_type}_FeedbackMessage")(
             goal_id=_uuid(self.types, goal.id), feedback=feedback)
         self._feedback_pub.publish(message)
@@ -231,19 +240,27 @@ class ActionServer:
         self._publish_status()
 
     def _publish_status(self) -> None:
+        if self._closed:
+            return  # a goal thread finishing after the node was destroyed
         types = self.types
         status_class = types.message_class("action_msgs/msg/GoalStatus")
         info = types.message_class("action_msgs/msg/GoalInfo")
         with self._lock:
             goals = list(self._goals.values())
-        self._status_pub.publish(types.message_class("action_msgs/msg/GoalStatusArray")(
+        message = types.message_class("action_msgs/msg/GoalStatusArray")(
             status_list=[status_class(goal_info=info(goal_id=_uuid(types, g.id),
                                                      stamp=_stamp(types, g.accepted_at)),
-                                      status=int(g.status)) for g in goals]))
+                                      status=int(g.status)) for g in goals])
+        try:
+            self._status_pub.publish(message)
+        except RuntimeError:
+            if not self._closed:
+                raise
 
     def destroy(self) -> None:
         with self._lock:
             goals = list(self._goals.values())
+            self._closed = True
         for goal in goals:
             goal._cancel.set()
         for entity in (*self._entities, self._feedback_pub, self._status_pub):

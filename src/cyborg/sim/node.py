@@ -62,6 +62,10 @@ class SimulatorNode:
         self._path_shown: object = None
         self._goal_generation = 0
         self._stepped = threading.Condition()  # notified after every sensor step
+        self._newest_goal = 0
+        self._active_goal: ServerGoal | None = None
+        self._feedback_at = -math.inf
+        self._feedback_class = types.message_class("cyborg_msgs/action/MoveToGoal_Feedback")
         self.clock = node.create_publisher("/clock", "rosgraph_msgs/msg/Clock")
         self.pose = node.create_publisher("pose", "geometry_msgs/msg/Pose2D")
         self.odom = node.create_publisher("odom", "nav_msgs/msg/Odometry")
@@ -92,6 +96,7 @@ class SimulatorNode:
         return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
 
     def _publish(self, sim: Simulator) -> None:
+        self._feedback(sim)
         with self._stepped:
             self._stepped.notify_all()
         message = self.types.message_class
@@ -177,9 +182,24 @@ class SimulatorNode:
 
     # ------------------------------------------------------------------ move_to_goal
     def _move(self, goal: ServerGoal) -> Any:
+        """Run one move_to_goal goal: start it, then wait for its end.
+
+        Feedback is sent from the simulation's own thread (see :meth:`_feedback`), every
+        ``FEEDBACK_PERIOD`` simulated seconds, so that however fast the simulation runs and
+        however busy the machine is, a client sees progress in step with simulated time.
+        Goals take over in the order they were accepted: a goal whose thread starts after a
+        newer one's is preempted at once.
+        """
         request = goal.request
         result = self.types.message_class("cyborg_msgs/action/MoveToGoal_Result")
         with self.loop.lock:
+            if goal.cancel_requested:
+                goal.canceled()
+                return result(outcome=CANCELED, message="cancelled before it started")
+            if goal.sequence < self._newest_goal:
+                goal.abort()
+                return result(outcome=FAILED, message="preempted by a newer goal")
+            self._newest_goal = goal.sequence
             self._goal_generation += 1
             generation = self._goal_generation
             try:
@@ -190,35 +210,44 @@ class SimulatorNode:
             except KeyError as exc:
                 goal.abort()
                 return result(outcome=NO_PATH, message=str(exc).strip("'\""))
-        if not plan.found:
-            goal.abort()
-            return result(outcome=NO_PATH, message=f"{plan.code}: {plan.reason}")
-        feedback = self.types.message_class("cyborg_msgs/action/MoveToGoal_Feedback")
-        next_check = -math.inf
-        while True:
-            with self._stepped:  # feedback follows simulated time, whatever the speed
-                while self.sim.time < next_check and self.loop.running and \
-                        not goal.cancel_requested:
+            if not plan.found:
+                goal.abort()
+                return result(outcome=NO_PATH, message=f"{plan.code}: {plan.reason}")
+            self._active_goal, self._feedback_at = goal, -math.inf
+            self._feedback(self.sim)
+        try:
+            while True:
+                with self._stepped:
                     self._stepped.wait(0.05)
-            with self.loop.lock:
-                state, message = self.sim.navigator.state, self.sim.navigator.message
-                pose, remaining = self.sim.pose, self.sim.navigator.remaining
-                busy = self.sim.docking.state is not DockState.UNDOCKED
-                if generation != self._goal_generation:
+                with self.loop.lock:
+                    state, message = self.sim.navigator.state, self.sim.navigator.message
+                    busy = self.sim.docking.state is not DockState.UNDOCKED
+                    if generation != self._goal_generation:
+                        goal.abort()
+                        return result(outcome=FAILED, message="preempted by another goal")
+                    if goal.cancel_requested:
+                        self.sim.cancel()
+                        goal.canceled()
+                        return result(outcome=CANCELED, message="cancelled")
+                if not busy and state is PathState.REACHED_GOAL:
+                    return result(outcome=SUCCEEDED, message="reached the goal")
+                if not busy and state.finished and state is not PathState.NOT_INITIALIZED:
                     goal.abort()
-                    return result(outcome=FAILED, message="preempted by another goal")
-                if goal.cancel_requested:
-                    self.sim.cancel()
-                    goal.canceled()
-                    return result(outcome=CANCELED, message="cancelled")
-            if not busy and state is PathState.REACHED_GOAL:
-                return result(outcome=SUCCEEDED, message="reached the goal")
-            if not busy and state.finished and state is not PathState.NOT_INITIALIZED:
-                goal.abort()
-                return result(outcome=FAILED, message=f"{state.value}: {message}")
-            if self.loop.error is not None or not self.loop.running:
-                goal.abort()
-                return result(outcome=FAILED, message="the simulation stopped")
-            goal.publish_feedback(feedback(current_pose=pose.to_message(self.types),
-                                           distance_remaining=min(remaining, 1e9)))
-            next_check = self.sim.time + FEEDBACK_PERIOD
+                    return result(outcome=FAILED, message=f"{state.value}: {message}")
+                if self.loop.error is not None or not self.loop.running:
+                    goal.abort()
+                    return result(outcome=FAILED, message="the simulation stopped")
+        finally:
+            with self.loop.lock:
+                if self._active_goal is goal:
+                    self._active_goal = None
+
+    def _feedback(self, sim: Simulator) -> None:
+        """Send the active goal's feedback when it is due (simulation thread, lock held)."""
+        goal = self._active_goal
+        if goal is None or sim.time < self._feedback_at + FEEDBACK_PERIOD:
+            return
+        self._feedback_at = sim.time
+        goal.publish_feedback(self._feedback_class(
+            current_pose=sim.pose.to_message(self.types),
+            distance_remaining=min(sim.navigator.remaining, 1e9)))

@@ -21,13 +21,50 @@ from cyborg.sim.simulator import Simulator
 log = logging.getLogger("cyborg.sim")
 
 
+class SimulationLock:
+    """A re-entrant lock that the simulation thread hands over to anyone waiting for it.
+
+    Running flat out, the simulation thread would take its lock back right after releasing
+    it, and a thread that wants to start a goal could wait for seconds of simulated time.
+    Whoever enters this lock is counted; between steps the simulation lets them all go first.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.RLock()
+        self._count = threading.Lock()
+        self.waiting = 0
+
+    def __enter__(self) -> SimulationLock:
+        with self._count:
+            self.waiting += 1
+        self._lock.acquire()
+        with self._count:
+            self.waiting -= 1
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._lock.release()
+
+    def acquire_for_steps(self) -> None:
+        """Take the lock for the simulation thread (not counted as waiting)."""
+        self._lock.acquire()
+
+    def release_after_steps(self, patience: float = 0.005) -> None:
+        """Release, and let waiting threads in first (for at most ``patience`` seconds)."""
+        self._lock.release()
+        if self.waiting:
+            deadline = time.monotonic() + patience
+            while self.waiting and time.monotonic() < deadline:
+                time.sleep(0)
+
+
 class SimulationLoop:
     def __init__(self, simulator: Simulator, speed: float = 1.0) -> None:
         if speed < 0 or math.isnan(speed):
             raise ValueError(f"speed must be positive (or 0 for as fast as possible), not {speed}")
         self.simulator = simulator
         self.speed = math.inf if speed == 0 else speed
-        self.lock = threading.RLock()
+        self.lock = SimulationLock()
         self.on_sensor: list[Callable[[Simulator], None]] = []
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -53,11 +90,14 @@ class SimulationLoop:
         every = simulator.steps_per_sensor
         try:
             while not self._stop.is_set():
-                with self.lock:
+                self.lock.acquire_for_steps()
+                try:
                     for _ in range(every):
                         simulator.step()
                     for callback in list(self.on_sensor):
                         callback(simulator)
+                finally:
+                    self.lock.release_after_steps()
                 if math.isfinite(self.speed):
                     ahead = (simulator.time - started_sim) / self.speed - (
                         time.monotonic() - started_wall)

@@ -1,0 +1,179 @@
+"""Launch files, `cyborg launch` across processes, `cyborg up`, and the runner's CLI controls."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cyborg.app.cli import main
+from cyborg.app.launch import Launch, read_launch
+from cyborg.app.launchables import LaunchError, RunningSimulator, RunningTree
+from cyborg.bus import BusConfig, Context
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def _launch_file(folder: Path, shared: Path, *, port: int = 7447, process: str = "main",
+                 extra: str = "") -> Path:
+    path = folder / "robot.toml"
+    path.write_text(f'''
+[bus]
+listen = "tcp/127.0.0.1:{port}"
+
+[[node]]
+kind = "simulator"
+name = "arnl"
+namespace = "/cyborg"
+process = "{process}"
+parameters = {{ map = "{shared / 'maps' / 'AMROffice.map'}", speed = 10, start = "Dock" }}
+
+[[node]]
+kind = "tree_runner"
+name = "tree_runner"
+namespace = "/cyborg/bt"
+parameters = {{ tree_file = "{shared / 'trees' / 'patrol_recharge.b3.json'}", use_sim_time = true }}
+{extra}''')
+    return path
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ("[[node]\nkind = 1", "robot.toml: not valid TOML: "),
+    ("[extras]\na = 1", "unknown section(s) extras"),
+    ("", "no [[node]] entries: nothing to launch"),
+    ('[[node]]\nname = "x"', "robot.toml: node 1: field `kind` is missing"),
+    ('[[node]]\nkind = "simulator"\nname = "x"\ncolour = "red"', "unknown field(s) colour"),
+    ('[[node]]\nkind = "teleporter"\nname = "x"', "node 1 (x): unknown kind 'teleporter'"),
+    ('[[node]]\nkind = "nowhere.module:start"\nname = "x"', "cannot load kind"),
+    ('[[node]]\nkind = "simulator"\nname = "x"\nparameters = 3', "`parameters` must be a table"),
+    ('[[node]]\nkind = "simulator"\nname = "x"\n[[node]]\nkind = "simulator"\nname = "x"',
+     "node 2 (x): another node is already called /x"),
+])
+def test_bad_launch_files_name_the_file_node_and_field(tmp_path: Path, text: str,
+                                                       expected: str) -> None:
+    path = tmp_path / "robot.toml"
+    path.write_text(text)
+    with pytest.raises(LaunchError) as error:
+        read_launch(path)
+    assert expected in str(error.value)
+    assert str(path) in str(error.value) or "robot.toml" in str(error.value)
+
+
+def test_bad_yaml_names_the_line(tmp_path: Path) -> None:
+    path = tmp_path / "robot.yaml"
+    path.write_text("node:\n  - kind: simulator\n    name: [unclosed\n")
+    with pytest.raises(LaunchError, match=r"robot.yaml:\d+: not valid YAML"):
+        read_launch(path)
+
+
+def test_yaml_launch_is_the_same_as_toml(tmp_path: Path) -> None:
+    path = tmp_path / "robot.yaml"
+    path.write_text("node:\n  - kind: tree_runner\n    name: runner\n    namespace: /r1/bt\n"
+                    "    process: brain\n    parameters: {tree_file: t.json, rate: 5}\n")
+    description = read_launch(path)
+    (spec,) = description.nodes
+    assert (spec.kind, spec.name, spec.namespace, spec.process) == (
+        "tree_runner", "runner", "/r1/bt", "brain")
+    assert spec.path("t.json") == tmp_path / "t.json"
+    assert description.processes() == ["main", "brain"]
+
+
+def test_nodes_that_cannot_start_stop_what_started(tmp_path: Path, shared: Path) -> None:
+    broken_tree = tmp_path / "broken.b3.json"
+    broken_tree.write_text('{"trees": [}')
+    path = _launch_file(tmp_path, shared).read_text().replace(
+        str(shared / "trees" / "patrol_recharge.b3.json"), str(broken_tree))
+    (tmp_path / "robot.toml").write_text(path)
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(read_launch(tmp_path / "robot.toml"), context)
+        with pytest.raises(LaunchError, match="the tree file has errors") as error:
+            launch.start()
+        assert "broken.b3.json:1" in str(error.value)
+        assert launch.running == [], "the simulator that had started was stopped again"
+    missing = tmp_path / "missing.toml"
+    missing.write_text('[[node]]\nkind = "simulator"\nname = "arnl"\n'
+                       'parameters = { map = "nowhere.map" }\n')
+    with Context(BusConfig.isolated()) as context, \
+            pytest.raises(LaunchError, match=r"missing.toml: node 1 \(arnl\): .*nowhere.map"):
+        Launch(read_launch(missing), context).start()
+
+
+def test_launch_in_one_process(tmp_path: Path, shared: Path) -> None:
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(read_launch(_launch_file(tmp_path, shared)), context)
+        launch.start()
+        try:
+            kinds = [type(item) for item in launch.running]
+            assert kinds == [RunningSimulator, RunningTree]
+            lines = launch.describe()
+            assert "simulator    /cyborg/arnl: AMROffice.map at 10x real time" in lines[0]
+            assert "tree runner  /cyborg/bt/tree_runner: 'Root tree' (18 nodes)" in lines[1]
+            runner = launch.running[1].runner  # type: ignore[attr-defined]
+            deadline = time.monotonic() + 20
+            while runner.tree.ticks < 20:
+                assert time.monotonic() < deadline
+                time.sleep(0.05)
+        finally:
+            launch.stop()
+        assert launch.running == []
+
+
+@pytest.mark.heavy
+def test_launch_across_processes_and_control_from_the_shell(
+        tmp_path: Path, shared: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    port = _free_port()
+    path = _launch_file(tmp_path, shared, port=port, process="robot")
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    parent = subprocess.Popen([sys.executable, "-m", "cyborg", "launch", str(path)],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env)
+    endpoint = f"tcp/127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            assert time.monotonic() < deadline, "the launched nodes did not appear"
+            if main(["node", "list", "--connect", endpoint, "--wait", "0.5"]) == 0:
+                out = capsys.readouterr().out
+                if "/cyborg/arnl" in out and "/cyborg/bt/tree_runner" in out:
+                    break
+            time.sleep(0.5)
+        assert main(["bt", "disable", "--connect", endpoint]) == 0
+        assert "disabled" in capsys.readouterr().out
+        bad = tmp_path / "bad.b3.json"
+        bad.write_text('{"trees": [\n}')
+        assert main(["bt", "reload", str(bad), "--connect", endpoint]) == 1
+        assert f"{bad}:2" in capsys.readouterr().out
+        assert main(["bt", "reload", "--connect", endpoint]) == 0
+        assert "loaded 'Root tree' (18 nodes)" in capsys.readouterr().out
+        assert main(["bt", "enable", "--connect", endpoint]) == 0
+    finally:
+        parent.send_signal(signal.SIGINT)
+        output = parent.communicate(timeout=30)[0].decode()
+    assert parent.returncode == 130, output
+    assert "process      robot (pid" in output and "tree runner  /cyborg/bt/tree_runner" in output
+    assert "stopped" in output
+
+
+@pytest.mark.heavy
+def test_cyborg_up_runs_the_bundled_system() -> None:
+    port = _free_port()
+    result = subprocess.run(
+        [sys.executable, "-m", "cyborg", "up", "--speed", "20", "--duration", "8",
+         "--listen", f"tcp/127.0.0.1:{port}"],
+        capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONUNBUFFERED="1"))
+    assert result.returncode == 0, result.stdout + result.stderr
+    out = result.stdout
+    assert "simulator    /cyborg/arnl: campus.map at 20x real time" in out
+    assert "tree runner  /cyborg/bt/tree_runner: 'Campus mission' (22 nodes)" in out
+    assert "Campus mission > Priority > Patrol > Repeat -1x > MemSequence > MoveTo Lecture hall" \
+        in out
+    assert "MoveTo Library" in out, "the robot got to the lecture hall and went on"
