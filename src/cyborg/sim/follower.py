@@ -54,8 +54,12 @@ class PathFollower:
         self.settings = settings or FollowerSettings()
         self._at_goal = False
 
-    def update(self, pose: Pose2D, front_range: float) -> Command:
-        """The command for now; ``front_range``: nearest obstacle ahead of the scanner."""
+    def update(self, pose: Pose2D, front_range: float,
+               stop_range: float | None = None) -> Command:
+        """The command for now; ``front_range``: nearest obstacle ahead of the scanner in a
+        corridor a little wider than the robot (to slow down); ``stop_range``: the same in a
+        corridor exactly as wide as the robot (to stop; default ``front_range``). A door jamb
+        beside the path slows the robot but does not stop it."""
         s = self.settings
         along, _gap = self.path.project(pose.x, pose.y)
         remaining = self.path.length - along
@@ -72,11 +76,12 @@ class PathFollower:
             return Command(0.0, turn, remaining=remaining)
         speed = s.cruise_speed * math.cos(error)
         speed = min(speed, math.sqrt(2 * s.deceleration * max(to_goal - 0.05, 0.0)) + 0.05)
-        blocked = front_range <= s.stop_distance and front_range + 0.05 < to_goal
+        stop = front_range if stop_range is None else stop_range
+        blocked = stop <= s.stop_distance and stop + 0.05 < to_goal
         if blocked:
             speed = 0.0
         elif front_range < s.slow_distance:
-            share = (front_range - s.stop_distance) / (s.slow_distance - s.stop_distance)
+            share = max(0.0, front_range - s.stop_distance) / (s.slow_distance - s.stop_distance)
             speed = min(speed, s.slow_speed + share * (s.cruise_speed - s.slow_speed))
         return Command(max(speed, 0.0), turn, blocked=blocked, remaining=remaining)
 

@@ -90,7 +90,9 @@ class Navigator:
         """Speed and turn rate for now; ``hits``: the scan's returns as map points."""
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
-        command = self.follower.update(pose, front_range(ranges, angles))
+        half_width = self.planner.footprint.width / 2
+        command = self.follower.update(pose, front_range(ranges, angles),
+                                       front_range(ranges, angles, half_width=half_width))
         self.remaining = command.remaining
         if command.arrived:
             self.state, self.message, self.follower = PathState.REACHED_GOAL, "", None
