@@ -27,12 +27,13 @@ def _schema() -> dict[str, Any]:
     return schema
 
 
-def _demo_tree_path() -> Path:
-    return Path(str(files("cyborg.app").joinpath("data", "demo.b3.json")))
+def _bundled_tree_path() -> Path:
+    return Path(str(files("cyborg.app").joinpath("data", "campus_patrol.b3.json")))
 
 
 @pytest.mark.parametrize("path", [
-    _demo_tree_path(), SHARED_TREES / "stock_nodes.tree.json",
+    _bundled_tree_path(), SHARED_TREES / "stock_nodes.tree.json",
+    SHARED_TREES / "patrol_recharge.b3.json",
 ], ids=lambda p: p.name)
 def test_structure_matches_schema(path: Path) -> None:
     tree = load_tree(path, clock=ManualClock())
@@ -82,7 +83,7 @@ def _dot_binary() -> str:
 
 
 def test_dot_renders_with_graphviz(tmp_path: Path) -> None:
-    tree = load_tree(_demo_tree_path(), clock=ManualClock())
+    tree = load_tree(_bundled_tree_path(), clock=ManualClock())
     snapshot = tree.tick()
     text = structure_to_dot(tree.structure.to_json(),
                             statuses={uid: s.label for uid, s in snapshot.visited},
@@ -94,7 +95,9 @@ def test_dot_renders_with_graphviz(tmp_path: Path) -> None:
     text_in_svg = html.unescape(svg)
     for node in tree:
         assert f">{node.label}</text>" in text_in_svg
-    assert svg.count("<g id=\"clust") == 4, "one cluster per subtree instance"
+    references = sum(node.category.value == "tree" for node in tree) - 1  # not the root tree
+    assert references == 2
+    assert svg.count("<g id=\"clust") == references, "one cluster per subtree reference"
 
 
 def test_dot_quotes_awkward_labels() -> None:

@@ -18,6 +18,7 @@ from cyborg.app.bus_commands import open_context
 from cyborg.app.launch import LaunchDescription
 from cyborg.app.launchables import NodeSpec
 from cyborg.app.sim_commands import DEFAULT_ROUTER
+from cyborg.app.up import add_bus_options, run
 from cyborg.bus import Node, ServiceError, new_message
 
 RUNNER_NAMESPACE = "/cyborg/bt"
@@ -41,12 +42,7 @@ def add_parsers(sub: Any) -> None:
     serve.add_argument("--disabled", action="store_true", help="start disabled")
     serve.add_argument("--nodes", action="append", default=[], metavar="MODULE",
                        help="import this module of node classes first (repeatable)")
-    serve.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                       help="join the router there instead of being one")
-    serve.add_argument("--listen", default=None, metavar="ENDPOINT",
-                       help=f"be the bus's router there (default {DEFAULT_ROUTER})")
-    serve.add_argument("--duration", type=float, default=None, metavar="SECONDS",
-                       help="stop after this many wall-clock seconds")
+    add_bus_options(serve)
     serve.set_defaults(handler=serve_command)
 
     for name, text in (("reload", "load the running tree's file again (or another file)"),
@@ -66,7 +62,6 @@ def add_parsers(sub: Any) -> None:
 
 
 def serve_command(args: argparse.Namespace) -> int:
-    from cyborg.app.up import run
     parameters: dict[str, Any] = {
         "tree_file": str(args.file.resolve()), "tree": args.tree, "rate": args.rate,
         "use_sim_time": args.use_sim_time, "robot_namespace": args.robot_namespace,

@@ -45,7 +45,7 @@ def add_parser(commands: Any) -> None:
     up.add_argument("--battery", type=float, default=100.0, metavar="PERCENT",
                     help="battery charge at the start (default 100)")
     up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
-    _bus_options(up)
+    add_bus_options(up)
     up.set_defaults(handler=up_command)
 
     launch = commands.add_parser("launch", help="start the nodes a launch file lists",
@@ -53,11 +53,12 @@ def add_parser(commands: Any) -> None:
                                              "in one process or several.")
     launch.add_argument("file", type=Path, help="launch file (.toml, .yaml)")
     launch.add_argument("--process", default="main", help=argparse.SUPPRESS)
-    _bus_options(launch)
+    add_bus_options(launch)
     launch.set_defaults(handler=launch_command)
 
 
-def _bus_options(parser: argparse.ArgumentParser) -> None:
+def add_bus_options(parser: argparse.ArgumentParser) -> None:
+    """``--connect``, ``--listen`` and ``--duration``, for every command that starts nodes."""
     parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                         help="join the router there instead of being one")
     parser.add_argument("--listen", default=None, metavar="ENDPOINT",
