@@ -118,6 +118,16 @@ def test_launch_in_one_process(tmp_path: Path, shared: Path) -> None:
             lines = launch.describe()
             assert "simulator    /cyborg/arnl: AMROffice.map at 10x real time" in lines[0]
             assert "tree runner  /cyborg/bt/tree_runner: 'Root tree' (18 nodes)" in lines[1]
+            simulator = launch.running[0]
+            assert isinstance(simulator, RunningSimulator)
+            simulator.node.parameters.set({"speed": 0.0})  # `cyborg param set` does this
+            deadline = time.monotonic() + 5
+            while simulator.loop.speed != float("inf"):
+                assert time.monotonic() < deadline, "the speed parameter was not applied"
+                time.sleep(0.01)
+            with pytest.raises(ValueError, match="speed must be positive"):
+                simulator.node.parameters.set({"speed": -1.0})
+            simulator.node.parameters.set({"speed": 10.0})
             runner = launch.running[1].runner  # type: ignore[attr-defined]
             deadline = time.monotonic() + 20
             while runner.tree.ticks < 20:

@@ -112,10 +112,12 @@ def start_simulator(context: Context, spec: NodeSpec) -> RunningSimulator:
         def check(changes: dict[str, Any]) -> None:
             if "speed" in changes and float(changes["speed"]) < 0:
                 raise ValueError("speed must be positive, or 0 for as fast as possible")
+
+        def change(changes: dict[str, Any]) -> None:
+            if "speed" in changes:
+                loop.speed = float(changes["speed"])
         params.on_set(check)
-        params.on_change(lambda changes: setattr(
-            loop, "speed", math.inf if float(changes.get("speed", loop.speed)) == 0
-            else float(changes.get("speed", loop.speed))))
+        params.on_change(change)
         SimulatorNode(node, loop)
         loop.start()
     except BaseException:

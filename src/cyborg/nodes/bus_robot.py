@@ -47,28 +47,28 @@ class BusMove:
 
     @property
     def outcome(self) -> MoveOutcome | None:
-        if self._handle is None:
-            return MoveOutcome.FAILED
-        if not self._handle.done:
-            return None
-        try:
-            _status, result = self._handle.result(0)
-        except (ActionError, ServiceError) as exc:
-            self._error = str(exc)
-            return MoveOutcome.FAILED
-        try:
-            return MoveOutcome(int(result.outcome))
-        except ValueError:
-            return MoveOutcome.FAILED
+        return self._ended()[0]
 
     @property
     def message(self) -> str:
-        if self._handle is None or not self._handle.done:
-            return self._error
+        return self._ended()[1]
+
+    def _ended(self) -> tuple[MoveOutcome | None, str]:
+        """``(outcome, message)``: ``(None, "")`` while the goal runs; a goal that could not
+        be sent or whose result could not be fetched counts as FAILED."""
+        handle = self._handle
+        if handle is None:
+            return MoveOutcome.FAILED, self._error
+        if not handle.done:
+            return None, ""
         try:
-            return str(self._handle.result(0)[1].message)
+            _status, result = handle.result(0)
         except (ActionError, ServiceError) as exc:
-            return str(exc)
+            return MoveOutcome.FAILED, str(exc)
+        try:
+            return MoveOutcome(int(result.outcome)), str(result.message)
+        except ValueError:
+            return MoveOutcome.FAILED, str(result.message)
 
     @property
     def remaining(self) -> float:

@@ -98,14 +98,24 @@ class PathFollower:
         return Command(0.0, turn, remaining=0.0)
 
 
-def front_range(ranges: np.ndarray, angles: np.ndarray, half_width: float = 0.3,
-                range_max: float = 30.0) -> float:
-    """Distance ahead to the nearest return within a corridor as wide as the robot."""
+SLOW_CORRIDOR = 0.3
+"""Half width (m) of the corridor ahead in which obstacles slow the robot: a little wider than
+the LX; it stops only for obstacles within its own half width."""
+
+
+def front_ranges(ranges: np.ndarray, angles: np.ndarray, half_widths: tuple[float, ...],
+                 range_max: float = 30.0) -> tuple[float, ...]:
+    """Distance ahead to the nearest return within corridors of the given half widths (one
+    projection of the scan serves all of them); inf where a corridor is clear."""
     valid = ranges <= range_max
     ahead = valid & (np.abs(angles) < math.pi / 2)
     if not ahead.any():
-        return math.inf
+        return tuple(math.inf for _ in half_widths)
     x = ranges[ahead] * np.cos(angles[ahead])
-    y = ranges[ahead] * np.sin(angles[ahead])
-    inside = np.abs(y) <= half_width
-    return float(x[inside].min()) if inside.any() else math.inf
+    side = np.abs(ranges[ahead] * np.sin(angles[ahead]))
+    found = []
+    for half_width in half_widths:
+        inside = side <= half_width
+        found.append(float(x[inside].min()) if inside.any() else math.inf)
+    return tuple(found)
+

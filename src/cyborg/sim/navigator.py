@@ -18,7 +18,7 @@ from numba import njit
 
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner, PlanResult
-from cyborg.sim.follower import FollowerSettings, PathFollower, front_range
+from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
 
 
 class PathState(StrEnum):
@@ -90,9 +90,9 @@ class Navigator:
         """Speed and turn rate for now; ``hits``: the scan's returns as map points."""
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
-        half_width = self.planner.footprint.width / 2
-        command = self.follower.update(pose, front_range(ranges, angles),
-                                       front_range(ranges, angles, half_width=half_width))
+        slow, stop = front_ranges(ranges, angles,
+                                  (SLOW_CORRIDOR, self.planner.footprint.width / 2))
+        command = self.follower.update(pose, slow, stop)
         self.remaining = command.remaining
         if command.arrived:
             self.state, self.message, self.follower = PathState.REACHED_GOAL, "", None

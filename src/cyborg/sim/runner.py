@@ -60,15 +60,25 @@ class SimulationLock:
 
 class SimulationLoop:
     def __init__(self, simulator: Simulator, speed: float = 1.0) -> None:
-        if speed < 0 or math.isnan(speed):
-            raise ValueError(f"speed must be positive (or 0 for as fast as possible), not {speed}")
         self.simulator = simulator
-        self.speed = math.inf if speed == 0 else speed
+        self.speed = speed
         self.lock = SimulationLock()
         self.on_sensor: list[Callable[[Simulator], None]] = []
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
+
+    @property
+    def speed(self) -> float:
+        """Simulated seconds per wall-clock second; ``inf`` when running flat out."""
+        return self._speed
+
+    @speed.setter
+    def speed(self, speed: float) -> None:
+        """Set the pace; 0 (or infinity) means as fast as possible. Takes effect at once."""
+        if speed < 0 or math.isnan(speed):
+            raise ValueError(f"speed must be positive (or 0 for as fast as possible), not {speed}")
+        self._speed = math.inf if speed == 0 else speed
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name="cyborg-sim", daemon=True)
