@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import StrEnum
 from typing import TYPE_CHECKING
 
@@ -235,7 +235,7 @@ class TreeHooks:
         dropped = []
         for hook in self.hooks():
             try:
-                other.set(replace(hook))
+                other.set(hook)  # hooks are frozen: the same one can serve both trees
             except HookError:
                 dropped.append(hook.node)
         return dropped
