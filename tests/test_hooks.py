@@ -149,3 +149,31 @@ def test_replace_tree_halts_the_old_one_and_carries_hooks_over() -> None:
     assert events(old)[-1] == ("halt", "old")
     assert runner.tree is new and new.hooks.get("root") is not None
     assert runner.step().status is FAILURE
+
+
+def test_timing_measures_every_visit_and_leaves_breakpoint_waits_out() -> None:
+    tree = tree_from(N("Sequence", N("Scripted", script="S", tag="a", id="a"),
+                       N("Scripted", script="S", tag="b", id="b"), id="top"))
+    assert not tree.tick().timed, "untimed by default: nodes run unwrapped"
+    assert "execute" not in vars(tree.by_uid["a"])
+    tree.hooks.timing = True
+    snapshot = tree.tick()
+    durations = dict(zip((uid for uid, _ in snapshot.visited), snapshot.visit_durations,
+                         strict=True))
+    assert {"a", "b", "top"} <= set(durations)
+    assert all(value >= 0 for value in durations.values())
+    assert durations["top"] >= durations["a"] + durations["b"], "a parent includes its subtree"
+    tree.hooks.breakpoint("b", once=True)
+    ticking = threading.Thread(target=tree.tick)
+    ticking.start()
+    _wait_for(lambda: tree.hooks.paused_at == "b")
+    time.sleep(0.2)
+    tree.hooks.resume()
+    ticking.join(5)
+    assert tree.last is not None
+    top = dict(zip((uid for uid, _ in tree.last.visited), tree.last.visit_durations,
+                   strict=True))["top"]
+    assert top < 0.1, f"the 0.2 s wait at the breakpoint is not the tree's time ({top:.3f} s)"
+    tree.hooks.timing = False
+    assert not tree.tick().timed
+    assert "execute" not in vars(tree.by_uid["a"]), "untimed nodes are unwrapped again"

@@ -126,6 +126,7 @@ def test_cdr_round_trip_and_numpy_views(types: MessageTypes) -> None:
     message = status_cls(stamp=time_cls(sec=12, nanosec=5), tick=42, duration=0.001, status=3,
                          visited_ids=["a", "b/c"],
                          visited_statuses=np.array([1, 3], dtype=np.uint8),
+                         visited_durations=np.array([1e-5, 2e-6], dtype=np.float32),
                          active_ids=["b/c"], halted_ids=[])
     raw = bytes(types.serialize(message, "cyborg_msgs/msg/BehaviorTreeStatus"))
     back = types.deserialize(raw, "cyborg_msgs/msg/BehaviorTreeStatus")

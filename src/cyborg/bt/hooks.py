@@ -23,6 +23,10 @@ Every hook has an ``owner`` (a name chosen by whoever set it, e.g. the monitor's
 :meth:`TreeHooks.clear_owner` removes all of an owner's hooks when it goes away. Hooks are keyed
 by node id, so they survive a reload of the same tree. A hooked node gets a wrapped
 ``execute``; nodes without hooks run exactly as before, at no extra cost.
+
+**Timing.** With ``hooks.timing = True`` every node gets the wrapped ``execute`` and each visit's
+wall time (the node and its subtree, breakpoint waits left out) goes into the tick's snapshot
+(:attr:`~cyborg.bt.snapshot.TickSnapshot.visit_durations`); monitors show it per node.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ import threading
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import StrEnum
+from time import perf_counter
 from typing import TYPE_CHECKING
 
 from cyborg.bt.status import FAILURE, RUNNING, SUCCESS, Status
@@ -80,7 +85,19 @@ class NodeHook:
         self.owner, self.node, self.hook = owner, node, hook
 
     def execute(self) -> Status:
-        """Stands in for ``node.execute`` while the node is hooked."""
+        """Stands in for ``node.execute`` while the node is hooked (or the tree is timed)."""
+        owner = self.owner
+        if not owner.timing:
+            return self.apply()
+        started, waited = perf_counter(), owner.waited
+        status = self.apply()
+        elapsed = perf_counter() - started - (owner.waited - waited)
+        record = self.node._record
+        record.durations[len(record.visits) - 1] = elapsed
+        return status
+
+    def apply(self) -> Status:
+        """Tick the node with its hook applied."""
         node = self.node
         replaced = self.before(node)
         if replaced is not None:
@@ -118,6 +135,9 @@ class TreeHooks:
         self._lock = threading.Condition()
         self._released = 0  # bumped to let waiting ticks go on
         self.stepping = False
+        self._timing = False
+        self.waited = 0.0
+        """Seconds ticks have spent waiting at breakpoints (kept out of the timings)."""
         self.paused_at: str | None = None
         """Id of the node a tick is waiting before, or None."""
         self.listeners: list[Callable[[], None]] = []
@@ -180,9 +200,23 @@ class TreeHooks:
     def get(self, uid: str) -> Hook | None:
         return self._hooks.get(uid)
 
+    # ------------------------------------------------------------------ timing
+    @property
+    def timing(self) -> bool:
+        """Whether every visit is timed (see the module docstring)."""
+        return self._timing
+
+    @timing.setter
+    def timing(self, on: bool) -> None:
+        with self._lock:
+            self._timing = bool(on)
+            for uid, node in self._nodes.items():
+                self._attach(node, self._hooks.get(uid))
+
     # ------------------------------------------------------------------ pausing
     def wait_at(self, node: Node, hook: Hook | None) -> None:
         """Called in the ticking thread: wait before ``node`` until released."""
+        started = perf_counter()
         with self._lock:
             if self.stepping:
                 self.stepping = False
@@ -194,6 +228,7 @@ class TreeHooks:
             while self._released == ticket:
                 self._lock.wait()
             self.paused_at = None
+            self.waited += perf_counter() - started
         if hook is not None and hook.once and hook.mode is HookMode.BREAKPOINT:
             self.clear(hook.node)
         self._changed()
@@ -242,7 +277,7 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ internals
     def _attach(self, node: Node, hook: Hook | None) -> None:
-        if hook is None and not self.stepping:
+        if hook is None and not self.stepping and not self._timing:
             node.hook = None
             node.__dict__.pop("execute", None)
         else:
@@ -252,7 +287,7 @@ class TreeHooks:
     def _detach_steps(self) -> None:
         for node in self._nodes.values():
             attached = node.hook
-            if attached is not None and attached.hook is None:
+            if attached is not None and attached.hook is None and not self._timing:
                 node.hook = None
                 node.__dict__.pop("execute", None)
 

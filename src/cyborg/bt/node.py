@@ -56,7 +56,7 @@ class TickRecord:
     handed to a snapshot without copying.
     """
 
-    __slots__ = ("halted", "now", "running", "visits")
+    __slots__ = ("durations", "halted", "now", "running", "visits")
 
     def __init__(self) -> None:
         self.now = 0.0
@@ -67,6 +67,8 @@ class TickRecord:
         """Nodes that returned RUNNING in this tick, deepest first."""
         self.halted: list[Node] = []
         """Nodes halted in this tick, deepest first."""
+        self.durations: dict[int, float] = {}
+        """Wall time of each visit (index into ``visits``), when the tree's hooks time nodes."""
 
 
 class Node:

@@ -26,12 +26,12 @@ SCHEMA = "cyborg.bt.structure/1"
 class TickSnapshot:
     """The result of one tick: root status, nodes visited with their status, active path."""
 
-    __slots__ = ("_active", "_halted", "_halted_ids", "_running", "_statuses", "_visited",
-                 "_visits", "duration", "status", "tick", "time")
+    __slots__ = ("_active", "_durations", "_halted", "_halted_ids", "_running", "_statuses",
+                 "_visited", "_visits", "duration", "status", "tick", "time")
 
     def __init__(self, tick: int, time: float, duration: float, status: Status,
                  visits: list[tuple[Node, Status]], running: list[Node],
-                 halted: list[Node]) -> None:
+                 halted: list[Node], durations: dict[int, float] | None = None) -> None:
         self.tick = tick
         """Tick number, from 1."""
         self.time = time
@@ -43,6 +43,7 @@ class TickSnapshot:
         self._visits = visits
         self._running = running
         self._halted = halted
+        self._durations = durations or {}
         self._visited: list[tuple[str, Status]] | None = None
         self._statuses: dict[str, Status] | None = None
         self._active: list[str] | None = None
@@ -59,6 +60,19 @@ class TickSnapshot:
         if self._visited is None:
             self._visited = [(node.uid, status) for node, status in self._visits]
         return self._visited
+
+    @property
+    def timed(self) -> bool:
+        """Whether this tick's visits were timed (``tree.hooks.timing``)."""
+        return bool(self._durations)
+
+    @property
+    def visit_durations(self) -> list[float]:
+        """Wall time of each visit in :attr:`visited` (the node and its subtree, breakpoint
+        waits excluded), in seconds; NaN for a visit that was not timed."""
+        durations = self._durations
+        nan = float("nan")
+        return [durations.get(index, nan) for index in range(len(self._visits))]
 
     @property
     def statuses(self) -> dict[str, Status]:

@@ -67,7 +67,9 @@ class Tree:
         visits: list[tuple[Node, Status]] = []
         running: list[Node] = []
         halted: list[Node] = []
+        durations: dict[int, float] = {}
         record.visits, record.running, record.halted = visits, running, halted
+        record.durations = durations
         started = perf_counter()
         status = self.root.execute()
         previous = self._running
@@ -86,7 +88,7 @@ class Tree:
         self._running = running
         self.ticks = ticks = self.ticks + 1
         self.last = snapshot = TickSnapshot(ticks, now, perf_counter() - started, status,
-                                            visits, running, halted)
+                                            visits, running, halted, durations)
         return snapshot
 
     def halt(self) -> list[Node]:

@@ -12,7 +12,9 @@ name                        type                                what
                                                                 published when it changes
 ``enabled``                 std_msgs/Bool                       latched: whether the tree ticks
 ``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: nodes visited with
-                                                                their status, tick, duration
+                                                                their status and wall time
+                                                                (timed while someone listens),
+                                                                tick, duration
 ``enable``                  std_srvs/SetBool                    service: run or pause the tree
 ``reload``                  cyborg_msgs/ReloadTree              service: load the file again
 ==========================  ==================================  ==================================
@@ -186,8 +188,13 @@ class TreeRunnerNode:
         if active != self._active:
             self._active = active
             self._publish_active(active)
+        hooks = self.tree.hooks
         if self._status.subscription_count() == 0:
+            if hooks.timing:
+                hooks.timing = False  # nodes run unwrapped again
             return  # nobody listens: skip building the message
+        if not hooks.timing:
+            hooks.timing = True  # per-node timings from the next tick on
         seconds = snapshot.time
         stamp = self._classes["builtin_interfaces/msg/Time"](
             sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9) % 1_000_000_000)
@@ -196,6 +203,7 @@ class TreeRunnerNode:
             stamp=stamp, tick=snapshot.tick, duration=snapshot.duration,
             status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
             visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
+            visited_durations=np.array(snapshot.visit_durations, np.float32),
             active_ids=list(active), halted_ids=snapshot.halted))
 
     # ------------------------------------------------------------------ services
