@@ -1,7 +1,8 @@
 """Entry point of the ``cyborg`` command.
 
-    cyborg up                      the simulated robot, navigation and the patrol tree
+    cyborg up                      the simulated robot, navigation, the patrol tree, the monitor
     cyborg launch FILE             start the nodes a TOML/YAML launch file lists
+    cyborg monitor                 the web monitor of running trees (http://127.0.0.1:8080/)
     cyborg bt validate FILE        report every problem in a behavior3editor export
     cyborg bt run FILE             tick a tree with a live status line
     cyborg bt dot FILE             the tree as a Graphviz DOT graph
@@ -28,7 +29,7 @@ import sys
 from collections.abc import Sequence
 
 from cyborg import __version__
-from cyborg.app import bt_commands, bus_commands, sim_commands, up
+from cyborg.app import bt_commands, bus_commands, monitor_commands, sim_commands, up
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -39,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="more log output (-vv for debug)")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     up.add_parser(commands)
+    monitor_commands.add_parser(commands)
     bt_commands.add_parser(commands)
     bus_commands.add_parser(commands)
     sim_commands.add_parser(commands)

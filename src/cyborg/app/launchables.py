@@ -14,6 +14,9 @@ kind            parameters (default)
 ``tree_runner`` ``tree_file`` (required), ``tree`` (the file's selected tree), ``rate`` (10 Hz),
                 ``use_sim_time`` (false), ``robot_namespace`` (/cyborg), ``enabled`` (true),
                 ``nodes`` (modules of node classes to import, [])
+``monitor``     ``trees`` (tree runner namespaces, ["/cyborg/bt"]), ``port`` (8080; 0 = any
+                free port), ``host`` (0.0.0.0), ``token`` (control from other machines;
+                default ``$CYBORG_MONITOR_TOKEN``)
 ==============  ================================================================================
 
 A user's own kind is given as ``"package.module:function"`` with the same signature.
@@ -30,6 +33,7 @@ from typing import Any, Protocol
 
 from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
 from cyborg.bus import Context, Node, SimClock
+from cyborg.monitor import DEFAULT_PORT, Monitor, MonitorError
 from cyborg.nav.arnl_map import MapError, read_map
 from cyborg.nodes.bus_robot import BusRobot
 from cyborg.nodes.tree_runner import TreeRunnerNode
@@ -187,7 +191,49 @@ def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
     return RunningTree(runner, robot_node)
 
 
-KINDS: dict[str, Starter] = {"simulator": start_simulator, "tree_runner": start_tree_runner}
+# ---------------------------------------------------------------------------------- monitor
+class RunningMonitor:
+    def __init__(self, monitor: Monitor) -> None:
+        self.monitor = monitor
+
+    def describe(self) -> str:
+        urls = self.monitor.urls()
+        others = f" (from other machines: {', '.join(urls[1:])})" if urls[1:] else ""
+        return (f"monitor      {self.monitor.node.fq_name}: open {urls[0]}{others}; trees "
+                f"{', '.join(sorted(self.monitor.hub.sources))}")
+
+    def stop(self) -> None:
+        self.monitor.stop()
+
+
+def start_monitor(context: Context, spec: NodeSpec) -> RunningMonitor:
+    node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
+    try:
+        params = node.parameters
+        trees = params.declare("trees", ["/cyborg/bt"], "tree runner namespaces to follow",
+                               read_only=True)
+        port = params.declare("port", DEFAULT_PORT, "web server port (0: any free port)",
+                              read_only=True)
+        host = params.declare("host", "0.0.0.0", "address to listen on", read_only=True)
+        token = params.declare("token", "", "token for control from other machines",
+                               read_only=True)
+        namespaces = [str(tree) for tree in trees if str(tree).startswith("/")]
+        if len(namespaces) != len(trees) or not namespaces:
+            raise spec.error(f"trees: namespaces such as /cyborg/bt, not {list(trees)!r}")
+        monitor = Monitor(node, namespaces=namespaces, host=str(host), port=int(port),
+                          token=str(token) or None)
+        try:
+            monitor.start()
+        except MonitorError as exc:
+            raise spec.error(str(exc)) from exc
+    except BaseException:
+        node.destroy()
+        raise
+    return RunningMonitor(monitor)
+
+
+KINDS: dict[str, Starter] = {"simulator": start_simulator, "tree_runner": start_tree_runner,
+                             "monitor": start_monitor}
 
 
 def starter_for(spec: NodeSpec) -> Starter:

@@ -2,9 +2,10 @@
 
 ``cyborg up`` with no arguments runs the whole system on built-in defaults, in one process:
 the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn by the project in
-ARNL format) with its navigation services, and the tree runner with the bundled
+ARNL format) with its navigation services, the tree runner with the bundled
 patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
-time. ``--map``, ``--tree`` and ``--speed`` swap the inputs. It prints what runs and where, then
+time, and the web monitor (http://127.0.0.1:8080/, ``--monitor-port``). ``--map``, ``--tree``
+and ``--speed`` swap the inputs. It prints what runs and where, then
 a live line of what the tree does; Ctrl-C stops everything cleanly.
 
 ``cyborg launch FILE`` starts what a launch description lists (see :mod:`cyborg.app.launch`).
@@ -45,6 +46,9 @@ def add_parser(commands: Any) -> None:
     up.add_argument("--battery", type=float, default=100.0, metavar="PERCENT",
                     help="battery charge at the start (default 100)")
     up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
+    up.add_argument("--monitor-port", type=int, default=8080, metavar="PORT",
+                    help="port of the web monitor (default 8080; 0: any free port)")
+    up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
     add_bus_options(up)
     up.set_defaults(handler=up_command)
 
@@ -77,12 +81,18 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     sim = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
     if args.start:
         sim["start"] = args.start
-    return LaunchDescription([
+    nodes = [] if args.no_monitor else [
+        # first: a taken port stops the launch before the robot moves
+        NodeSpec("monitor", "monitor", namespace,
+                 {"trees": [f"{namespace}/bt"], "port": args.monitor_port},
+                 where="monitor (--monitor-port)")]
+    nodes += [
         NodeSpec("simulator", "arnl", namespace, sim, where="simulator"),
         NodeSpec("tree_runner", "tree_runner", f"{namespace}/bt",
                  {"tree_file": str(tree_path), "use_sim_time": True,
                   "robot_namespace": namespace}, where="tree runner"),
-    ], list(args.connect), args.listen or DEFAULT_ROUTER)
+    ]
+    return LaunchDescription(nodes, list(args.connect), args.listen or DEFAULT_ROUTER)
 
 
 def up_command(args: argparse.Namespace) -> int:

@@ -3,7 +3,10 @@
 Nodes are drawn top-down in child order, shaped by category (composites as boxes, decorators as
 hexagons, actions as rounded boxes, conditions as ellipses) and each subtree instance is a
 labelled cluster. Pass ``statuses`` (node id -> status name) to colour a tick's result, and
-``active`` to draw the running path in bold.
+``active`` to draw the running path as rqt_bt did: active nodes outlined in green, the edges
+between them dashed red. ``collapsed`` ids are drawn as one node standing for their whole
+subtree ("+N" nodes hidden), which is how a monitor exports what it shows; ``rankdir="LR"``
+lays a wide tree out left to right.
 """
 
 from __future__ import annotations
@@ -30,13 +33,18 @@ def quote(text: str) -> str:
 
 def structure_to_dot(structure: Mapping[str, Any], *,
                      statuses: Mapping[str, str] | None = None,
-                     active: Iterable[str] = ()) -> str:
+                     active: Iterable[str] = (), collapsed: Iterable[str] = (),
+                     rankdir: str = "TB", graph_attributes: str = "") -> str:
     """DOT text for a structure as returned by ``TreeStructure.to_json()``."""
     statuses = statuses or {}
     active_ids = set(active)
+    folded = set(collapsed)
+    if rankdir not in ("TB", "LR"):
+        raise ValueError(f"rankdir must be TB or LR, not {rankdir!r}")
+    extra = f", {graph_attributes}" if graph_attributes else ""
     lines = [
         f"digraph {quote(structure.get('title') or 'behaviour tree')} {{",
-        '  graph [rankdir=TB, ordering=out, fontname="Helvetica"];',
+        f'  graph [rankdir={rankdir}, ordering=out, fontname="Helvetica"{extra}];',
         '  node [fontname="Helvetica", fontsize=11];',
         '  edge [arrowsize=0.6];',
     ]
@@ -45,12 +53,16 @@ def structure_to_dot(structure: Mapping[str, Any], *,
     def emit(node: Mapping[str, Any], indent: str) -> None:
         uid = node["id"]
         label = node["label"] or node["name"]
+        children = node.get("children", [])
         attributes = _SHAPES.get(node["category"], "shape=box")
+        if uid in folded and children:
+            label += f"\n(+{_count(node) - 1})"
+            attributes = attributes.replace('style="', 'peripheries=2, style="')
+            children = []
         fill = _FILL.get(statuses.get(uid, ""), _IDLE)
-        bold = ", penwidth=3" if uid in active_ids else ""
+        bold = ', color="#188038", penwidth=3' if uid in active_ids else ""
         lines.append(f"{indent}{quote(uid)} [label={quote(label)}, {attributes}, "
                      f"fillcolor={quote(fill)}{bold}];")
-        children = node.get("children", [])
         for child in children:
             if child["category"] == "tree" and child.get("children"):
                 cluster[0] += 1
@@ -62,9 +74,14 @@ def structure_to_dot(structure: Mapping[str, Any], *,
             else:
                 emit(child, indent)
         for child in children:
-            edge_bold = " [penwidth=3]" if uid in active_ids and child["id"] in active_ids else ""
+            edge_bold = (' [color="#d93025", style=dashed, penwidth=2]'
+                         if uid in active_ids and child["id"] in active_ids else "")
             lines.append(f"{indent}{quote(uid)} -> {quote(child['id'])}{edge_bold};")
 
     emit(structure["root"], "  ")
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _count(node: Mapping[str, Any]) -> int:
+    return 1 + sum(_count(child) for child in node.get("children", []))

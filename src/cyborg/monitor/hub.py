@@ -1,0 +1,250 @@
+"""The monitor's switchboard: tree runners on one side, browsers on the other.
+
+Everything here runs on the web server's event loop. The bus side calls :meth:`Hub.notify` from
+its own threads; the hub picks it up with ``call_soon_threadsafe``, so neither the tree nor the
+bus ever waits for a browser.
+
+* **Ticks** are coalesced: at most one frame per :data:`FRAME_INTERVAL` per tree, each frame
+  holding only the nodes whose display changed (see :mod:`cyborg.monitor.tree_state`). A frame
+  is encoded once and queued to every browser watching that tree.
+* **Structures** go to a browser once per version; a restarted runner with the same tree only
+  resets the statuses.
+* **Commands** from browsers (run/pause, per-node control, step, resume) are checked against
+  the control seat (:mod:`cyborg.monitor.seat`) and run as blocking service calls in worker
+  threads; each gets a ``result`` reply.
+* Every :data:`SLOW_PERIOD` the hub sends per-node timings, polls blackboards of watched trees,
+  looks for new tree runners on the bus and frees the seat of a holder gone too long.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import time
+from collections.abc import Callable
+from typing import Any
+
+from cyborg.monitor.client import Client
+from cyborg.monitor.seat import ControlSeat
+from cyborg.monitor.source import ControlError, TreeSource
+
+log = logging.getLogger("cyborg.monitor")
+
+FRAME_INTERVAL = 1 / 60
+"""Shortest time between two frames of one tree (ticks in between are merged)."""
+SLOW_PERIOD = 0.5
+
+Commands = dict[str, Callable[[Client, dict[str, Any]], Any]]
+
+
+def encode(message: dict[str, Any]) -> str:
+    return json.dumps(message, separators=(",", ":"))
+
+
+class Hub:
+    """Connects :class:`TreeSource` objects to browser :class:`Client` objects."""
+
+    def __init__(self, make_source: Callable[[str], TreeSource],
+                 discover: Callable[[], list[str]], *, default_namespace: str,
+                 seat: ControlSeat) -> None:
+        self._make_source = make_source
+        self._discover = discover
+        self.default_namespace = default_namespace
+        self.sources: dict[str, TreeSource] = {}
+        self.seat = seat
+        self.clients: set[Client] = set()
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._scheduled: set[str] = set()
+        self._last_frame: dict[str, float] = {}
+        self._blackboards: dict[str, str] = {}
+        self._numbers = 0
+        self.frames = 0
+
+    # ------------------------------------------------------------------ sources
+    def source(self, namespace: str) -> TreeSource:
+        """The source following ``namespace``, created on first use."""
+        namespace = "/" + namespace.strip("/")
+        found = self.sources.get(namespace)
+        if found is None:
+            found = self.sources[namespace] = self._make_source(namespace)
+        return found
+
+    def robots(self) -> dict[str, Any]:
+        return {"t": "robots", "robots": [source.describe() for source in
+                                          sorted(self.sources.values(),
+                                                 key=lambda source: source.namespace)],
+                "seat": self.seat.holder.key if self.seat.holder else None}
+
+    # ------------------------------------------------------------------ from the bus
+    def notify(self, namespace: str, what: str) -> None:
+        """Called from any thread when ``what`` changed for the tree under ``namespace``."""
+        loop = self._loop
+        if loop is None or loop.is_closed():
+            return
+        if what == "tick":
+            if namespace in self._scheduled:
+                return
+            self._scheduled.add(namespace)
+        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
+            loop.call_soon_threadsafe(self._on_change, namespace, what)
+
+    def _on_change(self, namespace: str, what: str) -> None:
+        if what == "tick":
+            delay = self._last_frame.get(namespace, 0.0) + FRAME_INTERVAL - time.monotonic()
+            assert self._loop is not None
+            if delay > 0:
+                self._loop.call_later(delay, self._flush, namespace)
+            else:
+                self._flush(namespace)
+        elif what == "structure":
+            for client in self._watchers(namespace):
+                self.send_tree(client, namespace)
+            self.broadcast(self.robots())
+        else:
+            source = self.sources.get(namespace)
+            if source is not None:
+                runner = encode(self._runner_message(source))
+                for client in self._watchers(namespace):
+                    client.send(runner)
+            self.broadcast(self.robots())
+
+    def _flush(self, namespace: str) -> None:
+        self._scheduled.discard(namespace)
+        self._last_frame[namespace] = time.monotonic()
+        source = self.sources.get(namespace)
+        state = source.state if source is not None else None
+        watchers = self._watchers(namespace)
+        if state is None or not watchers:
+            return  # a page that starts watching gets a snapshot
+        frame = state.frame()
+        if frame is None:
+            return
+        frame["ns"] = namespace
+        text = encode(frame)
+        self.frames += 1
+        for client in watchers:
+            if state.version in client.versions:
+                client.send(text)
+
+    # ------------------------------------------------------------------ to browsers
+    def _watchers(self, namespace: str) -> list[Client]:
+        return [client for client in self.clients if client.watching == namespace]
+
+    def broadcast(self, message: dict[str, Any]) -> None:
+        text = encode(message)
+        for client in self.clients:
+            client.send(text)
+
+    def _runner_message(self, source: TreeSource) -> dict[str, Any]:
+        return {"t": "runner", "ns": source.namespace, "alive": source.alive,
+                "enabled": source.enabled, "hooks": source.hooks,
+                "paused_at": source.paused_at, "problem": source.problem}
+
+    def send_tree(self, client: Client, namespace: str) -> None:
+        """Structure (if this client lacks this version), snapshot, runner state, timings."""
+        source = self.source(namespace)
+        client.send(self._runner_message(source))
+        state = source.state
+        if state is None:
+            client.send({"t": "structure", "ns": namespace, "v": None, "tree": None})
+            return
+        if state.version not in client.versions:
+            client.versions.add(state.version)
+            client.send('{"t":"structure","ns":' + json.dumps(namespace) + ',"v":"'
+                        + state.version + '","tree":' + state.text + "}")
+        snapshot = state.snapshot()
+        snapshot["ns"] = namespace
+        snapshot["generation"] = source.generation
+        client.send(snapshot)
+        client.send({"t": "timing", "ns": namespace, "v": state.version,
+                     "nodes": state.timings(all_nodes=True)})
+        blackboard = self._blackboards.get(namespace)
+        if blackboard is not None:
+            client.send(blackboard)
+
+    def resync(self, client: Client) -> None:
+        """Send a client that fell behind everything again."""
+        client.versions.clear()
+        if client.watching is not None:
+            self.send_tree(client, client.watching)
+
+    # ------------------------------------------------------------------ clients
+    def attach(self, loop: asyncio.AbstractEventLoop) -> None:
+        self._loop = loop
+
+    def connect(self, client: Client) -> None:
+        self._numbers += 1
+        self.clients.add(client)
+
+    def next_number(self) -> int:
+        return self._numbers + 1
+
+    def disconnect(self, client: Client) -> None:
+        self.clients.discard(client)
+        self.seat.disconnected(client.key)
+
+    def seat_message(self, client: Client) -> dict[str, Any]:
+        return {"t": "seat", "may_control": client.may_control,
+                "control": self.seat.holds(client.key),
+                "holder": self.seat.holder.key if self.seat.holder else None}
+
+    def announce_seat(self) -> None:
+        for client in self.clients:
+            client.send(self.seat_message(client))
+
+    # ------------------------------------------------------------------ periodic work
+    async def run_periodic(self) -> None:
+        """Timings, blackboards, discovery and seat expiry, until cancelled."""
+        while True:
+            await asyncio.sleep(SLOW_PERIOD)
+            try:
+                await self._periodic()
+            except Exception:
+                log.exception("monitor periodic work failed")
+
+    async def _periodic(self) -> None:
+        known = set(self.sources)
+        for namespace in await asyncio.to_thread(self._discover):
+            if namespace not in known:
+                self.source(namespace)
+                self.broadcast(self.robots())
+        watched = {client.watching for client in self.clients if client.watching}
+        for namespace in watched:
+            source = self.sources.get(namespace)
+            state = source.state if source else None
+            if source is None or state is None:
+                continue
+            rows = state.timings()
+            if rows:
+                text = encode({"t": "timing", "ns": namespace, "v": state.version,
+                               "nodes": rows})
+                for client in self._watchers(namespace):
+                    client.send(text)
+            if source.alive:
+                await self._poll_blackboard(source)
+        expired = self.seat.expired()
+        if expired is None:
+            return
+        for namespace, node_id in sorted(expired):
+            source = self.sources.get(namespace)
+            if source is not None:
+                try:
+                    await asyncio.to_thread(source.control, node_id, "clear")
+                except ControlError as exc:
+                    log.warning("could not release hook on %s: %s", node_id, exc)
+        log.info("the control seat is free (its holder left); %d hook(s) released",
+                 len(expired))
+        self.announce_seat()
+
+    async def _poll_blackboard(self, source: TreeSource) -> None:
+        try:
+            data = await asyncio.to_thread(source.blackboard)
+        except ControlError:
+            return
+        text = encode({"t": "blackboard", "ns": source.namespace, "data": data})
+        if text != self._blackboards.get(source.namespace):
+            self._blackboards[source.namespace] = text
+            for client in self._watchers(source.namespace):
+                client.send(text)

@@ -1,0 +1,153 @@
+"""The ``monitor`` node: follows tree runners on the bus and serves the page that shows them.
+
+::
+
+    monitor = Monitor(Node("monitor", "/cyborg"), namespaces=["/cyborg/bt"], port=8080)
+    monitor.start()          # serves http://<host>:8080/ from a background thread
+    print(monitor.urls())
+    ...
+    monitor.stop()
+
+The bus node (``/cyborg/monitor`` by default) subscribes to each runner's topics and calls its
+services (:mod:`cyborg.monitor.source`); tree runners that appear on the bus later are found by
+their ``behavior_tree`` topic and offered on the page too. The web side
+(:mod:`cyborg.monitor.server`) runs on uvicorn in its own thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import threading
+import time
+from typing import Any
+
+import uvicorn
+
+from cyborg.bus import Node
+from cyborg.bus.wire import EntityKind
+from cyborg.monitor.hub import Hub
+from cyborg.monitor.seat import ControlSeat
+from cyborg.monitor.server import create_app
+from cyborg.monitor.source import TreeSource
+
+log = logging.getLogger("cyborg.monitor")
+
+DEFAULT_PORT = 8080
+TOKEN_VARIABLE = "CYBORG_MONITOR_TOKEN"
+STRUCTURE_TYPE = "cyborg_msgs/msg/BehaviorTree"
+
+
+class MonitorError(RuntimeError):
+    """The monitor cannot start (say, its port is taken); the message says what to do."""
+
+
+class Monitor:
+    """See the module docstring."""
+
+    def __init__(self, node: Node, *, namespaces: list[str] | None = None,
+                 host: str = "0.0.0.0", port: int = DEFAULT_PORT,
+                 token: str | None = None) -> None:
+        """Follow the tree runners under ``namespaces`` (and any found later) through
+        ``node``, and serve on ``host:port`` (port 0: any free port) once started. Control
+        from other machines needs ``token`` (default: ``$CYBORG_MONITOR_TOKEN``)."""
+        self.node = node
+        self.host, self.requested_port = host, port
+        token = token if token is not None else os.environ.get(TOKEN_VARIABLE) or None
+        namespaces = namespaces or ["/cyborg/bt"]
+        self.hub = Hub(self._make_source, self.discover, default_namespace=namespaces[0],
+                       seat=ControlSeat(token))
+        for namespace in namespaces:
+            self.hub.source(namespace)
+        self.app = create_app(self.hub)
+        self._server: uvicorn.Server | None = None
+        self._thread: threading.Thread | None = None
+        self.port = 0
+
+    def _make_source(self, namespace: str) -> TreeSource:
+        return TreeSource(self.node, namespace, self.hub.notify)
+
+    def discover(self) -> list[str]:
+        """Namespaces of the tree runners on the bus (found by their structure topic)."""
+        found = set()
+        for entity in self.node.context.graph.entities([EntityKind.PUBLISHER]):
+            if entity.topic.endswith("/behavior_tree") and entity.type_name == STRUCTURE_TYPE:
+                found.add(entity.topic.removesuffix("/behavior_tree") or "/")
+        return sorted(found)
+
+    # ------------------------------------------------------------------ serving
+    def start(self, timeout: float = 10.0) -> None:
+        """Bind the port (:class:`MonitorError` if taken) and serve in a background thread."""
+        listener = _bind(self.host, self.requested_port)
+        self.port = listener.getsockname()[1]
+        config = uvicorn.Config(self.app, log_level="warning", lifespan="on",
+                                ws_per_message_deflate=False, ws_max_size=1 << 20)
+        server = self._server = uvicorn.Server(config)
+        self._thread = threading.Thread(target=server.run, kwargs={"sockets": [listener]},
+                                        name="cyborg-monitor-web", daemon=True)
+        self._thread.start()
+        deadline = time.monotonic() + timeout
+        while not server.started:
+            if not self._thread.is_alive() or time.monotonic() > deadline:
+                raise MonitorError(f"the monitor's web server did not start within "
+                                   f"{timeout:g} s")
+            time.sleep(0.01)
+        log.info("monitor serving on %s", ", ".join(self.urls()))
+
+    def urls(self) -> list[str]:
+        """Addresses to open in a browser (this machine first)."""
+        urls = [f"http://127.0.0.1:{self.port}/"]
+        if self.host not in ("127.0.0.1", "localhost", "::1"):
+            address = _lan_address()
+            if self.host not in ("0.0.0.0", "::"):
+                address = self.host
+            if address:
+                urls.append(f"http://{address}:{self.port}/")
+        return urls
+
+    def stop(self) -> None:
+        """Stop serving and leave the bus (hooks set from the page are released with it)."""
+        if self._server is not None:
+            self._server.should_exit = True
+        if self._thread is not None:
+            self._thread.join(10.0)
+            self._thread = None
+        for source in list(self.hub.sources.values()):
+            source.destroy()
+        self.node.destroy()
+
+    def __enter__(self) -> Monitor:
+        self.start()
+        return self
+
+    def __exit__(self, *_exc: Any) -> None:
+        self.stop()
+
+
+def _bind(host: str, port: int) -> socket.socket:
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    listener = socket.socket(family, socket.SOCK_STREAM)
+    listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        listener.bind((host, port))
+    except OSError as exc:
+        listener.close()
+        raise MonitorError(f"the monitor cannot listen on {host}:{port} ({exc.strerror}); "
+                           "choose another port with --port (or --monitor-port)") from None
+    listener.listen(128)
+    listener.setblocking(False)
+    return listener
+
+
+def _lan_address() -> str | None:
+    """This machine's address on its main network (no packet is sent)."""
+    probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        probe.connect(("192.0.2.1", 9))
+        address: str = probe.getsockname()[0]
+    except OSError:
+        return None
+    finally:
+        probe.close()
+    return None if address.startswith("127.") else address

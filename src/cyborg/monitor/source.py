@@ -1,0 +1,206 @@
+"""One tree runner, followed over the bus: its topics in, its control services out.
+
+A :class:`TreeSource` subscribes to a runner's namespace (``/cyborg/bt`` by default; see
+docs/controller.md for the topics) and keeps a :class:`~cyborg.monitor.tree_state.TreeState`
+up to date. It tells its listener what changed (``"structure"``, ``"tick"``, ``"enabled"``,
+``"hooks"``, ``"alive"``) from the bus threads; the listener hands that to the web side.
+
+It also follows the runner's liveliness: when the runner's process goes away the source says
+``alive = False`` (the page shows it), and when a runner comes back its latched structure
+arrives again and the page follows without a reload.
+
+Control goes through the runner's services (``enable``, ``control``, ``step``, ``resume``,
+``get_blackboard``) as blocking calls: call them from a worker thread.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Callable
+from typing import Any
+
+from cyborg.bus import Node, Qos, new_message
+from cyborg.bus.wire import EntityKind
+from cyborg.monitor.tree_state import StructureError, TreeState
+
+log = logging.getLogger("cyborg.monitor")
+
+Listener = Callable[[str, str], None]
+"""``listener(namespace, what)``."""
+
+HOOK_MODES = {1: "disable", 2: "force", 3: "breakpoint"}
+CONTROL_ACTIONS = {"clear": 0, "disable": 1, "force": 2, "breakpoint": 3}
+STATUSES = {"success": 1, "failure": 2, "running": 3}
+SERVICE_TIMEOUT = 5.0
+
+
+class ControlError(RuntimeError):
+    """A control request the runner refused or did not answer; the message says why."""
+
+
+class TreeSource:
+    """Follows the tree runner under ``namespace``; see the module docstring."""
+
+    def __init__(self, node: Node, namespace: str, listener: Listener) -> None:
+        self.node, self.namespace = node, "/" + namespace.strip("/")
+        self._listener = listener
+        self.state: TreeState | None = None
+        self.generation = 0
+        """Bumped each time a structure arrives (a start, a restart or a reload)."""
+        self.enabled: bool | None = None
+        self.hooks: list[dict[str, Any]] = []
+        self.paused_at = ""
+        self.alive = False
+        self.problem = ""
+        """Why the last structure could not be used, if it could not."""
+        ns = self.namespace
+        latched = Qos.latched()
+        self._subscriptions = [
+            node.create_subscription(f"{ns}/behavior_tree", "cyborg_msgs/msg/BehaviorTree",
+                                     self._on_structure, latched),
+            node.create_subscription(f"{ns}/behavior_tree_updates",
+                                     "cyborg_msgs/msg/BehaviorTreeNodes", self._on_active,
+                                     latched),
+            node.create_subscription(f"{ns}/enabled", "std_msgs/msg/Bool", self._on_enabled,
+                                     latched),
+            node.create_subscription(f"{ns}/hooks", "cyborg_msgs/msg/BehaviorTreeHooks",
+                                     self._on_hooks, latched),
+            node.create_subscription(f"{ns}/status", "cyborg_msgs/msg/BehaviorTreeStatus",
+                                     self._on_status, Qos(depth=50)),
+        ]
+        self._clients = {
+            "enable": node.create_client(f"{ns}/enable", "std_srvs/srv/SetBool"),
+            "control": node.create_client(f"{ns}/control", "cyborg_msgs/srv/ControlNode"),
+            "step": node.create_client(f"{ns}/step", "std_srvs/srv/Trigger"),
+            "resume": node.create_client(f"{ns}/resume", "std_srvs/srv/Trigger"),
+            "get_blackboard": node.create_client(f"{ns}/get_blackboard",
+                                                 "cyborg_msgs/srv/GetBlackboard"),
+        }
+        self._remove_graph_listener = node.context.graph.on_change(self._check_alive)
+        self._check_alive()
+
+    # ------------------------------------------------------------------ topics in
+    def _on_structure(self, message: Any) -> None:
+        try:
+            state = TreeState(message.tree)
+        except StructureError as exc:
+            self.problem = f"{self.namespace}/behavior_tree: {exc}"
+            log.warning("%s", self.problem)
+            return
+        self.problem = ""
+        self.state = state
+        self.generation += 1
+        self._tell("structure")
+
+    def _on_active(self, message: Any) -> None:
+        state = self.state
+        if state is not None:
+            state.apply_active(list(message.ids))
+            self._tell("tick")
+
+    def _on_status(self, message: Any) -> None:
+        state = self.state
+        if state is None:
+            return
+        stamp = message.stamp
+        state.apply_tick(int(message.tick), stamp.sec + stamp.nanosec * 1e-9,
+                         float(message.duration), int(message.status), list(message.visited_ids),
+                         message.visited_statuses, message.visited_durations,
+                         list(message.active_ids))
+        self._tell("tick")
+
+    def _on_enabled(self, message: Any) -> None:
+        self.enabled = bool(message.data)
+        self._tell("enabled")
+
+    def _on_hooks(self, message: Any) -> None:
+        self.hooks = [
+            {"id": uid, "mode": HOOK_MODES.get(int(action), "?"),
+             "status": {1: "success", 2: "failure", 3: "running"}.get(int(status), "?"),
+             "owner": owner}
+            for uid, action, status, owner in zip(message.node_ids, message.actions,
+                                                  message.statuses, message.owners, strict=False)]
+        self.paused_at = message.paused_at
+        self._tell("hooks")
+
+    def _check_alive(self) -> None:
+        graph = self.node.context.graph
+        alive = graph.count(f"{self.namespace}/behavior_tree", EntityKind.PUBLISHER) > 0
+        if alive != self.alive:
+            self.alive = alive
+            if not alive:
+                self.paused_at = ""
+            self._tell("alive")
+
+    def _tell(self, what: str) -> None:
+        try:
+            self._listener(self.namespace, what)
+        except Exception:
+            log.exception("monitor listener failed on %s %s", self.namespace, what)
+
+    # ------------------------------------------------------------------ services out
+    def _call(self, service: str, type_name: str, **fields: Any) -> Any:
+        client = self._clients[service]
+        request = new_message(self.node.types, f"{type_name}_Request", fields)
+        try:
+            return client.call(request, timeout=SERVICE_TIMEOUT)
+        except Exception as exc:
+            raise ControlError(f"{self.namespace}/{service}: {exc}") from exc
+
+    def set_enabled(self, on: bool) -> str:
+        response = self._call("enable", "std_srvs/srv/SetBool", data=on)
+        if not response.success:
+            raise ControlError(f"{self.namespace}/enable: {response.message}")
+        self.enabled = on
+        self._tell("enabled")
+        return str(response.message)
+
+    def control(self, node_id: str, action: str, status: str = "failure", *, once: bool = False,
+                keep: bool = False) -> str:
+        """Set or clear a hook; see ``cyborg_msgs/srv/ControlNode``."""
+        if action not in CONTROL_ACTIONS:
+            raise ControlError(f"unknown action {action!r}; expected one of "
+                               f"{', '.join(CONTROL_ACTIONS)}")
+        if status not in STATUSES:
+            raise ControlError(f"unknown status {status!r}; expected one of "
+                               f"{', '.join(STATUSES)}")
+        response = self._call("control", "cyborg_msgs/srv/ControlNode", node_id=node_id,
+                              action=CONTROL_ACTIONS[action], status=STATUSES[status],
+                              once=once, keep=keep)
+        if not response.success:
+            raise ControlError(str(response.message))
+        return str(response.message)
+
+    def trigger(self, service: str) -> str:
+        """Call ``step`` or ``resume``."""
+        if service not in ("step", "resume"):
+            raise ControlError(f"unknown trigger {service!r}")
+        response = self._call(service, "std_srvs/srv/Trigger")
+        if not response.success:
+            raise ControlError(f"{service}: {response.message}")
+        return str(response.message)
+
+    def blackboard(self) -> dict[str, Any]:
+        """The runner's blackboard as JSON (``{"global", "tree", "node"}`` scopes)."""
+        response = self._call("get_blackboard", "cyborg_msgs/srv/GetBlackboard")
+        try:
+            data = json.loads(response.json)
+        except ValueError as exc:
+            raise ControlError(f"{self.namespace}/get_blackboard: not JSON ({exc})") from None
+        return data if isinstance(data, dict) else {"value": data}
+
+    def describe(self) -> dict[str, Any]:
+        """The short summary the page's robot list shows."""
+        state = self.state
+        return {"ns": self.namespace, "alive": self.alive, "enabled": self.enabled,
+                "title": state.structure.get("title", "") if state else "",
+                "nodes": len(state) if state else 0, "tick": state.tick if state else 0,
+                "problem": self.problem}
+
+    def destroy(self) -> None:
+        self._remove_graph_listener()
+        for subscription in self._subscriptions:
+            subscription.destroy()
+        for client in self._clients.values():
+            client.destroy()

@@ -1,0 +1,422 @@
+// The monitor page: connects to the monitor, keeps the model, draws, and wires the controls.
+//
+// Drawing is coalesced per animation frame: any number of deltas between two frames cost one
+// repaint of the nodes they touched. `window.__monitor` exposes counters for tests and the
+// latency benchmark.
+
+import { Connection } from "./connection.js";
+import { TreeModel, stateAt } from "./model.js";
+import { showBlackboard, showNode } from "./panels.js";
+import { TreeView } from "./tree_view.js";
+
+const $ = (id) => document.getElementById(id);
+const stats = (window.__monitor = { messages: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null });
+
+const model = new TreeModel();
+const page = {
+  ns: null,
+  robots: [],
+  alive: false,
+  enabled: null,
+  hooks: new Map(),
+  pausedAt: "",
+  problem: "",
+  seat: { may_control: false, control: false, holder: null },
+  depth: -1,
+  folded: new Set(), // folded by hand
+  opened: new Set(), // unfolded by hand (wins over draw depth)
+  selected: null,
+  matches: [],
+  matchAt: -1,
+  blackboard: null,
+  history: null, // { ticks, position } while scrubbing
+  connected: false,
+};
+let needsLayout = true;
+let dirty = null; // Set of ids to repaint, or "all"
+let layoutKey = "";
+let scheduled = false;
+
+const view = new TreeView($("tree"), {
+  onSelect: (id) => select(id),
+  onToggle: (id) => toggle(id),
+  onUserZoom: () => { $("autofit").checked = false; },
+});
+
+const connection = new Connection({
+  onMessage: receive,
+  onState: (state) => {
+    page.connected = state === "open";
+    banner();
+  },
+  onOpen: () => connection.post({ t: "watch", ns: page.ns || "" }),
+});
+
+// ------------------------------------------------------------------ messages
+function receive(message) {
+  stats.messages += 1;
+  switch (message.t) {
+    case "watching":
+      page.ns = message.ns;
+      break;
+    case "structure":
+      if (message.ns !== page.ns) page.ns = message.ns;
+      model.reset(message.v, message.tree ? message.tree.root : null);
+      page.title = message.tree ? message.tree.title : "";
+      if (page.selected && !model.byId.has(page.selected)) page.selected = null;
+      needsLayout = true;
+      schedule();
+      break;
+    case "snapshot":
+      if (message.v !== model.version) break;
+      page.ns = message.ns;
+      model.applySnapshot(message);
+      needsLayout = true;
+      schedule();
+      break;
+    case "tick": {
+      if (message.ns !== page.ns) break;
+      const changed = model.applyFrame(message);
+      if (changed === null) break;
+      stats.frames += 1;
+      stats.tick = model.tick;
+      if (changed.activeChanged && visibleKey() !== layoutKey) needsLayout = true;
+      markDirty(changed);
+      break;
+    }
+    case "runner":
+      if (message.ns !== page.ns) break;
+      page.alive = message.alive;
+      page.enabled = message.enabled;
+      page.problem = message.problem;
+      page.hooks = new Map(message.hooks.map((hook) => [hook.id, hook]));
+      page.pausedAt = message.paused_at;
+      markDirty("all");
+      toolbar();
+      banner();
+      break;
+    case "robots":
+      page.robots = message.robots;
+      robotList();
+      break;
+    case "seat":
+      page.seat = message;
+      if (message.may_control && message.holder === null) connection.post({ t: "claim" });
+      toolbar();
+      break;
+    case "timing":
+      if (message.ns === page.ns && message.v === model.version) {
+        model.applyTiming(message.nodes);
+        if (page.selected) showNode(model, page.selected, page.hooks);
+      }
+      break;
+    case "blackboard":
+      if (message.ns === page.ns) {
+        page.blackboard = message.data;
+        showBlackboard(message.data, $("bb-filter").value, nodeName);
+      }
+      break;
+    case "history":
+      startHistory(message);
+      break;
+    case "error":
+      say(message.message, true);
+      break;
+    default:
+      break;
+  }
+}
+
+// ------------------------------------------------------------------ drawing
+function markDirty(ids) {
+  if (ids === "all" || dirty === "all") dirty = "all";
+  else if (dirty === null) dirty = new Set(ids);
+  else for (const id of ids) dirty.add(id);
+  schedule();
+}
+
+function schedule() {
+  if (scheduled) return;
+  scheduled = true;
+  requestAnimationFrame(render);
+}
+
+function render() {
+  scheduled = false;
+  if (needsLayout) {
+    needsLayout = false;
+    dirty = "all";
+    layoutKey = visibleKey();
+    stats.drawn = model.root ? view.draw(model.root, isOpen) : view.clear();
+    stats.draws += 1;
+    if ($("autofit").checked) view.fit();
+    applySearch(false);
+    if (page.selected) view.markClass("selected", new Set([page.selected]));
+  }
+  if (dirty !== null) {
+    const shown = page.history ? historyLook() : liveLook();
+    view.paint(dirty === "all" ? null : dirty, shown);
+    dirty = null;
+    if (page.selected) showNode(model, page.selected, page.hooks);
+  }
+  const now = performance.timeOrigin + performance.now();
+  if (stats.firstPaint === null && stats.drawn > 0) stats.firstPaint = now;
+  if (stats.recordPaints) stats.paints.push([model.tick, now]);
+  tickInfo();
+}
+
+function liveLook() {
+  return { code: (id) => model.code(id), active: model.activeSet, inside: insideActive(model.active), hooked: new Set(page.hooks.keys()), pausedAt: page.pausedAt };
+}
+
+function historyLook() {
+  const state = stateAt(page.history.ticks, page.history.position, model.ids.length);
+  const active = new Set(state.active.map((index) => model.ids[index]));
+  return { code: (id) => state.codes[model.indexOf.get(id)] ?? 0, active, inside: insideActive([...active]), hooked: new Set(), pausedAt: "" };
+}
+
+// Folded nodes drawn with part of the running path hidden inside them.
+function insideActive(active) {
+  const inside = new Set();
+  for (const id of active) {
+    if (view.elements.has(id)) continue;
+    for (const up of model.ancestors(id)) {
+      if (view.elements.has(up)) { inside.add(up); break; }
+    }
+  }
+  return inside;
+}
+
+// rqt_bt's Draw depth, hand folding, and the running path always shown.
+function isOpen(node) {
+  if (!node.children.length) return false;
+  if (page.folded.has(node.id)) return false;
+  if (page.opened.has(node.id)) return true;
+  if (model.activeSet.has(node.id)) return true;
+  if (page.depth >= 0 && node.children.some((child) => child.depth > page.depth)) return false;
+  return true;
+}
+
+function visibleKey() {
+  if (!model.root) return "";
+  const open = [];
+  const stack = [model.root];
+  while (stack.length) {
+    const node = stack.pop();
+    if (isOpen(node)) { open.push(node.id); stack.push(...node.children); }
+  }
+  return open.join("\u0000");
+}
+
+function relayout() {
+  needsLayout = true;
+  schedule();
+}
+
+function toggle(id) {
+  const node = model.byId.get(id);
+  if (!node || !node.children.length) return;
+  if (isOpen(node)) { page.folded.add(id); page.opened.delete(id); }
+  else { page.opened.add(id); page.folded.delete(id); }
+  relayout();
+}
+
+function select(id) {
+  page.selected = id;
+  view.markClass("selected", new Set(id ? [id] : []));
+  showNode(model, id, page.hooks);
+}
+
+function tickInfo() {
+  const names = ["", "success", "failure", "running", "error"];
+  const source = page.history ? stateAt(page.history.ticks, page.history.position, 0) : model;
+  const root = page.history ? source.root : model.rootStatus;
+  $("tickinfo").textContent = model.root
+    ? `${page.title || ""} · tick ${source.tick} · t = ${Number(source.time).toFixed(2)} s · ${Number(source.duration).toFixed(3)} ms · ${names[root] || "–"} · ${stats.drawn} of ${model.ids.length} nodes drawn`
+    : "";
+}
+
+// ------------------------------------------------------------------ toolbar and banners
+function toolbar() {
+  const seat = page.seat;
+  const mayAct = seat.control && page.alive;
+  for (const button of document.querySelectorAll("button.control")) button.disabled = !mayAct;
+  const run = $("run");
+  run.textContent = page.enabled === false ? "▶ Run" : "❚❚ Pause";
+  run.dataset.enabled = String(page.enabled);
+  run.disabled = !mayAct || page.enabled === null;
+  const seatLabel = $("seat");
+  seatLabel.className = `seat ${seat.control ? "control" : "view"}`;
+  seatLabel.textContent = seat.control ? "You have control" : seat.may_control ? (seat.holder ? "Another page has control" : "View only") : "View only";
+  $("take").hidden = !(seat.may_control && !seat.control);
+  $("paused").hidden = !page.pausedAt;
+  const pausedNode = model.byId.get(page.pausedAt);
+  $("paused-node").textContent = pausedNode ? pausedNode.label || pausedNode.name : page.pausedAt;
+}
+
+function banner() {
+  const el = $("banner");
+  let text = "";
+  el.className = "";
+  if (!page.connected) text = "Connection to the monitor lost — reconnecting…";
+  else if (page.problem) text = page.problem;
+  else if (!page.alive) {
+    text = `The tree runner ${page.ns || ""} is not running — waiting for it to come back.`;
+    el.className = "info";
+  }
+  el.textContent = text;
+  el.hidden = !text;
+  toolbar();
+}
+
+function robotList() {
+  const select = $("robot");
+  const current = page.ns;
+  select.innerHTML = "";
+  for (const robot of page.robots) {
+    const option = document.createElement("option");
+    option.value = robot.ns;
+    option.textContent = `${robot.ns}${robot.title ? ` — ${robot.title}` : ""}${robot.alive ? "" : " (offline)"}`;
+    select.append(option);
+  }
+  if (current) select.value = current;
+}
+
+function say(text, error = false) {
+  const el = $("message");
+  el.textContent = text;
+  el.className = error ? "error" : "";
+}
+
+async function command(body) {
+  const result = await connection.send(body);
+  say(result.message, !result.ok);
+  return result;
+}
+
+function nodeName(id) {
+  const node = model.byId.get(id);
+  return node ? `${node.label || node.name} (${id.slice(-8)})` : id;
+}
+
+// ------------------------------------------------------------------ search
+function applySearch(jump) {
+  const needle = $("search").value.trim().toLowerCase();
+  page.matches = [];
+  if (needle) {
+    for (const id of model.ids) {
+      const node = model.byId.get(id);
+      if (`${node.label} ${node.name} ${id}`.toLowerCase().includes(needle)) page.matches.push(id);
+    }
+  }
+  view.markClass("match", new Set(page.matches));
+  $("search-count").textContent = needle ? `${page.matches.length} found` : "";
+  if (jump && page.matches.length) {
+    page.matchAt = (page.matchAt + 1) % page.matches.length;
+    const id = page.matches[page.matchAt];
+    let opened = false;
+    for (const up of model.ancestors(id)) {
+      if (!view.elements.has(id) && (page.folded.delete(up) || !isOpen(model.byId.get(up)))) { page.opened.add(up); opened = true; }
+    }
+    if (opened) { render(); }
+    $("search-count").textContent = `${page.matchAt + 1} of ${page.matches.length}`;
+    select(id);
+    view.centerOn(id);
+    $("autofit").checked = false;
+  }
+}
+
+// ------------------------------------------------------------------ history
+function startHistory(message) {
+  if (message.v !== model.version || !message.ticks.length) { say("no ticks recorded yet"); return; }
+  page.history = { ticks: message.ticks, position: message.ticks.length - 1 };
+  const scrub = $("scrub");
+  scrub.max = String(message.ticks.length - 1);
+  scrub.value = scrub.max;
+  scrub.disabled = false;
+  $("live").disabled = false;
+  showHistory();
+}
+
+function showHistory() {
+  const { ticks, position } = page.history;
+  const [tick, time] = ticks[position];
+  $("scrub-info").textContent = `tick ${tick} (t = ${time.toFixed(2)} s), ${ticks.length - 1 - position} ticks before the latest recorded`;
+  markDirty("all");
+}
+
+function goLive() {
+  page.history = null;
+  $("scrub").disabled = true;
+  $("live").disabled = true;
+  $("scrub-info").textContent = "";
+  markDirty("all");
+}
+
+// ------------------------------------------------------------------ wiring
+$("robot").addEventListener("change", (event) => {
+  page.ns = event.target.value;
+  page.folded.clear();
+  page.opened.clear();
+  page.selected = null;
+  goLive();
+  connection.post({ t: "watch", ns: page.ns });
+});
+$("run").addEventListener("click", () => command({ t: "enable", on: page.enabled === false }));
+$("depth").addEventListener("change", (event) => {
+  page.depth = Math.max(-1, parseInt(event.target.value, 10) || 0);
+  relayout();
+});
+$("fit").addEventListener("click", () => view.fit());
+$("autofit").addEventListener("change", (event) => { if (event.target.checked) view.fit(); });
+$("highlight").addEventListener("change", (event) => { view.highlight = event.target.checked; });
+$("refresh").addEventListener("click", () => { connection.post({ t: "refresh" }); relayout(); });
+$("search").addEventListener("input", () => { page.matchAt = -1; applySearch(false); });
+$("search").addEventListener("keydown", (event) => { if (event.key === "Enter") applySearch(true); });
+$("take").addEventListener("click", () => command({ t: "claim", force: true }));
+$("step").addEventListener("click", () => command({ t: "step" }));
+$("resume").addEventListener("click", () => command({ t: "resume" }));
+$("history").addEventListener("click", () => connection.post({ t: "history" }));
+$("live").addEventListener("click", goLive);
+$("scrub").addEventListener("input", (event) => {
+  if (!page.history) return;
+  page.history.position = Number(event.target.value);
+  showHistory();
+});
+$("bb-filter").addEventListener("input", () => { if (page.blackboard) showBlackboard(page.blackboard, $("bb-filter").value, nodeName); });
+for (const button of document.querySelectorAll("#inspector button[data-action]")) {
+  button.addEventListener("click", () => {
+    if (!page.selected) return;
+    command({ t: "control", id: page.selected, action: button.dataset.action, status: button.dataset.status || "failure", once: $("once").checked, keep: $("keep").checked });
+  });
+}
+for (const button of document.querySelectorAll("button[data-export]")) {
+  button.addEventListener("click", () => exportView(button.dataset.export));
+}
+window.addEventListener("resize", () => { if ($("autofit").checked) view.fit(); });
+
+// Save what is shown: the folded nodes go to the server, which draws with Graphviz.
+async function exportView(format) {
+  const collapsed = [...view.elements.keys()].filter((id) => {
+    const node = model.byId.get(id);
+    return node && node.children.length && !isOpen(node);
+  });
+  const response = await fetch("/api/export", {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ ns: page.ns, format, collapsed }),
+  });
+  if (!response.ok) { say((await response.json()).error, true); return; }
+  const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `tree.${format}`;
+  const link = document.createElement("a");
+  link.href = URL.createObjectURL(await response.blob());
+  link.download = name;
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(link.href), 10000);
+  say(`saved ${name}`);
+}
+
+toolbar();
+connection.open();

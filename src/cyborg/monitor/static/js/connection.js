@@ -1,0 +1,98 @@
+// The page's WebSocket to the monitor: connects, says hello, reconnects when the link drops.
+//
+// `connection.send(command)` returns a promise of the `result` message answering it (commands
+// carry a request number `req`). Every other message goes to `onMessage`. `onState` hears
+// "open" and "closed" so the page can say when it is offline.
+
+const RETRY_FIRST_MS = 300;
+const RETRY_MAX_MS = 5000;
+
+export class Connection {
+  constructor({ onMessage, onState, onOpen }) {
+    this.onMessage = onMessage;
+    this.onState = onState;
+    this.onOpen = onOpen;
+    this.pending = new Map();
+    this.nextReq = 1;
+    this.retryMs = RETRY_FIRST_MS;
+    this.socket = null;
+    this.key = pageKey();
+    this.token = pageToken();
+  }
+
+  url() {
+    const scheme = location.protocol === "https:" ? "wss:" : "ws:";
+    const query = this.token ? `?token=${encodeURIComponent(this.token)}` : "";
+    return `${scheme}//${location.host}/ws${query}`;
+  }
+
+  open() {
+    const socket = new WebSocket(this.url());
+    this.socket = socket;
+    socket.onopen = () => {
+      this.retryMs = RETRY_FIRST_MS;
+      this.post({ t: "hello", key: this.key });
+      this.onState("open");
+      this.onOpen();
+    };
+    socket.onmessage = (event) => {
+      const message = JSON.parse(event.data);
+      if (message.t === "result" && this.pending.has(message.req)) {
+        this.pending.get(message.req)(message);
+        this.pending.delete(message.req);
+        return;
+      }
+      this.onMessage(message);
+    };
+    socket.onclose = () => {
+      if (this.socket !== socket) return;
+      this.socket = null;
+      for (const resolve of this.pending.values()) {
+        resolve({ t: "result", ok: false, message: "the connection dropped" });
+      }
+      this.pending.clear();
+      this.onState("closed");
+      setTimeout(() => this.open(), this.retryMs);
+      this.retryMs = Math.min(this.retryMs * 2, RETRY_MAX_MS);
+    };
+  }
+
+  get connected() {
+    return this.socket !== null && this.socket.readyState === WebSocket.OPEN;
+  }
+
+  // Send without waiting for an answer.
+  post(command) {
+    if (this.connected) this.socket.send(JSON.stringify(command));
+  }
+
+  // Send and wait for the `result` that answers it.
+  send(command) {
+    if (!this.connected) {
+      return Promise.resolve({ ok: false, message: "not connected to the monitor" });
+    }
+    const req = this.nextReq++;
+    return new Promise((resolve) => {
+      this.pending.set(req, resolve);
+      this.socket.send(JSON.stringify({ ...command, req }));
+    });
+  }
+}
+
+// A key that stays the same across reloads of this tab, so a page that reloads keeps the
+// control seat it held.
+function pageKey() {
+  let key = sessionStorage.getItem("cyborg-monitor-key");
+  if (!key) {
+    key = `page-${Math.random().toString(36).slice(2, 10)}`;
+    sessionStorage.setItem("cyborg-monitor-key", key);
+  }
+  return key;
+}
+
+// The control token, from `?token=` in the page's address (kept for this tab).
+function pageToken() {
+  const fromUrl = new URLSearchParams(location.search).get("token");
+  if (fromUrl) sessionStorage.setItem("cyborg-monitor-token", fromUrl);
+  return fromUrl || sessionStorage.getItem("cyborg-monitor-token") || "";
+}

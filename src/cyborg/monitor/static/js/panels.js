@@ -1,0 +1,76 @@
+// The side panels: the selected node (facts, timing, hook, control buttons) and the live
+// blackboard table.
+
+import { countBelow, escapeHtml } from "./tree_view.js";
+
+const STATUS_NAMES = ["never ran", "success", "failure", "running", "error"];
+
+export function showNode(model, id, hooks) {
+  const body = document.getElementById("inspector-body");
+  const empty = document.getElementById("inspector-empty");
+  const node = id ? model.byId.get(id) : null;
+  body.hidden = !node;
+  empty.hidden = !!node;
+  if (!node) return;
+  document.getElementById("node-label").textContent = node.label || node.name;
+  const code = model.code(id);
+  const facts = [
+    ["name", node.name],
+    ["id", id],
+    ["category", node.category],
+    ["nesting", `${node.depth} (subtree depth)`],
+    ["status", `${STATUS_NAMES[code & 7]}${code & 8 ? " (this tick)" : code & 7 ? " (last time)" : ""}`],
+    ["children", node.children.length ? `${node.children.length} (${countBelow(node)} below)` : "none"],
+  ];
+  for (const [key, value] of Object.entries(node.properties || {})) facts.push([key, JSON.stringify(value)]);
+  document.getElementById("node-facts").innerHTML = rows(facts);
+  const timing = model.timing.get(id);
+  document.getElementById("node-timing").innerHTML = timing
+    ? rows([
+        ["ticks", String(timing.calls)],
+        ["last", ms(timing.last)],
+        ["mean", ms(timing.mean)],
+        ["min / max", `${ms(timing.min)} / ${ms(timing.max)}`],
+        ["changes", `${timing.changes} status changes`],
+        ["since", `${STATUS_NAMES[code & 7]} since t = ${timing.since.toFixed(2)} s`],
+      ])
+    : rows([["ticks", "not timed yet"]]);
+  const hook = hooks.get(id);
+  document.getElementById("node-hook").textContent = hook
+    ? `${hook.mode}${hook.mode === "breakpoint" ? "" : ` → ${hook.status}`}${hook.owner ? ` (set by ${hook.owner})` : " (kept)"}`
+    : "no hook";
+}
+
+function rows(pairs) {
+  return pairs.map(([key, value]) => `<tr><td>${escapeHtml(key)}</td><td>${escapeHtml(value)}</td></tr>`).join("");
+}
+
+function ms(value) {
+  if (value === null || value === undefined || Number.isNaN(value)) return "–";
+  return value < 1 ? `${(value * 1000).toFixed(1)} µs` : `${value.toFixed(2)} ms`;
+}
+
+// ------------------------------------------------------------------ blackboard
+let previous = new Map();
+
+// `labelOf(id)` names a node for the "node" scope rows.
+export function showBlackboard(data, filter, labelOf) {
+  const entries = [];
+  const add = (scope, values) => {
+    for (const [key, value] of Object.entries(values || {})) entries.push([scope, key, JSON.stringify(value)]);
+  };
+  add("global", data.global);
+  for (const [tree, values] of Object.entries(data.trees || {})) add(`tree ${tree}`, values);
+  for (const [node, values] of Object.entries(data.nodes || {})) add(`node ${labelOf(node)}`, values);
+  const needle = filter.trim().toLowerCase();
+  const shown = needle ? entries.filter((row) => row.join(" ").toLowerCase().includes(needle)) : entries;
+  const now = new Map(entries.map(([scope, key, value]) => [`${scope}\u0000${key}`, value]));
+  document.getElementById("bb-rows").innerHTML = shown
+    .map(([scope, key, value]) => {
+      const before = previous.get(`${scope}\u0000${key}`);
+      const changed = previous.size && before !== value ? ' class="changed"' : "";
+      return `<tr${changed}><td>${escapeHtml(scope)}</td><td>${escapeHtml(key)}</td><td>${escapeHtml(value)}</td></tr>`;
+    })
+    .join("");
+  previous = now;
+}
