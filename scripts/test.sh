@@ -6,6 +6,8 @@ cd "$(dirname "$0")/.."
 
 need_debian=()
 command -v dot >/dev/null || need_debian+=(graphviz)
+# the monitor's browser tests drive Debian's Chromium (never a downloaded browser)
+command -v chromium >/dev/null || need_debian+=(chromium fonts-dejavu-core)
 if [ ${#need_debian[@]} -gt 0 ]; then
     if [ "$(id -u)" = 0 ]; then sudo=(); elif command -v sudo >/dev/null; then sudo=(sudo); else
         echo "scripts/test.sh: please install the Debian packages: ${need_debian[*]}" >&2; exit 1

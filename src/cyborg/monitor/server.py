@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hashlib
 import json
 import logging
 from collections.abc import AsyncIterator
@@ -28,9 +29,8 @@ from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, Response
-from starlette.routing import Mount, Route, WebSocketRoute
-from starlette.staticfiles import StaticFiles
+from starlette.responses import JSONResponse, PlainTextResponse, Response
+from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from cyborg.monitor.client import RESYNC, Client
@@ -58,8 +58,13 @@ def create_app(hub: Hub) -> Starlette:
             with contextlib.suppress(asyncio.CancelledError):
                 await periodic
 
-    async def page(_request: Request) -> Response:
-        return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
+    files = StaticCache(STATIC)
+
+    async def page(request: Request) -> Response:
+        return files.respond("index.html", request)
+
+    async def static(request: Request) -> Response:
+        return files.respond(request.path_params["path"], request)
 
     async def robots(_request: Request) -> Response:
         return JSONResponse(hub.robots())
@@ -101,6 +106,8 @@ def create_app(hub: Hub) -> Starlette:
         await socket.accept()
         hub.connect(client)
         writer = asyncio.create_task(_write(hub, client))
+        if socket.query_params.get("watch"):  # the page's first connection: no round trip
+            await handle(hub, client, {"t": "watch", "ns": hub.default_namespace})
         try:
             while True:
                 text = await socket.receive_text()
@@ -126,9 +133,37 @@ def create_app(hub: Hub) -> Starlette:
         Route("/api/export", export, methods=["POST"]),
         Route("/stats", stats),
         WebSocketRoute("/ws", websocket),
-        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+        Route("/static/{path:path}", static),
     ]
     return Starlette(routes=routes, lifespan=lifespan)
+
+
+class StaticCache:
+    """The page's files, read once and served from memory with an ETag (a reload costs a
+    304). The page is small and fixed, so this is quicker than reading files per request."""
+
+    TYPES = {".html": "text/html; charset=utf-8", ".css": "text/css; charset=utf-8",
+             ".js": "text/javascript; charset=utf-8", ".mjs": "text/javascript; charset=utf-8",
+             ".LICENSE": "text/plain; charset=utf-8"}
+
+    def __init__(self, folder: Path) -> None:
+        self.files: dict[str, tuple[bytes, str, str]] = {}
+        for path in sorted(folder.rglob("*")):
+            if path.is_file() and path.suffix in self.TYPES:
+                content = path.read_bytes()
+                etag = '"' + hashlib.sha1(content, usedforsecurity=False).hexdigest()[:16] + '"'
+                self.files[path.relative_to(folder).as_posix()] = (
+                    content, self.TYPES[path.suffix], etag)
+
+    def respond(self, name: str, request: Request) -> Response:
+        found = self.files.get(name)
+        if found is None:
+            return PlainTextResponse(f"no such file: {name}", 404)
+        content, media_type, etag = found
+        headers = {"ETag": etag, "Cache-Control": "no-cache"}
+        if request.headers.get("if-none-match") == etag:
+            return Response(status_code=304, headers=headers)
+        return Response(content, media_type=media_type, headers=headers)
 
 
 async def _write(hub: Hub, client: Client) -> None:

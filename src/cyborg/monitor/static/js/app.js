@@ -10,7 +10,7 @@ import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
 
 const $ = (id) => document.getElementById(id);
-const stats = (window.__monitor = { messages: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null });
+const stats = (window.__monitor = { messages: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null, drawMs: null });
 
 const model = new TreeModel();
 const page = {
@@ -81,7 +81,14 @@ function receive(message) {
       stats.frames += 1;
       stats.tick = model.tick;
       if (changed.activeChanged && visibleKey() !== layoutKey) needsLayout = true;
-      markDirty(changed);
+      if (needsLayout || page.history) {
+        markDirty(changed);
+      } else {
+        // Class changes are cheap and the browser draws them in its next frame anyway:
+        // apply them now rather than waiting for an animation frame.
+        addDirty(changed);
+        render();
+      }
       break;
     }
     case "runner":
@@ -129,25 +136,34 @@ function receive(message) {
 
 // ------------------------------------------------------------------ drawing
 function markDirty(ids) {
+  addDirty(ids);
+  schedule();
+}
+
+function addDirty(ids) {
   if (ids === "all" || dirty === "all") dirty = "all";
   else if (dirty === null) dirty = new Set(ids);
   else for (const id of ids) dirty.add(id);
-  schedule();
 }
 
 function schedule() {
   if (scheduled) return;
   scheduled = true;
-  requestAnimationFrame(render);
+  requestAnimationFrame(() => render(true));
 }
 
-function render() {
-  scheduled = false;
+function render(fromFrame = false) {
+  if (fromFrame) scheduled = false;
+  if (page.history && !needsLayout && dirty !== "all" && !fromFrame) return;
+  const started = performance.now();
+  const relaid = needsLayout;
   if (needsLayout) {
     needsLayout = false;
-    dirty = "all";
+    dirty = null;
     layoutKey = visibleKey();
-    stats.drawn = model.root ? view.draw(model.root, isOpen) : view.clear();
+    stats.drawn = model.root ? view.draw(model.root, isOpen, page.history ? historyLook() : liveLook()) : view.clear();
+    // folded nodes with part of the running path inside are known only once drawn
+    dirty = new Set(model.active.flatMap((id) => model.ancestors(id)));
     stats.draws += 1;
     if ($("autofit").checked) view.fit();
     applySearch(false);
@@ -159,10 +175,19 @@ function render() {
     dirty = null;
     if (page.selected) showNode(model, page.selected, page.hooks);
   }
-  const now = performance.timeOrigin + performance.now();
-  if (stats.firstPaint === null && stats.drawn > 0) stats.firstPaint = now;
-  if (stats.recordPaints) stats.paints.push([model.tick, now]);
+  if (relaid) stats.drawMs = performance.now() - started;
   tickInfo();
+  // A task queued from the next animation frame runs once that frame has been rendered:
+  // stamp the paint there.
+  const tick = model.tick;
+  const firstDraw = stats.firstPaint === null && stats.drawn > 0;
+  if (firstDraw || stats.recordPaints) {
+    requestAnimationFrame(() => setTimeout(() => {
+      const now = performance.timeOrigin + performance.now();
+      if (firstDraw && stats.firstPaint === null) stats.firstPaint = now;
+      if (stats.recordPaints) stats.paints.push([tick, now]);
+    }, 0));
+  }
 }
 
 function liveLook() {

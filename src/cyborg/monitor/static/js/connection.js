@@ -26,15 +26,20 @@ export class Connection {
     return `${scheme}//${location.host}/ws${query}`;
   }
 
+  // The first connection is the one index.html opened while the modules loaded (it watches
+  // the default tree from the start); later ones are made here.
   open() {
-    const socket = new WebSocket(this.url());
+    const early = window.__early;
+    window.__early = null;
+    const socket = early && early.socket.readyState <= WebSocket.OPEN ? early.socket : new WebSocket(this.url());
     this.socket = socket;
-    socket.onopen = () => {
+    const opened = () => {
       this.retryMs = RETRY_FIRST_MS;
       this.post({ t: "hello", key: this.key });
       this.onState("open");
-      this.onOpen();
+      if (socket !== early?.socket) this.onOpen();
     };
+    socket.onopen = opened;
     socket.onmessage = (event) => {
       const message = JSON.parse(event.data);
       if (message.t === "result" && this.pending.has(message.req)) {
@@ -44,6 +49,10 @@ export class Connection {
       }
       this.onMessage(message);
     };
+    if (socket === early?.socket) {
+      for (const event of early.buffered) socket.onmessage(event);
+      if (socket.readyState === WebSocket.OPEN) opened();
+    }
     socket.onclose = () => {
       if (this.socket !== socket) return;
       this.socket = null;

@@ -15,6 +15,7 @@ const CHAR_PX = 7;
 const PAD_PX = 18;
 const SIBLING_GAP = 14;
 const MAX_LABEL = 40;
+const FAR_SCALE = 0.35;
 const STATE_CLASSES = / (s\d|fresh|never|active|inside-active|hooked|paused)\b/g;
 
 export class TreeView {
@@ -31,12 +32,18 @@ export class TreeView {
     this.elements = new Map(); // id -> <g>
     this.edges = new Map(); // child id -> <path>
     this.highlight = true;
+    this.size = { width: 0, height: 0 };
+    new ResizeObserver(([entry]) => {
+      this.size = { width: entry.contentRect.width, height: entry.contentRect.height };
+    }).observe(svg);
     this.listen();
   }
 
   // Lay out and draw `root` (the structure's root), showing only nodes for which
-  // `isOpen(parent)` held all the way down. Returns the number of nodes drawn.
-  draw(root, isOpen) {
+  // `isOpen(parent)` held all the way down, in the state `look` gives (see paint()). The
+  // markup is built as one string with its classes in place: one parse, one style pass.
+  // Returns the number of nodes drawn.
+  draw(root, isOpen, look) {
     const layoutRoot = hierarchy(root, (node) => (isOpen(node) ? node.children : null));
     layoutRoot.each((d) => {
       const label = displayLabel(d.data, !isOpen(d.data) && d.data.children.length > 0);
@@ -56,16 +63,16 @@ export class TreeView {
       const id = d.data.id;
       const folded = !isOpen(d.data) && d.data.children.length > 0;
       nodes.push(
-        `<g class="node c-${d.data.category}${folded ? " folded" : ""}" data-id="${escapeHtml(id)}" ` +
+        `<g class="${stateClass(`node c-${d.data.category}${folded ? " folded" : ""}`, id, look)}" data-id="${escapeHtml(id)}" ` +
           `transform="translate(${d.x - d.width / 2},${d.y})">` +
           `<rect width="${d.width}" height="${BOX_HEIGHT}"></rect>` +
-          `<text x="${d.width / 2}" y="${BOX_HEIGHT / 2 + 1}">${escapeHtml(d.label)}</text>` +
-          `<title>${escapeHtml(`${d.data.name} ${id}`)}</title></g>`,
+          `<text x="${d.width / 2}" y="${BOX_HEIGHT / 2 + 1}">${escapeHtml(d.label)}</text></g>`,
       );
       if (d.parent) {
         const px = d.parent.x, py = d.parent.y + BOX_HEIGHT, my = (py + d.y) / 2;
+        const on = look.active.has(id) && look.active.has(d.parent.data.id);
         edges.push(
-          `<path class="edge" data-parent="${escapeHtml(d.parent.data.id)}" data-child="${escapeHtml(id)}" ` +
+          `<path class="edge${on ? " active" : ""}" data-parent="${escapeHtml(d.parent.data.id)}" data-child="${escapeHtml(id)}" ` +
             `d="M${px},${py}C${px},${my} ${d.x},${my} ${d.x},${d.y}"></path>`,
         );
       }
@@ -98,16 +105,8 @@ export class TreeView {
     for (const id of which) {
       const g = this.elements.get(id);
       if (!g) continue;
-      const code = look.code(id);
-      const status = code & 7;
-      let cls = g.getAttribute("class").replace(STATE_CLASSES, "");
-      cls += status ? ` s${status}` : " never";
-      if (code & 8) cls += " fresh";
-      if (look.active.has(id)) cls += " active";
-      else if (look.inside.has(id)) cls += " inside-active";
-      if (look.hooked.has(id)) cls += " hooked";
-      if (look.pausedAt === id) cls += " paused";
-      g.setAttribute("class", cls);
+      const cls = stateClass(g.getAttribute("class").replace(STATE_CLASSES, ""), id, look);
+      if (cls !== g.getAttribute("class")) g.setAttribute("class", cls);
       const path = this.edges.get(id);
       if (path) path.classList.toggle("active", look.active.has(id) && look.active.has(path.dataset.parent));
     }
@@ -121,10 +120,15 @@ export class TreeView {
   apply() {
     const { k, x, y } = this.transform;
     this.viewport.setAttribute("transform", `translate(${x},${y}) scale(${k})`);
+    // Labels smaller than ~4 px cannot be read: leave them out (and their layout) until
+    // the user zooms in.
+    this.svg.classList.toggle("far", k < FAR_SCALE);
   }
 
   fit() {
-    const box = this.svg.getBoundingClientRect();
+    // The size comes from the ResizeObserver: asking the DOM here would force a layout of
+    // everything just drawn.
+    const box = this.size.width ? this.size : this.svg.getBoundingClientRect();
     const width = this.bounds.x1 - this.bounds.x0, height = this.bounds.y1 - this.bounds.y0;
     if (!box.width || !box.height) return;
     const k = Math.min(box.width / width, box.height / height, 1.5);
@@ -200,6 +204,19 @@ export class TreeView {
       }
     }
   }
+}
+
+// `base` classes plus those showing the node's state.
+function stateClass(base, id, look) {
+  const code = look.code(id);
+  const status = code & 7;
+  let cls = base + (status ? ` s${status}` : " never");
+  if (code & 8) cls += " fresh";
+  if (look.active.has(id)) cls += " active";
+  else if (look.inside.has(id)) cls += " inside-active";
+  if (look.hooked.has(id)) cls += " hooked";
+  if (look.pausedAt === id) cls += " paused";
+  return cls;
 }
 
 function displayLabel(node, folded) {
