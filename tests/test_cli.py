@@ -160,7 +160,7 @@ def test_ctrl_c_stops_cleanly_and_halts() -> None:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
-    process = _cyborg("up", "--listen", f"tcp/127.0.0.1:{port}")
+    process = _cyborg("up", "--listen", f"tcp/127.0.0.1:{port}", "--monitor-port", "0")
     assert process.stdout is not None
     first = process.stdout.readline()
     assert first.startswith("cyborg up: bus router at")

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import socket
 import subprocess
 import sys
 import time
+import urllib.request
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -176,12 +179,32 @@ def test_launch_across_processes_and_control_from_the_shell(
 @pytest.mark.heavy
 def test_cyborg_up_runs_the_bundled_system() -> None:
     port = _free_port()
-    result = subprocess.run(
+    process = subprocess.Popen(
         [sys.executable, "-m", "cyborg", "up", "--speed", "20", "--duration", "8",
-         "--listen", f"tcp/127.0.0.1:{port}"],
-        capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONUNBUFFERED="1"))
-    assert result.returncode == 0, result.stdout + result.stderr
-    out = result.stdout
+         "--listen", f"tcp/127.0.0.1:{port}", "--monitor-port", "0"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"))
+    assert process.stdout is not None
+    lines = []
+    while not any("monitor      /cyborg/monitor: open " in line for line in lines):
+        line = process.stdout.readline()
+        assert line, "cyborg up ended before printing the monitor's address"
+        lines.append(line)
+    url = lines[-1].split("open ")[1].split()[0]
+    assert url.startswith("http://127.0.0.1:")
+    deadline = time.monotonic() + 20
+    robots: dict[str, Any] = {}
+    while time.monotonic() < deadline:
+        robots = json.loads(urllib.request.urlopen(url + "api/robots", timeout=5).read())
+        if robots["robots"] and robots["robots"][0]["alive"] and robots["robots"][0]["tick"]:
+            break
+        time.sleep(0.2)
+    assert robots["robots"][0]["title"] == "Campus mission", robots
+    page = urllib.request.urlopen(url, timeout=5).read().decode()
+    assert "<title>cyborg monitor</title>" in page
+    rest = process.stdout.read()  # what the text wrapper has read ahead stays in it
+    assert process.wait(timeout=120) == 0, rest + (process.stderr.read() if process.stderr else "")
+    out = "".join(lines) + rest
     assert "simulator    /cyborg/arnl: campus.map at 20x real time" in out
     assert "tree runner  /cyborg/bt/tree_runner: 'Campus mission' (22 nodes)" in out
     assert "Campus mission > Priority > Patrol > Repeat -1x > MemSequence > MoveTo Lecture hall" \
