@@ -185,7 +185,7 @@ def test_cyborg_up_runs_the_bundled_system() -> None:
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         env=dict(os.environ, PYTHONUNBUFFERED="1"))
     assert process.stdout is not None
-    lines = []
+    lines: list[str] = []
     while not any("monitor      /cyborg/monitor: open " in line for line in lines):
         line = process.stdout.readline()
         assert line, "cyborg up ended before printing the monitor's address"
@@ -210,3 +210,32 @@ def test_cyborg_up_runs_the_bundled_system() -> None:
     assert "Campus mission > Priority > Patrol > Repeat -1x > MemSequence > MoveTo Lecture hall" \
         in out
     assert "MoveTo Library" in out, "the robot got to the lecture hall and went on"
+
+
+def test_cyborg_monitor_serves_and_a_taken_port_is_a_clear_error() -> None:
+    bus = _free_port()
+    with socket.socket() as taken:
+        taken.bind(("0.0.0.0", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        refused = subprocess.run(
+            [sys.executable, "-m", "cyborg", "monitor", "--port", str(port), "--duration", "5",
+             "--listen", f"tcp/127.0.0.1:{bus}"], capture_output=True, text=True, timeout=60)
+    assert refused.returncode == 1
+    assert f"cannot listen on 0.0.0.0:{port}" in refused.stderr
+    assert "choose another port with --port" in refused.stderr
+    assert "Traceback" not in refused.stderr
+    process = subprocess.Popen(
+        [sys.executable, "-m", "cyborg", "monitor", "--port", "0", "--duration", "4",
+         "--namespace", "robot1/bt", "--listen", f"tcp/127.0.0.1:{bus}"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"))
+    assert process.stdout is not None
+    line = ""
+    while "open http" not in line:
+        line = process.stdout.readline()
+        assert line, "cyborg monitor ended before printing its address"
+    url = line.split("open ")[1].split()[0]
+    stats = json.loads(urllib.request.urlopen(url + "stats", timeout=5).read())
+    assert stats["trees"] == ["/robot1/bt"]
+    assert process.wait(timeout=60) == 0
