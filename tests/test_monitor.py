@@ -86,9 +86,12 @@ def test_timings_history_and_unknown_ids() -> None:
     assert math.isclose(last, 10.0) and math.isclose(mean, 6.0)
     assert (math.isclose(low, 2.0), math.isclose(high, 10.0)) == (True, True)
     assert state.timings() == [], "only what changed since the last call"
+    _tick(state, 6, {"leaf0": 1}, [], durations=[0.001])
+    assert len(state.timings(all_nodes=True)) == 2, "a new page gets every timed node"
+    assert [row[0] for row in state.timings()] == [2], "and the others still get the change"
     history = state.history_json()
-    assert [entry[0] for entry in history] == [3, 4, 5], "a bounded ring of recent ticks"
-    assert history[-1][4] == [2, 0] and history[-1][5] == [1, 1]
+    assert [entry[0] for entry in history] == [4, 5, 6], "a bounded ring of recent ticks"
+    assert history[-2][4] == [2, 0] and history[-2][5] == [1, 1]
 
 
 def test_a_structure_that_is_not_one_is_refused() -> None:

@@ -36,9 +36,6 @@ FRAME_INTERVAL = 1 / 60
 """Shortest time between two frames of one tree (ticks in between are merged)."""
 SLOW_PERIOD = 0.5
 
-Commands = dict[str, Callable[[Client, dict[str, Any]], Any]]
-
-
 def encode(message: dict[str, Any]) -> str:
     return json.dumps(message, separators=(",", ":"))
 

@@ -201,10 +201,12 @@ class TreeState:
 
     def timings(self, *, all_nodes: bool = False) -> list[list[float]]:
         """``[index, calls, last, mean, min, max (ms), status changes, since]`` for each node
-        whose timings changed since the last call (or every timed node)."""
+        whose timings changed since the last call without ``all_nodes`` (or, with it, every
+        timed node)."""
         with self._lock:
             which = np.flatnonzero(self.calls > 0 if all_nodes else self._timed)
-            self._timed[:] = False
+            if not all_nodes:  # a page's first full table leaves the others' deltas be
+                self._timed[:] = False
             calls = self.calls[which]
             rows = np.column_stack([
                 which, calls, self.last_ms[which], self.total_ms[which] / calls,

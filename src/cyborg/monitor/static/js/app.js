@@ -21,6 +21,7 @@ const page = {
   hooks: new Map(),
   pausedAt: "",
   problem: "",
+  title: "",
   seat: { may_control: false, control: false, holder: null },
   depth: -1,
   folded: new Set(), // folded by hand

@@ -8,7 +8,6 @@
 
 import { hierarchy, tree as tidyTree } from "../vendor/d3-hierarchy.min.mjs";
 
-const SVG_NS = "http://www.w3.org/2000/svg";
 const BOX_HEIGHT = 28;
 const ROW_GAP = 46;
 const CHAR_PX = 7;
@@ -240,5 +239,3 @@ export function countBelow(node) {
 export function escapeHtml(text) {
   return String(text).replace(/[&<>"']/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" })[c]);
 }
-
-export { SVG_NS };
