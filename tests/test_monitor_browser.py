@@ -245,9 +245,10 @@ def test_breakpoint_step_resume_blackboard_timing_search_and_history(
     newest = page.evaluate("window.__monitor.tick")
     page.fill("#scrub", "0")
     page.dispatch_event("#scrub", "input")
-    info = page.inner_text("#tickinfo")
-    oldest = int(info.split("tick ")[1].split(" ")[0])
-    assert oldest < newest, "scrubbing shows an older tick"
+    oldest = int(page.inner_text("#scrub-info").split()[1])  # set at once by the slider
+    assert oldest < newest, "scrubbing goes back to an older tick"
+    # the view is redrawn on the next animation frame: wait for it to show that tick
+    _wait_page(page, f"document.getElementById('tickinfo').textContent.includes('tick {oldest} ')")
     screenshot(page, "history")
     page.click("#live")
     assert page.is_disabled("#scrub")
