@@ -20,9 +20,10 @@ import logging
 from collections.abc import Callable
 from typing import Any
 
+from cyborg.bt.status import Status
 from cyborg.bus import Node, Qos, new_message
 from cyborg.bus.wire import EntityKind
-from cyborg.monitor.tree_state import StructureError, TreeState
+from cyborg.monitor.tree_state import StructureError, TreeState, status_name
 
 log = logging.getLogger("cyborg.monitor")
 
@@ -31,7 +32,9 @@ Listener = Callable[[str, str], None]
 
 HOOK_MODES = {1: "disable", 2: "force", 3: "breakpoint"}
 CONTROL_ACTIONS = {"clear": 0, "disable": 1, "force": 2, "breakpoint": 3}
-STATUSES = {"success": 1, "failure": 2, "running": 3}
+STATUSES = {status.label: int(status) for status in (Status.SUCCESS, Status.FAILURE,
+                                                     Status.RUNNING)}
+"""The statuses a hook may give, by name."""
 SERVICE_TIMEOUT = 5.0
 
 
@@ -117,7 +120,7 @@ class TreeSource:
     def _on_hooks(self, message: Any) -> None:
         self.hooks = [
             {"id": uid, "mode": HOOK_MODES.get(int(action), "?"),
-             "status": {1: "success", 2: "failure", 3: "running"}.get(int(status), "?"),
+             "status": status_name(int(status)),
              "owner": owner}
             for uid, action, status, owner in zip(message.node_ids, message.actions,
                                                   message.statuses, message.owners, strict=False)]

@@ -30,11 +30,21 @@ from typing import Any
 import numpy as np
 import xxhash
 
+from cyborg.bt.status import Status
+
 FRESH = 8
 """Added to a node's status in a display code when the node ran in the latest tick."""
 
 HISTORY_TICKS = 1200
 """Ticks kept for the history timeline (a minute at 20 Hz, two at the default 10 Hz)."""
+
+
+def status_name(code: int) -> str:
+    """``"success"`` for 1 and so on, as the engine names statuses; ``"?"`` for others."""
+    try:
+        return Status(code).label
+    except ValueError:
+        return "?"
 
 
 class StructureError(ValueError):
@@ -223,9 +233,8 @@ class TreeState:
 
     def statuses_by_id(self) -> dict[str, str]:
         """Last status of every node that has run, by id (for exports)."""
-        names = {1: "success", 2: "failure", 3: "running", 4: "error"}
         with self._lock:
-            return {self.ids[index]: names[int(code)]
+            return {self.ids[index]: status_name(int(code))
                     for index, code in enumerate(self.status) if code}
 
     def active_ids(self) -> list[str]:
