@@ -14,7 +14,8 @@ it. See docs/monitor.md.
 * :mod:`~cyborg.monitor.server` — the Starlette application; :mod:`~cyborg.monitor.monitor` —
   the node that runs it all.
 
-This package uses the bus, the engine's DOT writer and its statuses; only :mod:`cyborg.app` wires it up.
+This package uses the bus, the engine's DOT writer and its statuses; only :mod:`cyborg.app`
+wires it up.
 """
 
 from cyborg.monitor.monitor import DEFAULT_PORT, Monitor, MonitorError
