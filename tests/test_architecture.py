@@ -38,10 +38,12 @@ def test_modules_stay_small() -> None:
 
 ALLOWED = {"nav": ("cyborg.nav", "cyborg.bus"), "sim": ("cyborg.sim", "cyborg.nav", "cyborg.bus"),
            "nodes": ("cyborg.nodes", "cyborg.bt", "cyborg.bus", "cyborg.nav.geometry"),
-           "monitor": ("cyborg.monitor", "cyborg.bus", "cyborg.bt.dot", "cyborg.bt.status")}
+           "monitor": ("cyborg.monitor", "cyborg.bus", "cyborg.bt.dot", "cyborg.bt.status"),
+           "vision": ("cyborg.vision", "cyborg.bus")}
 """Navigation may use the bus (its services); the simulator builds on navigation and the bus;
 the robot's nodes glue the engine to the bus, with navigation's pose types (not its planner);
-the monitor watches trees over the bus and borrows only the engine's DOT writer and statuses."""
+the monitor watches trees over the bus and borrows only the engine's DOT writer and statuses;
+vision publishes and subscribes on the bus and knows nothing of trees or navigation."""
 
 
 @pytest.mark.parametrize("package", sorted(ALLOWED))

@@ -1,0 +1,32 @@
+"""Object detection on stereo images, with distance, and the detector node.
+
+* camera sources behind one interface (:class:`FrameSource` of :class:`Frame`): images,
+  folders, videos, stereo pairs, local cameras (:mod:`~cyborg.vision.file_sources`), ROS bags
+  (:mod:`~cyborg.vision.bag_source`) and the bus (:mod:`~cyborg.vision.bus_source`), opened
+  from a short description by :func:`open_source`;
+* depth maps in metres from a depth camera or a rectified stereo pair
+  (:mod:`~cyborg.vision.depth`);
+* YOLO-family detectors (YOLOX, YOLOv5/v7, YOLOv8/11, YOLOv10, Darknet) on onnxruntime or
+  OpenCV's DNN module (:class:`Detector`; :mod:`~cyborg.vision.layouts`,
+  :mod:`~cyborg.vision.backends`, :mod:`~cyborg.vision.letterbox`);
+* the distance of each detection: the median of valid depth in its box
+  (:mod:`~cyborg.vision.distance`), the annotated image (:mod:`~cyborg.vision.annotate`), and
+  the bus messages (:mod:`~cyborg.vision.predictions`);
+* the nodes: :class:`DetectorNode` and :class:`CameraNode`; model files
+  (:mod:`~cyborg.vision.models`).
+
+This package uses the bus for its messages and nodes; only :mod:`cyborg.app` wires it up.
+"""
+
+from cyborg.vision.camera_node import CameraNode
+from cyborg.vision.depth import StereoCalibration, StereoDepth, depth_in_metres
+from cyborg.vision.detector import Detection, Detector
+from cyborg.vision.detector_node import CameraTopics, DetectorNode
+from cyborg.vision.distance import box_distance
+from cyborg.vision.frames import Frame, FrameSource, VisionError
+from cyborg.vision.pipeline import DetectionPipeline, Result
+from cyborg.vision.sources import SourceOptions, open_source
+
+__all__ = ["CameraNode", "CameraTopics", "Detection", "DetectionPipeline", "Detector",
+           "DetectorNode", "Frame", "FrameSource", "Result", "SourceOptions", "StereoCalibration",
+           "StereoDepth", "VisionError", "box_distance", "depth_in_metres", "open_source"]

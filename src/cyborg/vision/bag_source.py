@@ -1,0 +1,128 @@
+"""Frames from recorded ROS bags: ROS 1 ``.bag`` and ROS 2 bags (``.db3`` or ``.mcap``).
+
+Bags are read with rosbags' ``AnyReader``, so no ROS installation is needed. Images may be
+``sensor_msgs/Image`` or ``CompressedImage``; depth maps ``32FC1`` metres or ``16UC1``
+millimetres. Topics are given, or found: the depth topic is the image topic with ``depth`` in
+its name, the right image the one with ``right``, the left image the remaining one (preferring
+``left``, ``rgb`` or ``color``). Streams are paired by exact header stamp; unpaired messages are
+counted in :attr:`BagSource.dropped`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from cyborg.vision.frames import Frame, FrameSource, VisionError
+from cyborg.vision.image_messages import (
+    compressed_to_bgr,
+    image_to_bgr,
+    image_to_depth,
+    stamp_ns,
+)
+from cyborg.vision.pairing import ExactPairer
+
+IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
+BAG_SUFFIXES = frozenset({".bag", ".db3", ".mcap"})
+
+
+def is_bag(path: Path) -> bool:
+    return path.suffix in BAG_SUFFIXES or (path.is_dir() and (path / "metadata.yaml").is_file())
+
+
+def _bag_path(path: Path) -> Path:
+    """A ROS 2 storage file is read through its bag folder (where ``metadata.yaml`` lives)."""
+    if path.suffix in (".db3", ".mcap") and path.is_file():
+        if not (path.parent / "metadata.yaml").is_file():
+            raise VisionError(f"bag {path}: a ROS 2 bag is a folder with metadata.yaml next to "
+                              "its storage files; give the folder")
+        return path.parent
+    if not path.exists():
+        raise VisionError(f"bag {path}: not found")
+    return path
+
+
+class BagSource(FrameSource):
+    """Frames of a bag's image topic, with its depth and right-image topics when present."""
+
+    def __init__(self, path: Path, *, image_topic: str | None = None,
+                 depth_topic: str | None = None, right_topic: str | None = None) -> None:
+        from rosbags.highlevel import AnyReader, AnyReaderError
+
+        super().__init__()
+        self.name = str(path)
+        try:
+            self.reader = AnyReader([_bag_path(path)])
+            self.reader.open()
+        except (AnyReaderError, OSError, ValueError) as exc:
+            raise VisionError(f"bag {path}: cannot be read ({exc})") from exc
+        image_topics = {c.topic: c.msgtype for c in self.reader.connections
+                        if c.msgtype in IMAGE_TYPES}
+        self.topics = self._choose(path, image_topics, image_topic, depth_topic, right_topic)
+        self.length = sum(c.msgcount for c in self.reader.connections
+                          if c.topic == self.topics["image"])
+
+    def _choose(self, path: Path, found: dict[str, str], image: str | None, depth: str | None,
+                right: str | None) -> dict[str, str]:
+        for given in (image, depth, right):
+            if given is not None and given not in found:
+                raise VisionError(f"bag {path}: no image topic {given!r}; image topics: "
+                                  f"{', '.join(sorted(found)) or 'none'}")
+        rest = [topic for topic in sorted(found) if topic not in (image, depth, right)]
+        if depth is None:
+            depth = next((t for t in rest if "depth" in t.lower()), None)
+        if right is None:
+            right = next((t for t in rest if "right" in t.lower() and t != depth), None)
+        if image is None:
+            others = [t for t in rest if t not in (depth, right)]
+            preferred = [t for t in others if any(word in t.lower()
+                                                  for word in ("left", "rgb", "color"))]
+            choices = preferred or others
+            if len(choices) != 1:
+                raise VisionError(f"bag {path}: cannot tell which topic is the camera image "
+                                  f"among {', '.join(others) or 'no image topics'}; give "
+                                  "--image-topic")
+            image = choices[0]
+        topics = {"image": image}
+        if depth is not None:
+            topics["depth"] = depth
+        if right is not None:
+            topics["right"] = right
+        return topics
+
+    def frames(self) -> Iterator[Frame]:
+        streams = {topic: stream for stream, topic in self.topics.items()}
+        pairer = ExactPairer(tuple(self.topics))
+        connections = [c for c in self.reader.connections if c.topic in streams]
+        index = 0
+        for connection, _, raw in self.reader.messages(connections=connections):
+            where = f"{self.name} {connection.topic}"
+            try:
+                message: Any = self.reader.deserialize(raw, connection.msgtype)
+            except Exception as exc:  # rosbags raises several types for bad data
+                raise VisionError(f"{where}: message cannot be decoded ({exc})") from exc
+            stream = streams[connection.topic]
+            complete = pairer.add(stream, stamp_ns(message.header),
+                                  self._convert(stream, message, where))
+            self.dropped = pairer.dropped
+            if complete is None:
+                continue
+            yield Frame(stamp_ns(message.header), complete["image"], complete.get("right"),
+                        complete.get("depth"), frame_id=str(message.header.frame_id),
+                        index=index)
+            index += 1
+        pairer.finish()
+        self.dropped = pairer.dropped
+
+    @staticmethod
+    def _convert(stream: str, message: Any, where: str) -> Any:
+        if stream == "depth":
+            return image_to_depth(message, where)
+        if hasattr(message, "format"):
+            return compressed_to_bgr(message, where)
+        return image_to_bgr(message, where)
+
+    def close(self) -> None:
+        if self.reader.stack is not None:
+            self.reader.close()

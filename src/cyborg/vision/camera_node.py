@@ -1,0 +1,83 @@
+"""The camera node: plays a frame source on the bus, as a camera driver would.
+
+Publishes, in the node's namespace, ``left/image_raw`` (``bgr8``), and when the source has them
+``right/image_raw`` and ``depth/depth_registered`` (``32FC1`` metres), all three stamped alike
+with the time of publication so subscribers pair them by exact stamp. Files are played at
+``rate`` frames per second (looping when asked); a camera at its own pace. On the robot a
+ZED driver publishes the same; in simulation this node stands in for it with recorded frames.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from cyborg.bus import Node, Qos
+from cyborg.vision.frames import FrameSource, VisionError
+from cyborg.vision.image_messages import bgr_to_image, depth_to_image
+
+log = logging.getLogger(__name__)
+
+IMAGE_TOPIC, RIGHT_TOPIC, DEPTH_TOPIC = "left/image_raw", "right/image_raw", \
+    "depth/depth_registered"
+
+
+class CameraNode:
+    """Publishes a source's frames from a thread of its own until stopped or exhausted."""
+
+    def __init__(self, node: Node, open_source: Callable[[], FrameSource], *, rate: float = 15.0,
+                 loop: bool = True, frame_id: str = "camera_left",
+                 now_ns: Callable[[], int] = time.time_ns) -> None:
+        self.node, self.open_source = node, open_source
+        self.rate, self.loop, self.frame_id, self.now_ns = rate, loop, frame_id, now_ns
+        qos = Qos(depth=2)
+        self.image = node.create_publisher(IMAGE_TOPIC, "sensor_msgs/msg/Image", qos)
+        self.right = node.create_publisher(RIGHT_TOPIC, "sensor_msgs/msg/Image", qos)
+        self.depth = node.create_publisher(DEPTH_TOPIC, "sensor_msgs/msg/Image", qos)
+        self.published = 0
+        self.error: VisionError | None = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True,
+                                        name=f"cyborg-camera{node.fq_name}")
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def _run(self) -> None:
+        period = 1.0 / self.rate if self.rate > 0 else 0.0
+        deadline = time.monotonic()
+        try:
+            while not self._stop.is_set():
+                with self.open_source() as source:
+                    played = 0
+                    for frame in source:
+                        if self._stop.is_set():
+                            return
+                        self._publish(frame.left, frame.right, frame.depth)
+                        played += 1
+                        deadline += period
+                        self._stop.wait(max(0.0, deadline - time.monotonic()))
+                if not self.loop or played == 0:
+                    return
+        except VisionError as exc:
+            self.error = exc
+            log.error("%s: %s", self.node.fq_name, exc)
+
+    def _publish(self, left: np.ndarray, right: np.ndarray | None,
+                 depth: np.ndarray | None) -> None:
+        types, stamp = self.node.types, self.now_ns()
+        self.image.publish(bgr_to_image(types, left, stamp, self.frame_id))
+        if right is not None:
+            self.right.publish(bgr_to_image(types, right, stamp, self.frame_id))
+        if depth is not None:
+            self.depth.publish(depth_to_image(types, depth, stamp, self.frame_id))
+        self.published += 1
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread.is_alive() and threading.current_thread() is not self._thread:
+            self._thread.join(2.0)

@@ -1,0 +1,179 @@
+"""The detector: an image in, labelled boxes out, with the time each stage took.
+
+    detector = Detector.open(Path("yolox_nano.onnx"))           # layout from the model
+    detections = detector.detect(image)                         # BGR uint8, any size
+    detector.confidence = 0.6                                   # changeable while running
+
+One :class:`Detector` letterboxes the image (:mod:`~cyborg.vision.letterbox`), runs the network
+on a backend (:mod:`~cyborg.vision.backends`), decodes the family's output
+(:mod:`~cyborg.vision.layouts`), keeps the classes asked for, and applies class-aware
+non-maximum suppression — overlapping boxes of one class collapse to the best one, while a
+person in front of a car keeps both boxes.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from cyborg.vision.backends import Backend, OnnxRuntimeBackend, OpenCvBackend
+from cyborg.vision.frames import VisionError, check_image
+from cyborg.vision.labels import COCO, label_of, read_labels
+from cyborg.vision.layouts import Candidates, Layout, decode, guess_layout, layout_named
+from cyborg.vision.letterbox import InputFormat, Letterbox, Preprocessor
+
+FORMATS = {Layout.YOLOX: InputFormat(rgb=False, scale=1.0, centred=False),
+           Layout.YOLOV5: InputFormat(rgb=True, scale=1 / 255, centred=True),
+           Layout.YOLOV8: InputFormat(rgb=True, scale=1 / 255, centred=True),
+           Layout.END2END: InputFormat(rgb=True, scale=1 / 255, centred=True),
+           Layout.DARKNET: InputFormat(rgb=True, scale=1 / 255, centred=True)}
+"""The input each family was trained on (channel order set per family, never left implicit)."""
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One object: its class, confidence and box in image pixels, and its distance.
+
+    ``distance`` is in metres, NaN when unknown (no depth, or no valid depth in the box);
+    ``depth_fraction`` is the share of sampled depth pixels that were valid.
+    """
+
+    label: str
+    class_id: int
+    confidence: float
+    box: tuple[float, float, float, float]  # x1, y1, x2, y2
+    distance: float = math.nan
+    depth_fraction: float = 0.0
+
+    @property
+    def corners(self) -> tuple[tuple[float, float], ...]:
+        """Top-left, top-right, bottom-right, bottom-left (the 2018 polygon order)."""
+        x1, y1, x2, y2 = self.box
+        return (x1, y1), (x2, y1), (x2, y2), (x1, y2)
+
+
+@dataclass
+class StageTimes:
+    """Seconds spent per stage on the last frame."""
+
+    preprocess: float = 0.0
+    inference: float = 0.0
+    postprocess: float = 0.0
+    extra: dict[str, float] = field(default_factory=dict)
+
+
+class Detector:
+    """A YOLO-family detector on one backend. Thread-compatible, not thread-safe."""
+
+    def __init__(self, backend: Backend, *, layout: Layout | None = None,
+                 labels: tuple[str, ...] = COCO, confidence: float = 0.5, iou: float = 0.45,
+                 classes: frozenset[str] = frozenset(), max_detections: int = 100,
+                 model_name: str = "") -> None:
+        self.backend = backend
+        self.labels = labels
+        self.input_hw = backend.input_hw
+        self.model_name = model_name or backend.name
+        probe = backend.run(np.zeros((1, 3, *self.input_hw), dtype=np.float32))  # warm-up
+        self.output_shape = tuple(int(size) for size in probe.shape)
+        self.layout = layout or guess_layout(self.output_shape, len(labels), self.input_hw,
+                                             model_name)
+        self.preprocessor = Preprocessor(self.input_hw, FORMATS[self.layout])
+        self.confidence, self.iou = confidence, iou
+        self.classes = classes
+        self.max_detections = max_detections
+        self.times = StageTimes()
+        decode(self.layout, probe, self.input_hw, 1.1)  # a wrong layout fails here, clearly
+
+    @staticmethod
+    def open(model: Path, *, backend: str = "onnxruntime", family: str | None = None,
+             weights: Path | None = None, labels: Path | None = None, threads: int = 0,
+             input_size: int | None = None, confidence: float = 0.5, iou: float = 0.45,
+             classes: frozenset[str] = frozenset()) -> Detector:
+        """A detector for a model file (``.onnx``, or a Darknet ``.cfg`` with ``weights``)."""
+        names = read_labels(labels) if labels is not None else None
+        runner: Backend
+        if model.suffix == ".cfg":
+            runner = OpenCvBackend(model, weights=weights, threads=threads,
+                                   input_size=input_size)
+            family = family or "darknet"
+        elif backend == "onnxruntime":
+            runner = OnnxRuntimeBackend(model, threads=threads, input_size=input_size)
+            names = names or _metadata_labels(runner.metadata)
+        elif backend == "opencv":
+            runner = OpenCvBackend(model, threads=threads, input_size=input_size)
+        else:
+            raise VisionError(f"unknown backend {backend!r}; known: onnxruntime, opencv")
+        return Detector(runner, layout=layout_named(family) if family else None,
+                        labels=names or COCO, confidence=confidence, iou=iou,
+                        classes=classes, model_name=model.name)
+
+    def detect(self, image: np.ndarray) -> list[Detection]:
+        """The objects in one BGR image, best first. Stage times go to :attr:`times`."""
+        check_image(image, "image")
+        started = time.perf_counter()
+        tensor, letterbox = self.preprocessor(image)
+        prepared = time.perf_counter()
+        output = self.backend.run(tensor)
+        inferred = time.perf_counter()
+        detections = self.postprocess(output, letterbox)
+        self.times = StageTimes(prepared - started, inferred - prepared,
+                                time.perf_counter() - inferred)
+        return detections
+
+    def postprocess(self, output: np.ndarray, letterbox: Letterbox) -> list[Detection]:
+        """Decode, keep the wanted classes, suppress overlaps, map boxes to the image."""
+        try:
+            candidates = decode(self.layout, output, self.input_hw, self.confidence)
+        except (IndexError, ValueError) as exc:
+            raise VisionError(f"{self.model_name}: output {list(output.shape)} does not fit "
+                              f"the {self.layout.value} layout ({exc})") from exc
+        if self.classes:
+            candidates = self._keep_classes(candidates)
+        if not len(candidates):
+            return []
+        if self.layout is not Layout.END2END:
+            candidates = self._suppress(candidates)
+        boxes = letterbox.to_image(candidates.boxes)
+        order = np.argsort(-candidates.scores, kind="stable")[: self.max_detections]
+        return [Detection(label_of(self.labels, int(candidates.class_ids[i])),
+                          int(candidates.class_ids[i]), float(candidates.scores[i]),
+                          (float(boxes[i, 0]), float(boxes[i, 1]), float(boxes[i, 2]),
+                           float(boxes[i, 3])))
+                for i in order]
+
+    def _keep_classes(self, candidates: Candidates) -> Candidates:
+        wanted = np.array([label_of(self.labels, int(c)) in self.classes
+                           for c in candidates.class_ids], dtype=bool)
+        return Candidates(candidates.boxes[wanted], candidates.scores[wanted],
+                          candidates.class_ids[wanted])
+
+    def _suppress(self, candidates: Candidates) -> Candidates:
+        """Class-aware non-maximum suppression (boxes of different classes never compete)."""
+        xywh = candidates.boxes.copy()
+        xywh[:, 2:] -= xywh[:, :2]
+        kept = cv2.dnn.NMSBoxesBatched(xywh.tolist(), candidates.scores.tolist(),
+                                       candidates.class_ids.tolist(), self.confidence, self.iou)
+        index = np.asarray(kept, dtype=np.int64).reshape(-1)
+        return Candidates(candidates.boxes[index], candidates.scores[index],
+                          candidates.class_ids[index])
+
+
+def _metadata_labels(metadata: dict[str, str]) -> tuple[str, ...] | None:
+    """Class names an Ultralytics export stores in its metadata (``{0: 'person', ...}``)."""
+    text = metadata.get("names")
+    if not text:
+        return None
+    import ast
+
+    try:
+        names = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return None
+    if isinstance(names, dict) and all(isinstance(key, int) for key in names):
+        return tuple(str(names[key]) for key in sorted(names))
+    return None

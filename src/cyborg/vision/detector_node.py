@@ -1,0 +1,150 @@
+"""The detector node: camera frames from the bus in; predictions, detections and the annotated
+image out.
+
+Subscribes to a colour image topic and, when given, a depth topic (``32FC1`` metres or
+``16UC1`` millimetres) and/or a right-image topic for stereo depth; streams are paired by exact
+header stamp and unpaired messages are counted (:attr:`DetectorNode.dropped`). Publishes, in the
+node's namespace:
+
+==================  ==================================  ========================================
+topic               type                                content
+==================  ==================================  ========================================
+``predictions``     ``cyborg_msgs/msg/Predictions``     the 2018 message (latched, depth 1)
+``detections``      ``vision_msgs/msg/Detection2DArray``  ROS 2's standard message
+``detection_image`` ``sensor_msgs/msg/Image``           the image with boxes, labels, distances
+==================  ==================================  ========================================
+
+When none of the three has a subscriber the network is not run at all (:attr:`skipped` counts
+such frames); the annotated image is drawn only while someone watches it. Runtime parameters:
+``confidence_threshold`` (0..1), ``classes`` (labels to keep; empty: all) and
+``iou_threshold``; ``cyborg param set /cyborg/detector confidence_threshold 0.7``.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from cyborg.bus import Node, Qos
+from cyborg.vision.frames import Frame, VisionError
+from cyborg.vision.image_messages import (
+    bgr_to_image,
+    image_to_bgr,
+    image_to_depth,
+    stamp_ns,
+)
+from cyborg.vision.pairing import ExactPairer
+from cyborg.vision.pipeline import DetectionPipeline, Result
+from cyborg.vision.predictions import detection_array_message, predictions_message
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class CameraTopics:
+    """Where the camera's streams are (``depth`` and ``right`` are optional)."""
+
+    image: str
+    depth: str = ""
+    right: str = ""
+
+
+class DetectorNode:
+    """Runs a :class:`DetectionPipeline` on a node, on frames from the bus."""
+
+    def __init__(self, node: Node, pipeline: DetectionPipeline, topics: CameraTopics, *,
+                 now_ns: Callable[[], int] = time.time_ns) -> None:
+        self.node, self.pipeline, self.topics = node, pipeline, topics
+        self.now_ns = now_ns
+        detector = pipeline.detector
+        params = node.parameters
+        detector.confidence = float(params.declare(
+            "confidence_threshold", detector.confidence, "detections below this are dropped",
+            limits=(0.0, 1.0)))
+        detector.iou = float(params.declare(
+            "iou_threshold", detector.iou, "overlap above which boxes of one class merge",
+            limits=(0.0, 1.0)))
+        detector.classes = frozenset(
+            str(name) for name in params.declare(
+                "classes", [""], "labels to keep (empty: every class)") if name)
+        params.on_set(self._check)
+        params.on_change(self._apply)
+        self.processed = self.skipped = self.failed = 0
+        self.last: Result | None = None
+        self.predictions = node.create_publisher("predictions", "cyborg_msgs/msg/Predictions",
+                                                 Qos.latched())
+        self.detections = node.create_publisher("detections",
+                                                "vision_msgs/msg/Detection2DArray", Qos(depth=5))
+        self.image = node.create_publisher("detection_image", "sensor_msgs/msg/Image",
+                                           Qos(depth=1))
+        streams = ("image",) + (("depth",) if topics.depth else ()) + \
+            (("right",) if topics.right else ())
+        self.pairer = ExactPairer(streams, max_pending=10)
+        for stream in streams:
+            topic = getattr(topics, stream)
+            node.create_subscription(topic, "sensor_msgs/msg/Image",
+                                     self._receiver(stream, topic), Qos(depth=2))
+
+    @property
+    def dropped(self) -> int:
+        return self.pairer.dropped
+
+    def _check(self, changes: dict[str, Any]) -> None:
+        labels = set(self.pipeline.detector.labels)
+        unknown = [name for name in changes.get("classes", []) if name and name not in labels]
+        if unknown:
+            raise ValueError(f"classes: unknown labels {', '.join(map(repr, unknown))}")
+
+    def _apply(self, changes: dict[str, Any]) -> None:
+        detector = self.pipeline.detector
+        if "confidence_threshold" in changes:
+            detector.confidence = float(changes["confidence_threshold"])
+        if "iou_threshold" in changes:
+            detector.iou = float(changes["iou_threshold"])
+        if "classes" in changes:
+            detector.classes = frozenset(str(name) for name in changes["classes"] if name)
+
+    def _receiver(self, stream: str, topic: str) -> Callable[[Any], None]:
+        def receive(message: Any) -> None:
+            complete = self.pairer.add(stream, stamp_ns(message.header), message)
+            if complete is not None:
+                self._on_frame(complete)
+        return receive
+
+    def watched(self) -> bool:
+        return any(publisher.subscription_count() > 0
+                   for publisher in (self.predictions, self.detections, self.image))
+
+    def _on_frame(self, messages: dict[str, Any]) -> None:
+        if not self.watched():
+            self.skipped += 1
+            return
+        image_message = messages["image"]
+        try:
+            frame = Frame(stamp_ns(image_message.header),
+                          image_to_bgr(image_message, self.topics.image),
+                          image_to_bgr(messages["right"], self.topics.right)
+                          if "right" in messages else None,
+                          image_to_depth(messages["depth"], self.topics.depth)
+                          if "depth" in messages else None,
+                          frame_id=str(image_message.header.frame_id))
+            result = self.pipeline.process(frame, draw=self.image.subscription_count() > 0)
+        except VisionError as exc:
+            self.failed += 1
+            if self.failed == 1 or self.failed % 100 == 0:
+                log.warning("%s: frame dropped (%d so far): %s", self.node.fq_name,
+                            self.failed, exc)
+            return
+        self.processed += 1
+        self.last = result
+        types = self.node.types
+        self.predictions.publish(predictions_message(types, result.detections,
+                                                     image_message.header, self.now_ns()))
+        self.detections.publish(detection_array_message(types, result.detections,
+                                                        image_message.header))
+        if result.annotated is not None:
+            self.image.publish(bgr_to_image(types, result.annotated, frame.stamp_ns,
+                                            frame.frame_id))

@@ -1,0 +1,102 @@
+"""``sensor_msgs/Image`` and ``CompressedImage`` to numpy and back.
+
+Colour images become BGR ``uint8`` (height x width x 3): ``bgr8``, ``rgb8``, ``bgra8``,
+``rgba8``, ``mono8`` and ``8UC3`` are read. Depth images become ``float32`` metres following
+REP 118: ``32FC1`` is metres, ``16UC1``/``mono16`` millimetres (0 = unknown → NaN). Rows padded
+beyond ``width`` (``step`` larger than a row) are handled. Reading gives views where it can.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+
+from cyborg.vision.depth import depth_in_metres
+from cyborg.vision.frames import VisionError
+
+_COLOUR = {"bgr8": (3, None), "8UC3": (3, None), "rgb8": (3, cv2.COLOR_RGB2BGR),
+           "bgra8": (4, cv2.COLOR_BGRA2BGR), "rgba8": (4, cv2.COLOR_RGBA2BGR),
+           "mono8": (1, cv2.COLOR_GRAY2BGR), "8UC1": (1, cv2.COLOR_GRAY2BGR)}
+_DEPTH: dict[str, np.dtype[Any]] = {"32FC1": np.dtype("<f4"), "16UC1": np.dtype("<u2"),
+                                    "mono16": np.dtype("<u2")}
+
+
+def stamp_ns(header: Any) -> int:
+    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+
+
+def _rows(message: Any, dtype: np.dtype, channels: int, topic: str) -> np.ndarray:
+    height, width, step = int(message.height), int(message.width), int(message.step)
+    row_bytes = width * channels * dtype.itemsize
+    data = np.asarray(message.data, dtype=np.uint8).reshape(-1)
+    if height == 0 or width == 0 or step < row_bytes or data.size < step * (height - 1) \
+            + row_bytes:
+        raise VisionError(f"{topic}: image of {width}x{height} {message.encoding} with step "
+                          f"{step} needs {step * height} bytes, the message has {data.size}")
+    if getattr(message, "is_bigendian", 0) and dtype.itemsize > 1:
+        dtype = dtype.newbyteorder(">")
+    if step == row_bytes:
+        pixels = data[: height * step].view(dtype)
+    else:
+        padded = np.lib.stride_tricks.as_strided(data, (height, row_bytes), (step, 1))
+        pixels = np.ascontiguousarray(padded).reshape(-1).view(dtype)
+    shape = (height, width, channels) if channels > 1 else (height, width)
+    return pixels.reshape(shape)
+
+
+def image_to_bgr(message: Any, topic: str = "image") -> np.ndarray:
+    """A colour ``sensor_msgs/Image`` as a BGR ``uint8`` array (a view for ``bgr8``)."""
+    encoding = str(message.encoding)
+    if encoding not in _COLOUR:
+        raise VisionError(f"{topic}: image encoding {encoding!r} is not a colour encoding "
+                          f"({', '.join(_COLOUR)})")
+    channels, conversion = _COLOUR[encoding]
+    pixels = _rows(message, np.dtype(np.uint8), channels, topic)
+    return pixels if conversion is None else cv2.cvtColor(pixels, conversion)
+
+
+def image_to_depth(message: Any, topic: str = "depth") -> np.ndarray:
+    """A depth ``sensor_msgs/Image`` as ``float32`` metres (NaN where unknown)."""
+    encoding = str(message.encoding)
+    if encoding not in _DEPTH:
+        raise VisionError(f"{topic}: depth encoding {encoding!r}; expected 32FC1 (metres) "
+                          "or 16UC1 (millimetres)")
+    return depth_in_metres(np.asarray(_rows(message, _DEPTH[encoding], 1, topic)).astype(
+        _DEPTH[encoding].newbyteorder("="), copy=False), topic)
+
+
+def compressed_to_bgr(message: Any, topic: str = "image") -> np.ndarray:
+    """A ``sensor_msgs/CompressedImage`` (JPEG, PNG) decoded to BGR."""
+    data = np.asarray(message.data, dtype=np.uint8)
+    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if image is None:
+        raise VisionError(f"{topic}: compressed image ({message.format or 'no format'}, "
+                          f"{data.size} bytes) cannot be decoded")
+    return image
+
+
+def header(types: Any, stamp: int, frame_id: str) -> Any:
+    time_class = types.message_class("builtin_interfaces/msg/Time")
+    return types.message_class("std_msgs/msg/Header")(
+        stamp=time_class(sec=stamp // 1_000_000_000, nanosec=stamp % 1_000_000_000),
+        frame_id=frame_id)
+
+
+def bgr_to_image(types: Any, image: np.ndarray, stamp: int, frame_id: str) -> Any:
+    """A ``bgr8`` ``sensor_msgs/Image`` sharing ``image``'s memory when it is contiguous."""
+    pixels = np.ascontiguousarray(image)
+    height, width = pixels.shape[:2]
+    return types.message_class("sensor_msgs/msg/Image")(
+        header=header(types, stamp, frame_id), height=height, width=width, encoding="bgr8",
+        is_bigendian=0, step=width * 3, data=pixels.reshape(-1))
+
+
+def depth_to_image(types: Any, depth: np.ndarray, stamp: int, frame_id: str) -> Any:
+    """A ``32FC1`` ``sensor_msgs/Image`` of depth in metres."""
+    metres = np.ascontiguousarray(depth, dtype=np.float32)
+    height, width = metres.shape
+    return types.message_class("sensor_msgs/msg/Image")(
+        header=header(types, stamp, frame_id), height=height, width=width, encoding="32FC1",
+        is_bigendian=0, step=width * 4, data=metres.reshape(-1).view(np.uint8))

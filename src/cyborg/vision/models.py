@@ -1,0 +1,130 @@
+"""Finding model files, and fetching known ones with their checksum verified.
+
+A model is given by path, or by name (``yolox_nano``) and then looked for, in order, in the
+folder named by ``CYBORG_MODELS``, in ``$CYBORG_SHARED/models`` when that is set, and in the
+user's cache (``~/.cache/cyborg/models``, or ``$XDG_CACHE_HOME/cyborg/models``).
+
+``cyborg detect models fetch yolox_nano`` downloads a known model into the cache (or
+``--dir``), checks its SHA-256 against the catalogue and only then moves it into place, so a
+failed or tampered download never leaves a file behind.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+import urllib.error
+import urllib.request
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from cyborg.vision.frames import VisionError
+
+DEFAULT_MODEL = "yolox_nano"
+
+
+@dataclass(frozen=True)
+class KnownModel:
+    name: str
+    url: str
+    sha256: str
+    size: int
+    family: str
+    licence: str
+    description: str
+
+    @property
+    def filename(self) -> str:
+        return f"{self.name}.onnx"
+
+
+CATALOGUE = {model.name: model for model in (
+    KnownModel("yolox_nano",
+               "https://github.com/Megvii-BaseDetection/YOLOX/releases/download/0.1.1rc0/"
+               "yolox_nano.onnx",
+               "c789161ed43c8269fcd4e67c67eeeb4e80c622da2eb296a20bc6007bd18a0b7d", 3_659_407,
+               "yolox", "Apache-2.0",
+               "YOLOX-Nano, COCO 80 classes, 416x416 input, 0.91 M parameters"),
+)}
+"""Models ``cyborg detect models fetch`` knows, with where they come from and their hash."""
+
+
+def model_dirs() -> list[Path]:
+    """Folders searched for models by name, in order."""
+    dirs = []
+    if os.environ.get("CYBORG_MODELS"):
+        dirs.append(Path(os.environ["CYBORG_MODELS"]).expanduser())
+    if os.environ.get("CYBORG_SHARED"):
+        dirs.append(Path(os.environ["CYBORG_SHARED"]).expanduser() / "models")
+    dirs.append(cache_dir())
+    return dirs
+
+
+def cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "cyborg" / "models"
+
+
+def find_model(name_or_path: str) -> Path:
+    """The model file for a path or a model name; a clear error saying where it looked."""
+    path = Path(name_or_path).expanduser()
+    if path.suffix in (".onnx", ".cfg") or "/" in name_or_path:
+        if not path.is_file():
+            raise VisionError(f"model file {path}: not found")
+        return path
+    searched = model_dirs()
+    for folder in searched:
+        for candidate in (folder / f"{name_or_path}.onnx", folder / name_or_path):
+            if candidate.is_file():
+                return candidate
+    hint = (f"; fetch it with `cyborg detect models fetch {name_or_path}`"
+            if name_or_path in CATALOGUE else
+            f"; known models: {', '.join(CATALOGUE)}, or give a path to an .onnx file")
+    raise VisionError(f"model {name_or_path!r} not found in "
+                      f"{', '.join(str(folder) for folder in searched)}{hint}")
+
+
+def fetch(model: KnownModel, folder: Path | None = None, *, url: str | None = None,
+          progress: Callable[[int, int], None] | None = None, timeout: float = 60.0) -> Path:
+    """Download ``model`` into ``folder`` (default: the cache), verified by its SHA-256."""
+    folder = folder or cache_dir()
+    target = folder / model.filename
+    if target.is_file() and _sha256(target) == model.sha256:
+        return target
+    folder.mkdir(parents=True, exist_ok=True)
+    source = url or model.url
+    digest = hashlib.sha256()
+    handle, temporary = tempfile.mkstemp(prefix=f".{model.name}.", suffix=".part", dir=folder)
+    try:
+        with os.fdopen(handle, "wb") as out, urllib.request.urlopen(source,
+                                                                    timeout=timeout) as reply:
+            total = int(reply.headers.get("Content-Length") or model.size)
+            done = 0
+            while chunk := reply.read(1 << 16):
+                out.write(chunk)
+                digest.update(chunk)
+                done += len(chunk)
+                if progress is not None:
+                    progress(done, total)
+        if digest.hexdigest() != model.sha256:
+            raise VisionError(f"{source}: SHA-256 {digest.hexdigest()} does not match the "
+                              f"expected {model.sha256} for {model.name}; the file was not "
+                              "kept")
+        os.replace(temporary, target)
+        return target
+    except (urllib.error.URLError, OSError) as exc:
+        reason = getattr(exc, "reason", None) or exc
+        raise VisionError(f"cannot download {model.name} from {source}: {reason}") from exc
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+
+
+def _sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with path.open("rb") as file:
+        while chunk := file.read(1 << 20):
+            digest.update(chunk)
+    return digest.hexdigest()

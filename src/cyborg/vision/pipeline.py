@@ -1,0 +1,74 @@
+"""Frame in, detections with distances out: the detector plus depth, timed per stage.
+
+    pipeline = DetectionPipeline(Detector.open(model), stereo=StereoDepth(calibration))
+    result = pipeline.process(frame)      # frame: image + depth map, or a stereo pair
+    for detection in result.detections:
+        print(detection.label, detection.distance)
+
+Depth comes from the frame's depth map when it has one, else from its stereo pair when the
+pipeline has a :class:`~cyborg.vision.depth.StereoDepth`, else distances are NaN (unknown).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cyborg.vision.annotate import annotate
+from cyborg.vision.depth import StereoDepth
+from cyborg.vision.detector import Detection, Detector
+from cyborg.vision.distance import box_distance
+from cyborg.vision.frames import Frame
+
+STAGES = ("depth", "preprocess", "inference", "postprocess", "distance", "drawing")
+
+
+@dataclass
+class Result:
+    """The detections of one frame, its depth map (if any) and seconds per stage."""
+
+    frame: Frame
+    detections: list[Detection]
+    depth: np.ndarray | None
+    times: dict[str, float] = field(default_factory=dict)
+    annotated: np.ndarray | None = None
+
+
+class DetectionPipeline:
+    """A detector, depth for distances, and the annotated image when asked for."""
+
+    def __init__(self, detector: Detector, *, stereo: StereoDepth | None = None,
+                 inner: float = 0.5, max_stride: int = 4) -> None:
+        self.detector, self.stereo = detector, stereo
+        self.inner, self.max_stride = inner, max_stride
+
+    def depth_of(self, frame: Frame) -> np.ndarray | None:
+        if frame.depth is not None:
+            return frame.depth
+        if frame.right is not None and self.stereo is not None:
+            return self.stereo.depth(frame.left, frame.right)
+        return None
+
+    def process(self, frame: Frame, *, draw: bool = False) -> Result:
+        started = time.perf_counter()
+        depth = self.depth_of(frame)
+        depth_done = time.perf_counter()
+        detections = self.detector.detect(frame.left)
+        detected = time.perf_counter()
+        if depth is not None:
+            detections = [dataclasses.replace(detection, distance=median, depth_fraction=share)
+                          for detection in detections
+                          for median, share in [box_distance(depth, detection.box,
+                                                             inner=self.inner,
+                                                             max_stride=self.max_stride)]]
+        measured = time.perf_counter()
+        annotated = annotate(frame.left, detections) if draw else None
+        drawn = time.perf_counter()
+        stage = self.detector.times
+        return Result(frame, detections, depth, {
+            "depth": depth_done - started, "preprocess": stage.preprocess,
+            "inference": stage.inference, "postprocess": stage.postprocess,
+            "distance": measured - detected, "drawing": drawn - measured}, annotated)

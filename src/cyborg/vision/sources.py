@@ -1,0 +1,79 @@
+"""Opening a camera source from a short description, as ``cyborg detect SOURCE`` takes it.
+
+====================================  ==========================================================
+SOURCE                                what is read
+====================================  ==========================================================
+``photo.png``                         one image (``--right``, ``--depth`` add its pair/depth)
+``frames/``                           a folder of images (``left/``, ``right/``, ``depth/``
+                                      subfolders are paired by file name)
+``ride.mp4``                          a video file (``--side-by-side`` for ZED recordings)
+``left.png,right.png``                a stereo pair of images, or of videos
+``recording.bag``, ``rosbag2_dir/``   a ROS 1 bag, a ROS 2 bag (``.db3`` or ``.mcap``)
+``camera:0`` (or ``0``)               a local camera through OpenCV
+``bus:/cyborg/camera/left/image_raw``  camera topics on the bus (``--depth-topic``)
+====================================  ==========================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from cyborg.vision.bag_source import BagSource, is_bag
+from cyborg.vision.file_sources import DEFAULT_RATE, FolderSource, ImageSource, VideoSource
+from cyborg.vision.frames import FrameSource, VisionError
+from cyborg.vision.image_files import IMAGE_SUFFIXES, VIDEO_SUFFIXES
+
+
+@dataclass(frozen=True)
+class SourceOptions:
+    """What a bare path cannot say: partners of an image, stereo packing, bag topics."""
+
+    right: Path | None = None
+    depth: Path | None = None
+    side_by_side: bool = False
+    rate: float = DEFAULT_RATE
+    image_topic: str | None = None
+    depth_topic: str | None = None
+    right_topic: str | None = None
+
+
+def camera_index(spec: str) -> int | None:
+    """The device number of ``camera:N`` or ``N``, else None."""
+    text = spec.removeprefix("camera:")
+    return int(text) if text.isdigit() and (text != spec or spec.isdigit()) else None
+
+
+def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
+    """The frame source ``spec`` names (see the module's table); ``bus:`` is opened by the
+    caller, which owns a bus node."""
+    options = options or SourceOptions()
+    index = camera_index(spec)
+    if index is not None:
+        return VideoSource(index, side_by_side=options.side_by_side)
+    if spec.startswith("bus:"):
+        raise VisionError(f"{spec}: bus sources need a bus node (open them with BusSource)")
+    if "," in spec and not Path(spec).exists():
+        left_text, _, right_text = spec.partition(",")
+        left, right = Path(left_text), Path(right_text)
+        if left.suffix.lower() in VIDEO_SUFFIXES:
+            return VideoSource(left, right=right)
+        return ImageSource(left, right=right, depth=options.depth)
+    path = Path(spec).expanduser()
+    if is_bag(path):
+        return BagSource(path, image_topic=options.image_topic, depth_topic=options.depth_topic,
+                         right_topic=options.right_topic)
+    if path.is_dir():
+        return FolderSource(path, rate=options.rate, side_by_side=options.side_by_side)
+    if not path.exists():
+        raise VisionError(f"source {spec}: not found (a file, folder, bag, 'camera:N' or "
+                          "'bus:TOPIC')")
+    suffix = path.suffix.lower()
+    if suffix in VIDEO_SUFFIXES:
+        return VideoSource(path, side_by_side=options.side_by_side)
+    if suffix in IMAGE_SUFFIXES:
+        return ImageSource(path, right=options.right, depth=options.depth,
+                           side_by_side=options.side_by_side)
+    raise VisionError(f"source {spec}: unknown kind of file {suffix!r} (images: "
+                      f"{', '.join(sorted(IMAGE_SUFFIXES))}; videos: "
+                      f"{', '.join(sorted(VIDEO_SUFFIXES))}; bags: .bag, .db3, .mcap)")
