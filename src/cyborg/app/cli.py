@@ -17,6 +17,8 @@
     cyborg param list|get|set      parameters of a node
     cyborg sim --map FILE          the simulated robot on an ARNL map, on the bus
     cyborg nav goals|plan FILE     goals of a map; plan a path and print its length
+    cyborg detect SOURCE           objects and their distance in images, videos, bags, topics
+    cyborg detect models list|fetch   known detector models
 
 Exit codes: 0 success, 1 the input has errors, 2 wrong usage, 130 interrupted.
 """
@@ -29,7 +31,14 @@ import sys
 from collections.abc import Sequence
 
 from cyborg import __version__
-from cyborg.app import bt_commands, bus_commands, monitor_commands, sim_commands, up
+from cyborg.app import (
+    bt_commands,
+    bus_commands,
+    detect_commands,
+    monitor_commands,
+    sim_commands,
+    up,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -44,6 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     bt_commands.add_parser(commands)
     bus_commands.add_parser(commands)
     sim_commands.add_parser(commands)
+    detect_commands.add_parser(commands)
     return parser
 
 

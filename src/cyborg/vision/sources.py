@@ -11,6 +11,7 @@ SOURCE                                what is read
 ``recording.bag``, ``rosbag2_dir/``   a ROS 1 bag, a ROS 2 bag (``.db3`` or ``.mcap``)
 ``camera:0`` (or ``0``)               a local camera through OpenCV
 ``bus:/cyborg/camera/left/image_raw``  camera topics on the bus (``--depth-topic``)
+``sample:motorcycle``                 sample data from scikit-image (:mod:`.samples`)
 ====================================  ==========================================================
 """
 
@@ -23,6 +24,7 @@ from cyborg.vision.bag_source import BagSource, is_bag
 from cyborg.vision.file_sources import DEFAULT_RATE, FolderSource, ImageSource, VideoSource
 from cyborg.vision.frames import FrameSource, VisionError
 from cyborg.vision.image_files import IMAGE_SUFFIXES, VIDEO_SUFFIXES
+from cyborg.vision.samples import SampleSource
 
 
 @dataclass(frozen=True)
@@ -51,6 +53,8 @@ def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
     index = camera_index(spec)
     if index is not None:
         return VideoSource(index, side_by_side=options.side_by_side)
+    if spec.startswith("sample:"):
+        return SampleSource(spec.removeprefix("sample:"))
     if spec.startswith("bus:"):
         raise VisionError(f"{spec}: bus sources need a bus node (open them with BusSource)")
     if "," in spec and not Path(spec).exists():
@@ -66,8 +70,8 @@ def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
     if path.is_dir():
         return FolderSource(path, rate=options.rate, side_by_side=options.side_by_side)
     if not path.exists():
-        raise VisionError(f"source {spec}: not found (a file, folder, bag, 'camera:N' or "
-                          "'bus:TOPIC')")
+        raise VisionError(f"source {spec}: not found (a file, folder, bag, 'camera:N', "
+                          "'sample:NAME' or 'bus:TOPIC')")
     suffix = path.suffix.lower()
     if suffix in VIDEO_SUFFIXES:
         return VideoSource(path, side_by_side=options.side_by_side)
