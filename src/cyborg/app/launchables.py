@@ -17,6 +17,8 @@ kind            parameters (default)
 ``monitor``     ``trees`` (tree runner namespaces, ["/cyborg/bt"]), ``port`` (8080; 0 = any
                 free port), ``host`` (0.0.0.0), ``token`` (control from other machines;
                 default ``$CYBORG_MONITOR_TOKEN``)
+``camera``,     see :mod:`cyborg.app.vision_launchables`
+``detector``
 ==============  ================================================================================
 
 A user's own kind is given as ``"package.module:function"`` with the same signature.
@@ -26,12 +28,15 @@ from __future__ import annotations
 
 import importlib
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
+from cyborg.app.node_spec import LaunchError, NodeSpec, Running, Starter
+from cyborg.app.vision_launchables import start_camera, start_detector
 from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
+
+__all__ = ["KINDS", "LaunchError", "NodeSpec", "Running", "RunningMonitor", "RunningSimulator",
+           "RunningTree", "Starter", "starter_for"]
 from cyborg.bus import Context, Node, SimClock
 from cyborg.monitor import DEFAULT_PORT, Monitor, MonitorError
 from cyborg.nav.arnl_map import MapError, read_map
@@ -41,40 +46,6 @@ from cyborg.sim.battery import Battery
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
-
-
-class LaunchError(ValueError):
-    """A launch description that cannot be started; the message says where and why."""
-
-
-@dataclass
-class NodeSpec:
-    """One entry of a launch description."""
-
-    kind: str
-    name: str
-    namespace: str = "/"
-    parameters: dict[str, Any] = field(default_factory=dict)
-    process: str = "main"
-    base: Path = Path(".")
-    """Folder that relative paths in parameters are relative to (the launch file's)."""
-    where: str = ""
-    """Where the entry was written (``file: node 2``), for error messages."""
-
-    def path(self, value: str) -> Path:
-        path = Path(value).expanduser()
-        return path if path.is_absolute() else self.base / path
-
-    def error(self, message: str) -> LaunchError:
-        return LaunchError(f"{self.where or self.name}: {message}")
-
-
-class Running(Protocol):
-    def describe(self) -> str: ...
-    def stop(self) -> None: ...
-
-
-Starter = Callable[[Context, NodeSpec], Running]
 
 
 # ---------------------------------------------------------------------------------- simulator
@@ -233,7 +204,8 @@ def start_monitor(context: Context, spec: NodeSpec) -> RunningMonitor:
 
 
 KINDS: dict[str, Starter] = {"simulator": start_simulator, "tree_runner": start_tree_runner,
-                             "monitor": start_monitor}
+                             "monitor": start_monitor, "camera": start_camera,
+                             "detector": start_detector}
 
 
 def starter_for(spec: NodeSpec) -> Starter:

@@ -4,9 +4,10 @@
 the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn by the project in
 ARNL format) with its navigation services, the tree runner with the bundled
 patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
-time, and the web monitor (http://127.0.0.1:8080/, ``--monitor-port``). ``--map``, ``--tree``
-and ``--speed`` swap the inputs. It prints what runs and where, then
-a live line of what the tree does; Ctrl-C stops everything cleanly.
+time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``), and a camera playing
+sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
+``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. It prints what runs
+and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
 
 ``cyborg launch FILE`` starts what a launch description lists (see :mod:`cyborg.app.launch`).
 """
@@ -24,6 +25,7 @@ from cyborg.app.launch import Launch, LaunchDescription, read_launch
 from cyborg.app.launchables import LaunchError, NodeSpec, RunningTree
 from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
 from cyborg.app.status_line import StatusLine
+from cyborg.app.up_vision import add_vision_options, vision_nodes
 
 DATA = files("cyborg.app").joinpath("data")
 CAMPUS_MAP = "campus.map"
@@ -49,6 +51,7 @@ def add_parser(commands: Any) -> None:
     up.add_argument("--monitor-port", type=int, default=8080, metavar="PORT",
                     help="port of the web monitor (default 8080; 0: any free port)")
     up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
+    add_vision_options(up)
     add_bus_options(up)
     up.set_defaults(handler=up_command)
 
@@ -92,6 +95,7 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
                  {"tree_file": str(tree_path), "use_sim_time": True,
                   "robot_namespace": namespace}, where="tree runner"),
     ]
+    nodes += vision_nodes(args, namespace)
     return LaunchDescription(nodes, list(args.connect), args.listen or DEFAULT_ROUTER)
 
 

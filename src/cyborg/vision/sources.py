@@ -43,7 +43,8 @@ class SourceOptions:
 def camera_index(spec: str) -> int | None:
     """The device number of ``camera:N`` or ``N``, else None."""
     text = spec.removeprefix("camera:")
-    return int(text) if text.isdigit() and (text != spec or spec.isdigit()) else None
+    # ASCII digits only: str.isdigit() also takes '²', which int() refuses
+    return int(text) if text.isascii() and text.isdigit() else None
 
 
 def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
@@ -53,13 +54,15 @@ def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
     index = camera_index(spec)
     if index is not None:
         return VideoSource(index, side_by_side=options.side_by_side)
+    if spec.startswith("camera:"):
+        raise VisionError(f"{spec}: a camera is 'camera:N', N its device number (0, 1, ...)")
     if spec.startswith("sample:"):
         return SampleSource(spec.removeprefix("sample:"))
     if spec.startswith("bus:"):
         raise VisionError(f"{spec}: bus sources need a bus node (open them with BusSource)")
     if "," in spec and not Path(spec).exists():
         left_text, _, right_text = spec.partition(",")
-        left, right = Path(left_text), Path(right_text)
+        left, right = (Path(text.strip()).expanduser() for text in (left_text, right_text))
         if left.suffix.lower() in VIDEO_SUFFIXES:
             return VideoSource(left, right=right)
         return ImageSource(left, right=right, depth=options.depth)
