@@ -28,6 +28,18 @@ def shared() -> Path:
     return shared_dir()
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _models_from_shared() -> Iterator[None]:
+    """Programs the tests start (``cyborg up``, ``cyborg detect``) find the shared detector model
+    instead of downloading one."""
+    if "CYBORG_MODELS" not in os.environ and (shared_dir() / "models").is_dir():
+        os.environ["CYBORG_MODELS"] = str(shared_dir() / "models")
+        yield
+        del os.environ["CYBORG_MODELS"]
+    else:
+        yield
+
+
 @pytest.fixture(autouse=True)
 def _restore_registered_nodes() -> Iterator[None]:
     """Nodes a test registers with @register do not leak into other tests."""
