@@ -188,7 +188,7 @@ def test_fetch_checks_the_sha256_and_keeps_nothing_on_a_mismatch(tmp_path: Path,
     assert path == tmp_path / "models" / "yolox_nano.onnx"
     assert path.read_bytes() == MODEL.read_bytes()
     assert seen[-1] == (MODEL.stat().st_size, MODEL.stat().st_size)
-    with pytest.raises(VisionError, match="cannot download yolox_nano from .*missing.onnx"):
+    with pytest.raises(VisionError, match=r"cannot download yolox_nano from .*missing\.onnx"):
         fetch(same, tmp_path / "other", url=f"{http_server}/missing.onnx")
     assert list((tmp_path / "other").iterdir()) == []
 
@@ -198,8 +198,8 @@ def test_models_are_found_by_path_or_name(tmp_path: Path, monkeypatch: pytest.Mo
     monkeypatch.setenv("CYBORG_MODELS", str(tmp_path))
     monkeypatch.delenv("CYBORG_SHARED", raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    with pytest.raises(VisionError, match="model 'yolox_nano' not found in .*cyborg detect "
-                                          "models fetch yolox_nano"):
+    with pytest.raises(VisionError, match=r"model 'yolox_nano' not found in .*cyborg detect "
+                                          r"models fetch yolox_nano"):
         find_model("yolox_nano")
     (tmp_path / "yolox_nano.onnx").write_bytes(b"x")
     assert find_model("yolox_nano") == tmp_path / "yolox_nano.onnx"
