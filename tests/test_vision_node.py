@@ -299,3 +299,31 @@ def test_cyborg_up_detects_the_motorcycle_in_the_sample_stereo_frames() -> None:
         process.terminate()
         process.communicate(timeout=30)
     assert "camera       /cyborg/camera/camera: sample:motorcycle" in "".join(lines)
+
+
+def test_launch_kinds_refuse_bad_sources_and_models_naming_the_entry(bus: Context,
+                                                                       tmp_path: Path) -> None:
+    from cyborg.app.launchables import LaunchError, NodeSpec, starter_for
+
+    def start(kind: str, parameters: dict[str, Any]) -> Any:
+        spec = NodeSpec(kind, kind, "/cyborg", parameters, base=tmp_path,
+                        where=f"robot.toml: node {kind}")
+        return starter_for(spec)(bus, spec)
+
+    with pytest.raises(LaunchError, match=r"robot.toml: node camera: source .*ride\.mp4: not "
+                                          r"found"):
+        start("camera", {"source": "ride.mp4"})
+    with pytest.raises(LaunchError, match="node camera: the camera needs a `source`"):
+        start("camera", {})
+    with pytest.raises(LaunchError, match=r"node detector: model file .*gone\.onnx: not found"):
+        start("detector", {"model": "gone.onnx"})
+    with pytest.raises(LaunchError, match="right_topic needs focal and baseline"):
+        start("detector", {"model": str(MODEL), "right_topic": "/cam/right"})
+    running = start("detector", {"model": str(MODEL), "threads": 1, "classes": ["person"]})
+    assert wait_for(lambda: "/cyborg/detector" in bus.graph.nodes())
+    try:
+        assert "yolox_nano.onnx (yolox, onnxruntime)" in running.describe()
+        assert running.detector.pipeline.detector.classes == frozenset({"person"})
+    finally:
+        running.stop()
+    assert wait_for(lambda: "/cyborg/detector" not in bus.graph.nodes())
