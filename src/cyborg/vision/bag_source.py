@@ -49,19 +49,29 @@ class BagSource(FrameSource):
     def __init__(self, path: Path, *, image_topic: str | None = None,
                  depth_topic: str | None = None, right_topic: str | None = None) -> None:
         from rosbags.highlevel import AnyReader, AnyReaderError
+        from rosbags.typesys import Stores, get_typestore
 
         super().__init__()
         self.name = str(path)
         try:
-            self.reader = AnyReader([_bag_path(path)])
+            # ROS 2 bags before Iron (rosbag2 storage < 8) carry no message definitions: their
+            # sensor_msgs are read with the standard ones
+            self.reader = AnyReader([_bag_path(path)],
+                                    default_typestore=get_typestore(Stores.ROS2_HUMBLE))
             self.reader.open()
         except (AnyReaderError, OSError, ValueError) as exc:
             raise VisionError(f"bag {path}: cannot be read ({exc})") from exc
         image_topics = {c.topic: c.msgtype for c in self.reader.connections
                         if c.msgtype in IMAGE_TYPES}
-        self.topics = self._choose(path, image_topics, image_topic, depth_topic, right_topic)
+        try:
+            self.topics = self._choose(path, image_topics, image_topic, depth_topic,
+                                       right_topic)
+        except VisionError:
+            self.reader.close()
+            raise
         self.length = sum(c.msgcount for c in self.reader.connections
                           if c.topic == self.topics["image"])
+        """The number of image messages: an upper bound when images are paired with depth."""
 
     def _choose(self, path: Path, found: dict[str, str], image: str | None, depth: str | None,
                 right: str | None) -> dict[str, str]:
@@ -69,9 +79,13 @@ class BagSource(FrameSource):
             if given is not None and given not in found:
                 raise VisionError(f"bag {path}: no image topic {given!r}; image topics: "
                                   f"{', '.join(sorted(found)) or 'none'}")
+        if depth is not None and found[depth] != "sensor_msgs/msg/Image":
+            raise VisionError(f"bag {path}: depth topic {depth!r} is a {found[depth]}; depth "
+                              "must be a sensor_msgs/msg/Image (32FC1 or 16UC1)")
         rest = [topic for topic in sorted(found) if topic not in (image, depth, right)]
         if depth is None:
-            depth = next((t for t in rest if "depth" in t.lower()), None)
+            depth = next((t for t in rest if "depth" in t.lower()
+                          and found[t] == "sensor_msgs/msg/Image"), None)
         if right is None:
             right = next((t for t in rest if "right" in t.lower() and t != depth), None)
         if image is None:
@@ -102,15 +116,20 @@ class BagSource(FrameSource):
                 message: Any = self.reader.deserialize(raw, connection.msgtype)
             except Exception as exc:  # rosbags raises several types for bad data
                 raise VisionError(f"{where}: message cannot be decoded ({exc})") from exc
-            stream = streams[connection.topic]
-            complete = pairer.add(stream, stamp_ns(message.header),
-                                  self._convert(stream, message, where))
+            stream, stamp = streams[connection.topic], stamp_ns(message.header)
+            # the frame is named by its image's frame_id, whichever message completes it
+            item = (self._convert(stream, message, where), str(message.header.frame_id))
+            complete = pairer.add(stream, stamp, item)
             self.dropped = pairer.dropped
             if complete is None:
                 continue
-            yield Frame(stamp_ns(message.header), complete["image"], complete.get("right"),
-                        complete.get("depth"), frame_id=str(message.header.frame_id),
-                        index=index)
+            images = {name: pixels for name, (pixels, _) in complete.items()}
+            try:
+                frame = Frame(stamp, images["image"], images.get("right"), images.get("depth"),
+                              frame_id=complete["image"][1], index=index)
+            except VisionError as exc:
+                raise VisionError(f"{self.name} at stamp {stamp}: {exc}") from None
+            yield frame
             index += 1
         pairer.finish()
         self.dropped = pairer.dropped

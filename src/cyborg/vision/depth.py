@@ -27,6 +27,8 @@ def depth_in_metres(depth: np.ndarray, what: str = "depth map") -> np.ndarray:
     """``float32`` metres from a float depth map (metres) or a ``uint16`` one (millimetres)."""
     if not isinstance(depth, np.ndarray) or depth.ndim != 2:
         raise VisionError(f"{what} must be a 2-D array, not {getattr(depth, 'shape', depth)!r}")
+    if not depth.dtype.isnative:  # e.g. a big-endian .npy: same numbers, native order
+        depth = depth.astype(depth.dtype.newbyteorder("="))
     if depth.dtype == np.uint16:
         metres = depth.astype(np.float32) * np.float32(0.001)
         metres[depth == 0] = np.nan
@@ -51,12 +53,13 @@ class StereoCalibration:
                               f"not f={self.focal_px} px, B={self.baseline_m} m")
 
     def depth_from_disparity(self, disparity: np.ndarray) -> np.ndarray:
-        """Depth in metres; NaN where the disparity is not positive or not finite."""
+        """Depth in metres; NaN where the disparity is not positive or not finite (or, with a
+        negative ``doffs``, where ``d + doffs`` is not positive: no depth is negative)."""
         disparity = disparity.astype(np.float32, copy=False)
-        valid = np.isfinite(disparity) & (disparity > 0)
+        shifted = disparity + np.float32(self.doffs_px)
+        valid = np.isfinite(disparity) & (disparity > 0) & (shifted > 0)
         depth = np.full(disparity.shape, np.nan, dtype=np.float32)
-        np.divide(np.float32(self.focal_px * self.baseline_m),
-                  disparity + np.float32(self.doffs_px), out=depth, where=valid)
+        np.divide(np.float32(self.focal_px * self.baseline_m), shifted, out=depth, where=valid)
         return depth
 
 

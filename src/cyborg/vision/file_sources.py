@@ -40,7 +40,7 @@ DEFAULT_RATE = 30.0
 
 def stamp_for(path: Path, index: int, rate: float) -> int:
     stem = path.stem
-    if stem.isdigit() and len(stem) >= 16:
+    if stem.isascii() and stem.isdigit() and len(stem) >= 16:
         return int(stem)
     return round(index * 1e9 / rate)
 
@@ -94,6 +94,8 @@ class FolderSource(FrameSource):
         super().__init__()
         if not folder.is_dir():
             raise VisionError(f"image folder {folder}: not found")
+        if not rate > 0:
+            raise VisionError(f"image folder {folder}: the frame rate must be positive, not {rate}")
         self.name, self.rate, self.side_by_side = str(folder), rate, side_by_side
         left_dir = folder / "left" if (folder / "left").is_dir() else folder
         self.left = _files(left_dir, IMAGE_SUFFIXES)
@@ -107,10 +109,11 @@ class FolderSource(FrameSource):
         wanted = [name for name in self.left
                   if (self.right is None or name in self.right)
                   and (self.depth is None or name in self.depth)]
-        # every file left without its partner is dropped, and counted
-        partners = [files for files in (self.right, self.depth) if files is not None]
-        self.dropped = (len(self.left) - len(wanted)) + sum(
-            len(set(files) - set(self.left)) for files in partners)
+        # every file left without its partner is dropped, and counted: an image without its
+        # depth map, and also its right image (as a bag's pairer counts every unpaired message)
+        used = set(wanted)
+        self.dropped = sum(len(set(files) - used)
+                           for files in (self.left, self.right, self.depth) if files is not None)
         self.names = wanted
         self.length = len(wanted)
 
@@ -138,9 +141,15 @@ class VideoSource(FrameSource):
         if width and height:
             self.capture.set(cv2.CAP_PROP_FRAME_WIDTH, width)
             self.capture.set(cv2.CAP_PROP_FRAME_HEIGHT, height)
-        self.right_capture = self._open(right) if right is not None else None
-        count = int(self.capture.get(cv2.CAP_PROP_FRAME_COUNT))
-        self.length = count if count > 0 and not self.camera else None
+        try:
+            self.right_capture = self._open(right) if right is not None else None
+        except VisionError:
+            self.capture.release()
+            raise
+        counts = [int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
+                  for capture in (self.capture, self.right_capture) if capture is not None]
+        # a stereo pair ends with its shorter video
+        self.length = min(counts) if min(counts) > 0 and not self.camera else None
 
     def _open(self, video: Path | int) -> cv2.VideoCapture:
         if isinstance(video, Path) and not video.is_file():

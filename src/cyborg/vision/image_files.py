@@ -52,11 +52,15 @@ def read_depth(path: Path) -> np.ndarray:
     """A depth map in ``float32`` metres (NaN where unknown) from a file."""
     if not path.is_file():
         raise VisionError(f"depth map {path}: {'is a folder' if path.is_dir() else 'not found'}")
-    if path.suffix in (".npy", ".npz"):
+    array: np.ndarray | None
+    if path.suffix.lower() in (".npy", ".npz"):
         try:
             loaded = np.load(path, allow_pickle=False)
-            array = loaded[loaded.files[0]] if isinstance(loaded, np.lib.npyio.NpzFile) \
-                else loaded
+            if isinstance(loaded, np.lib.npyio.NpzFile):
+                with loaded:  # an archive keeps its file open until closed
+                    array = loaded[loaded.files[0]]
+            else:
+                array = loaded
         except (ValueError, OSError, EOFError, zipfile.BadZipFile, IndexError) as exc:
             raise VisionError(f"depth map {path}: not a readable numpy array ({exc})") from exc
     else:

@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 
 from cyborg.vision.depth import depth_in_metres
-from cyborg.vision.frames import VisionError
+from cyborg.vision.frames import VisionError, check_image
 
 _COLOUR = {"bgr8": (3, None), "8UC3": (3, None), "rgb8": (3, cv2.COLOR_RGB2BGR),
            "bgra8": (4, cv2.COLOR_BGRA2BGR), "rgba8": (4, cv2.COLOR_RGBA2BGR),
@@ -27,10 +27,18 @@ def stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
+def _bytes(data: Any) -> np.ndarray:
+    """A message's ``uint8[]`` field as a flat ``uint8`` array: a numpy array (as rosbags and
+    the bus deserialise it), or ``bytes``, which ``np.asarray`` would try to parse as a number."""
+    if isinstance(data, bytes | bytearray | memoryview):
+        return np.frombuffer(data, dtype=np.uint8)
+    return np.asarray(data, dtype=np.uint8).reshape(-1)
+
+
 def _rows(message: Any, dtype: np.dtype, channels: int, topic: str) -> np.ndarray:
     height, width, step = int(message.height), int(message.width), int(message.step)
     row_bytes = width * channels * dtype.itemsize
-    data = np.asarray(message.data, dtype=np.uint8).reshape(-1)
+    data = _bytes(message.data)
     if height == 0 or width == 0 or step < row_bytes or data.size < step * (height - 1) \
             + row_bytes:
         raise VisionError(f"{topic}: image of {width}x{height} {message.encoding} with step "
@@ -69,7 +77,7 @@ def image_to_depth(message: Any, topic: str = "depth") -> np.ndarray:
 
 def compressed_to_bgr(message: Any, topic: str = "image") -> np.ndarray:
     """A ``sensor_msgs/CompressedImage`` (JPEG, PNG) decoded to BGR."""
-    data = np.asarray(message.data, dtype=np.uint8)
+    data = _bytes(message.data)
     image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
     if image is None:
         raise VisionError(f"{topic}: compressed image ({message.format or 'no format'}, "
@@ -86,6 +94,7 @@ def header(types: Any, stamp: int, frame_id: str) -> Any:
 
 def bgr_to_image(types: Any, image: np.ndarray, stamp: int, frame_id: str) -> Any:
     """A ``bgr8`` ``sensor_msgs/Image`` sharing ``image``'s memory when it is contiguous."""
+    check_image(image, "image")  # a grey image would give a message whose step lies
     pixels = np.ascontiguousarray(image)
     height, width = pixels.shape[:2]
     return types.message_class("sensor_msgs/msg/Image")(
@@ -96,6 +105,8 @@ def bgr_to_image(types: Any, image: np.ndarray, stamp: int, frame_id: str) -> An
 def depth_to_image(types: Any, depth: np.ndarray, stamp: int, frame_id: str) -> Any:
     """A ``32FC1`` ``sensor_msgs/Image`` of depth in metres."""
     metres = np.ascontiguousarray(depth, dtype=np.float32)
+    if metres.ndim != 2 or metres.size == 0:
+        raise VisionError(f"depth map must be a 2-D array in metres, not {metres.shape}")
     height, width = metres.shape
     return types.message_class("sensor_msgs/msg/Image")(
         header=header(types, stamp, frame_id), height=height, width=width, encoding="32FC1",

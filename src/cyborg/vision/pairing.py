@@ -21,6 +21,9 @@ class ExactPairer:
     """
 
     def __init__(self, streams: tuple[str, ...], max_pending: int = 30) -> None:
+        if not streams or len(set(streams)) != len(streams):
+            # a stream named twice could never complete a set: every item would be dropped
+            raise ValueError(f"streams must be distinct names, at least one, not {streams!r}")
         self.streams = streams
         self.max_pending = max_pending
         self.pending: OrderedDict[int, dict[str, Any]] = OrderedDict()

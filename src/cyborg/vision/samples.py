@@ -31,7 +31,7 @@ def motorcycle() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Left and right BGR images and the ground-truth depth in metres (NaN where unknown)."""
     from skimage import data
 
-    left, right, disparity = data.stereo_motorcycle()
+    left, right, disparity = data.stereo_motorcycle()  # type: ignore[no-untyped-call]
     # unknown disparities are +inf in this file; depth_from_disparity makes them NaN
     depth = MOTORCYCLE_CALIBRATION.depth_from_disparity(
         np.where(np.isfinite(disparity), disparity, np.nan).astype(np.float32))
