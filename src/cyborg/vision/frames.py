@@ -4,7 +4,7 @@ A :class:`Frame` is what one exposure of the camera gives: the left image (BGR, 
 height x width x 3) with its timestamp, and, when the source has them, the right image of a
 stereo pair and a depth map in metres (``float32``, NaN where unknown) registered to the left
 image. Sources (:mod:`cyborg.vision.sources`, :mod:`cyborg.vision.bag_source`,
-:mod:`cyborg.vision.bus_source`) are iterables of frames with a length when they know it::
+:mod:`cyborg.vision.bus_source`) are iterables of frames with a :attr:`~FrameSource.length` when they know it::
 
     with open_source("ride.mp4") as source:
         for frame in source:
@@ -77,9 +77,9 @@ def _size(array: np.ndarray) -> str:
 class FrameSource:
     """Base of camera sources: iterate for frames; ``close()`` (or ``with``) releases them.
 
-    ``len(source)`` is the number of frames when known (files, bags), else ``TypeError`` is
-    not raised but :attr:`length` is None. ``dropped`` counts frames the source had to drop
-    (an image without its depth map, or a depth map without its image).
+    :attr:`length` is the number of frames when known (files, bags; an upper bound where
+    pairing may drop some), else None. :attr:`dropped` counts what the source had to drop (an
+    image without its depth map, or a depth map without its image).
     """
 
     name = "source"
