@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -100,7 +101,7 @@ def fill_with(value: int) -> Callable[[memoryview], object]:
 
 
 def test_a_leased_slot_is_never_overwritten() -> None:
-    writer, reader = SlotWriter(max_slots=2), SlotReader()
+    writer, reader = SlotWriter(max_slots=2, reuse_grace=0.0), SlotReader()
     try:
         first = writer.write(8, fill_with(1))
         assert first is not None
@@ -137,7 +138,7 @@ def test_all_slots_leased_means_no_slot() -> None:
 
 
 def test_a_reused_slot_is_reported_not_read() -> None:
-    writer, reader = SlotWriter(max_slots=1), SlotReader()
+    writer, reader = SlotWriter(max_slots=1, reuse_grace=0.0), SlotReader()
     try:
         old = writer.write(4, fill_with(1))
         assert writer.write(4, fill_with(2)) is not None  # nobody leased the first
@@ -148,8 +149,28 @@ def test_a_reused_slot_is_reported_not_read() -> None:
     assert not Path(old.path).exists()
 
 
+def test_a_burst_gets_fresh_slots_until_its_readers_had_time_to_lock() -> None:
+    """Two frames published back to back: the first one's reader has not locked its slot
+    yet, so the second must not overwrite it (it did, before the grace)."""
+    writer, reader = SlotWriter(max_slots=2, reuse_grace=0.05), SlotReader()
+    try:
+        first = writer.write(4, fill_with(1))
+        second = writer.write(4, fill_with(2))
+        assert first is not None and second is not None and second.path != first.path
+        assert writer.write(4, fill_with(3)) is None, "both are fresh: send inline instead"
+        lease = reader.read(first)
+        assert lease is not None and lease.tolist() == [1] * 4
+        del lease
+        gc.collect()
+        time.sleep(0.06)
+        reused = writer.write(4, fill_with(4))
+        assert reused is not None and reused.path == second.path, "the last one, warm, again"
+    finally:
+        writer.close()
+
+
 def test_a_bigger_message_gets_a_bigger_slot() -> None:
-    writer, reader = SlotWriter(max_slots=1), SlotReader()
+    writer, reader = SlotWriter(max_slots=1, reuse_grace=0.0), SlotReader()
     try:
         assert writer.write(10, fill_with(1)) is not None
         big = writer.write(3 << 20, fill_with(7))

@@ -13,8 +13,10 @@ Who may write a slot is decided by ``flock`` locks:
 * the writer skips slots it cannot lock and makes new ones up to ``max_slots``; when every slot
   is leased, :meth:`SlotWriter.write` returns ``None`` and the caller sends the bytes inline.
 
-A reader that finds a newer generation in the slot (the writer reused it before the reader got
-its lock, which takes a message rate of thousands per second) drops the frame; the caller counts
+A slot written less than ``REUSE_GRACE`` seconds ago is not reused even when unlocked: its
+readers may not have taken their lock yet (the reference is still on its way), so a burst of
+messages gets fresh slots instead of overwriting each other. A reader that still finds a newer
+generation in the slot (a reader slower than the grace) drops the frame; the caller counts
 it. Locks vanish with the process that
 held them, so a crashed reader never blocks a writer, and writers remove slot files of dead
 processes when they start.
@@ -31,6 +33,7 @@ import secrets
 import struct
 import tempfile
 import threading
+import time
 import weakref
 from collections import OrderedDict
 from collections.abc import Callable
@@ -71,10 +74,16 @@ class SlotRef:
         return cls(path, generation, length)
 
 
+REUSE_GRACE = 0.02
+"""Seconds a written slot is left alone for its readers to lock it (a 30 Hz camera's slot is
+reused at its next frame; a burst spreads over several slots)."""
+
+
 class _Slot:
     def __init__(self, path: Path, capacity: int) -> None:
         self.path = path
         self.capacity = capacity
+        self.written_at = -float("inf")
         self.fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o600)
         os.ftruncate(self.fd, _HEADER.size + capacity)
         self.map = mmap.mmap(self.fd, _HEADER.size + capacity)
@@ -98,11 +107,12 @@ class _Slot:
 
 class SlotWriter:
     """One publisher's slots. The slot written last is reused first while no reader holds
-    it, so its pages are still in the CPU cache; a leased slot is skipped, and a new one is made
-    (up to ``max_slots``) when all are leased."""
+    it, so its pages are still in the CPU cache; a leased slot, or one written within
+    ``REUSE_GRACE``, is skipped, and a new one is made (up to ``max_slots``) when all are."""
 
-    def __init__(self, max_slots: int = 16) -> None:
+    def __init__(self, max_slots: int = 16, reuse_grace: float = REUSE_GRACE) -> None:
         self.max_slots = max_slots
+        self.reuse_grace = reuse_grace
         self._slots: list[_Slot] = []
         self._generation = 0
         self._tag = f"{PREFIX}{os.getpid()}-{secrets.token_hex(4)}"
@@ -119,13 +129,15 @@ class SlotWriter:
             _HEADER.pack_into(slot.map, 0, self._generation, length)
             with memoryview(slot.map) as whole, whole[_HEADER.size:][:length] as view:
                 fill(view)
+            slot.written_at = time.monotonic()
         finally:
             slot.unlock()
         return SlotRef(str(slot.path), self._generation, length)
 
     def _free_slot(self, length: int) -> _Slot | None:
+        recent = time.monotonic() - self.reuse_grace
         for index, slot in enumerate(self._slots):  # most recently written first
-            if slot.try_lock():
+            if slot.written_at < recent and slot.try_lock():
                 if slot.capacity < length:  # too small: replace it with a bigger one
                     slot.unlock()
                     slot.close()
