@@ -2,8 +2,9 @@
 
 Background pixels at a box's edges pull a mean away from the object, and a single pixel may be
 a hole. So the distance is the **median** of the valid depths in the box's central part (by
-default the middle 50 % of its width and height), sampled on a grid for speed: a 1320 x 616 box
-costs 0.6 ms at stride 4 instead of 10 ms for every pixel, with the same median to 2 cm.
+default the middle 50 % of its width and height), sampled on a regular grid of about 2,500
+points for speed: a median over every pixel of a 1320 x 616 box costs 10 ms, over a grid 0.1 ms,
+and they agree to a few centimetres (the depth map itself is not finer than that).
 Valid means finite and positive: NaN (unknown), +-inf (too far / too close) and 0 (a
 ``uint16`` map's "no reading") are ignored. With no valid depth the distance is NaN —
 "unknown" — and never 0, which would read as "touching".
@@ -18,16 +19,17 @@ import math
 
 import numpy as np
 
-MIN_SAMPLES = 400
-"""Boxes are sampled with a stride small enough to keep at least this many pixels."""
+SAMPLES = 2500
+"""About how many depth pixels a box's distance is taken from (all of them in small boxes)."""
 
 
 def box_distance(depth: np.ndarray, box: tuple[float, float, float, float], *,
-                 inner: float = 0.5, max_stride: int = 4) -> tuple[float, float]:
+                 inner: float = 0.5, samples: int = SAMPLES) -> tuple[float, float]:
     """``(median depth in metres, fraction of sampled pixels that were valid)``.
 
     ``inner`` is the share of the box's width and height kept around its centre (1.0: the
-    whole box). The distance is NaN when no sampled pixel is valid.
+    whole box); ``samples`` bounds the pixels looked at (the grid's stride grows with the box).
+    The distance is NaN when no sampled pixel is valid.
     """
     height, width = depth.shape
     x1, y1, x2, y2 = box
@@ -39,12 +41,12 @@ def box_distance(depth: np.ndarray, box: tuple[float, float, float, float], *,
     area = (right - left) * (bottom - top)
     if area <= 0:
         return math.nan, 0.0
-    stride = max(1, min(max_stride, int(math.sqrt(area / MIN_SAMPLES))))
-    samples = depth[top:bottom:stride, left:right:stride]
-    valid = samples[np.isfinite(samples) & (samples > 0)]
+    stride = max(1, math.ceil(math.sqrt(area / samples)))
+    grid = depth[top:bottom:stride, left:right:stride]
+    valid = grid[np.isfinite(grid) & (grid > 0)]
     if valid.size == 0:
         return math.nan, 0.0
-    return float(np.median(valid)), valid.size / samples.size
+    return float(np.median(valid)), valid.size / grid.size
 
 
 def box_mean_2018(depth: np.ndarray, box: tuple[float, float, float, float]) -> float:

@@ -20,7 +20,7 @@ import numpy as np
 from cyborg.vision.annotate import annotate
 from cyborg.vision.depth import StereoDepth
 from cyborg.vision.detector import Detection, Detector
-from cyborg.vision.distance import box_distance
+from cyborg.vision.distance import SAMPLES, box_distance
 from cyborg.vision.frames import Frame
 
 STAGES = ("depth", "preprocess", "inference", "postprocess", "distance", "drawing")
@@ -41,9 +41,9 @@ class DetectionPipeline:
     """A detector, depth for distances, and the annotated image when asked for."""
 
     def __init__(self, detector: Detector, *, stereo: StereoDepth | None = None,
-                 inner: float = 0.5, max_stride: int = 4) -> None:
+                 inner: float = 0.5, samples: int = SAMPLES) -> None:
         self.detector, self.stereo = detector, stereo
-        self.inner, self.max_stride = inner, max_stride
+        self.inner, self.samples = inner, samples
 
     def depth_of(self, frame: Frame) -> np.ndarray | None:
         if frame.depth is not None:
@@ -63,7 +63,7 @@ class DetectionPipeline:
                           for detection in detections
                           for median, share in [box_distance(depth, detection.box,
                                                              inner=self.inner,
-                                                             max_stride=self.max_stride)]]
+                                                             samples=self.samples)]]
         measured = time.perf_counter()
         annotated = annotate(frame.left, detections) if draw else None
         drawn = time.perf_counter()
