@@ -4,7 +4,8 @@ A :class:`Frame` is what one exposure of the camera gives: the left image (BGR, 
 height x width x 3) with its timestamp, and, when the source has them, the right image of a
 stereo pair and a depth map in metres (``float32``, NaN where unknown) registered to the left
 image. Sources (:mod:`cyborg.vision.sources`, :mod:`cyborg.vision.bag_source`,
-:mod:`cyborg.vision.bus_source`) are iterables of frames with a :attr:`~FrameSource.length` when they know it::
+:mod:`cyborg.vision.bus_source`) are iterables of frames, with a :attr:`~FrameSource.length`
+when they know it::
 
     with open_source("ride.mp4") as source:
         for frame in source:
