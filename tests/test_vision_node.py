@@ -327,3 +327,33 @@ def test_launch_kinds_refuse_bad_sources_and_models_naming_the_entry(bus: Contex
     finally:
         running.stop()
     assert wait_for(lambda: "/cyborg/detector" not in bus.graph.nodes())
+
+
+def test_bus_source_pairs_camera_topics_into_frames(bus: Context) -> None:
+    from cyborg.vision.bus_source import BusSource
+    from cyborg.vision.image_messages import bgr_to_image, depth_to_image
+
+    reader = Node("reader", context=bus)
+    source = BusSource(reader, CameraTopics("/cam/image", "/cam/depth"), idle_timeout=0.5)
+    camera = Node("cam", context=bus)
+    image_pub = camera.create_publisher("/cam/image", "sensor_msgs/msg/Image")
+    depth_pub = camera.create_publisher("/cam/depth", "sensor_msgs/msg/Image")
+    left = np.zeros((4, 6, 3), np.uint8)
+    left[1, 2] = (1, 2, 3)
+    depth = np.full((4, 6), 1.25, np.float32)
+    image_pub.publish(bgr_to_image(bus.types, left, 10, "cam"))  # its depth never comes
+    for stamp in (20, 30):
+        depth_pub.publish(depth_to_image(bus.types, depth * stamp, stamp, "cam"))
+        image_pub.publish(bgr_to_image(bus.types, left, stamp, "cam"))
+    frames = list(source)  # ends after 0.5 s without a frame
+    assert [frame.stamp_ns for frame in frames] == [20, 30]
+    assert frames[1].left[1, 2].tolist() == [1, 2, 3] and frames[1].frame_id == "cam"
+    assert frames[1].depth is not None and float(frames[1].depth[0, 0]) == 37.5
+    assert source.total_dropped == 1
+    wrong = BusSource(reader, CameraTopics("/bad/image", "/bad/depth"), idle_timeout=0.5)
+    bad = camera.create_publisher("/bad/image", "sensor_msgs/msg/Image")
+    bad_depth = camera.create_publisher("/bad/depth", "sensor_msgs/msg/Image")
+    bad_depth.publish(depth_to_image(bus.types, np.ones((2, 2), np.float32), 5, "cam"))
+    bad.publish(bgr_to_image(bus.types, left, 5, "cam"))
+    with pytest.raises(VisionError, match="bus /bad/image: depth map is 2x2 but the image is"):
+        list(wrong)
