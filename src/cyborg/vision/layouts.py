@@ -146,7 +146,7 @@ def decode(layout: Layout, output: np.ndarray, input_hw: tuple[int, int],
 _GRIDS: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
 
-def _yolox_grid(input_hw: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+def yolox_grid(input_hw: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """Per anchor point: its grid cell (x, y) and its stride."""
     if input_hw not in _GRIDS:
         cells, strides = [], []
@@ -161,7 +161,7 @@ def _yolox_grid(input_hw: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _yolox_centres(rows: np.ndarray, keep: np.ndarray, input_hw: tuple[int, int]) -> np.ndarray:
-    cells, strides = _yolox_grid(input_hw)
+    cells, strides = yolox_grid(input_hw)
     if len(cells) != len(rows):
         raise VisionError(f"YOLOX output has {len(rows)} anchor points, but a "
                           f"{input_hw[1]}x{input_hw[0]} input has {len(cells)}: is this a "
