@@ -1,0 +1,293 @@
+"""The detector end to end on 1080p frames with depth, against the 2018 approach, in one run.
+
+    python3 benchmarks/detector.py             # full run, about 100 s
+    python3 benchmarks/detector.py --quick     # smoke test, about 12 s
+    python3 benchmarks/detector.py --markdown  # the tables as Markdown
+    python3 benchmarks/detector.py --threads 1 # onnxruntime / OpenCV threads (default 2)
+
+Frames (:mod:`benchmarks.detector_frames`): four photos from scikit-image tiled into a
+1920x1080 BGR image (YOLOX-Nano finds 5 objects at confidence 0.5), with a float32 depth map
+in metres with NaN, +inf, -inf and 0 holes; four variants are cycled, so consecutive frames are
+different memory.
+
+Measured in one run, on this machine:
+
+* **ours, two processes** (:mod:`benchmarks.detector_ours`): a camera process publishes each
+  frame on the bus as two ``sensor_msgs/Image`` (``bgr8`` + ``32FC1``, CameraNode's topics and
+  encodings); a detector process runs the real :class:`~cyborg.vision.DetectorNode`
+  (``DetectionPipeline``, onnxruntime, YOLOX-Nano 416, ``--threads``) and publishes
+  ``Predictions`` and ``Detection2DArray``; the camera process receives the
+  ``Detection2DArray``, which gives the latency. Run with **one frame in flight** (the next
+  frame is sent when the last one's detections are back: clean per-stage times and latency)
+  and **streaming** (two frames in flight, so one is always waiting when the detector finishes
+  the other: the throughput, i.e. frames per second when the camera offers frames as fast as the
+  detector takes them, none dropped). The camera sends as soon as the window allows: a
+  streaming run starts with two frames published back to back.
+* **ours, one process**: the same camera and detector nodes on one bus context, as
+  ``cyborg up`` runs them (in-process delivery: the frame is handed over, not copied).
+* **drawn or not**: the node draws (and publishes) the annotated image only while someone
+  subscribes to ``detection_image``. By default a viewer in the detector's process does; the
+  "nothing drawn" configurations (streaming, and one process) run without it.
+* **2018 approach** (:mod:`benchmarks.detector_2018`): OpenCV DNN on the same ONNX file,
+  stretch-resize, the per-row Python loop without NMS, the mean depth over the whole box, the
+  same drawing, and the frame pickled down a ``multiprocessing`` Pipe. One frame in flight and
+  streaming.
+* **bare inference**: the onnxruntime session alone on a prepared tensor, same threads (and
+  OpenCV DNN's ``forward`` alone, for the 2018 side).
+
+Stages: transport (header stamp taken just before the camera publishes → both messages in the
+detector's callback), message → frame (numpy views of the messages, frame checks),
+preprocess, inference, postprocess (decode, NMS), distance, drawing, publish (building and
+publishing the output messages). Throughput: frames answered per second. Overhead = time per
+frame / bare inference - 1. Configurations run round-robin, several rounds; FPS is the median
+over rounds. CPU used by other processes is measured per round and reported.
+
+Goals: >= 60 FPS end to end with onnxruntime on 2 cores; overhead <= 20 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+if __package__ in (None, ""):  # run as a file: the benchmarks package from the repository root
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.detector_2018 import Approach2018
+from benchmarks.detector_frames import STAGES, THRESHOLD, Run, make_frames, quantiles
+from benchmarks.detector_ours import BareInference, OursInProcess, OursTwoProcesses, detector_peer
+
+SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
+MODEL = SHARED / "models" / "yolox_nano.onnx"
+GOAL_FPS, GOAL_OVERHEAD = 60.0, 0.20
+
+
+# ---------------------------------------------------------------------- driver
+CONFIGURATIONS = {
+    "bare": "bare inference, onnxruntime",
+    "bare_2018": "bare inference, OpenCV DNN (2018 side)",
+    "streaming": "ours, 2 processes, streaming",
+    "streaming_plain": "ours, 2 processes, streaming, nothing drawn",
+    "lockstep": "ours, 2 processes, 1 frame in flight",
+    "in_process": "ours, 1 process",
+    "in_process_plain": "ours, 1 process, nothing drawn",
+    "old_streaming": "2018, 2 processes, streaming",
+    "old_lockstep": "2018, 2 processes, 1 frame in flight"}
+
+
+class CpuMeter:
+    """How much CPU processes other than ours took (Linux ``/proc``; NaN elsewhere)."""
+
+    def __init__(self) -> None:
+        self.pids: list[int] = [os.getpid()]
+        self.cores = os.cpu_count() or 1
+        self._start = self._sample()
+
+    @staticmethod
+    def _jiffies(pid: int) -> int:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])  # utime + stime, all threads
+
+    def _sample(self) -> tuple[float, int, int] | None:
+        try:
+            numbers = [int(value) for value in Path("/proc/stat").read_text().split()[1:9]]
+            busy = sum(numbers) - numbers[3] - numbers[4]  # minus idle and iowait
+            ours = sum(self._jiffies(pid) for pid in self.pids)
+        except (OSError, ValueError, IndexError):
+            return None
+        return time.monotonic(), busy, ours
+
+    def restart(self) -> None:
+        self._start = self._sample()
+
+    def foreign(self) -> float:
+        """Share of all cores used by other processes since the last ``restart``."""
+        end = self._sample()
+        if end is None or self._start is None:
+            return math.nan
+        ticks = os.sysconf("SC_CLK_TCK")
+        seconds = end[0] - self._start[0]
+        other = (end[1] - self._start[1]) - (end[2] - self._start[2])
+        return max(0.0, other / ticks / (seconds * self.cores))
+
+
+@dataclass
+class Results:
+    runs: dict[str, Run]
+    threads: int
+    rounds: int
+    dropped: int
+    seconds: float
+    foreign: list[float]
+    bus_drops: dict[str, int]
+
+
+def measure(model: Path, threads: int, quick: bool) -> Results:
+    """Every configuration once per round, round-robin, so drift touches all alike."""
+    started = time.monotonic()
+    frames = make_frames()
+    rounds, scale = (2, 5) if quick else (5, 1)
+    runs = {key: Run(name) for key, name in CONFIGURATIONS.items()}
+    bare = BareInference(frames, model, threads)
+    in_process = OursInProcess(frames, model, threads)
+    two = OursTwoProcesses(frames, model, threads)
+    old = Approach2018(frames, model, threads)
+    meter = CpuMeter()
+    meter.pids += [two.peer.pid, old.peer.pid or 0]
+    foreign = []
+    try:
+        in_process.run(20, 1)  # warm-ups
+        two.run(20, 1)
+        old.bare(5)
+        old.run(3, 1)
+        for _ in range(rounds):
+            meter.restart()
+            runs["bare"].add(bare.run(100 // scale))
+            runs["bare_2018"].add(old.bare(40 // scale))
+            runs["in_process"].add(in_process.run(200 // scale, 2))
+            runs["in_process_plain"].add(in_process.run(200 // scale, 2, draw=False))
+            runs["lockstep"].add(two.run(100 // scale, 1))
+            runs["streaming"].add(two.run(250 // scale, 2))
+            runs["streaming_plain"].add(two.run(250 // scale, 2, draw=False))
+            runs["old_lockstep"].add(old.run(max(3, 15 // scale), 1))
+            runs["old_streaming"].add(old.run(max(5, 30 // scale), 2))
+            foreign.append(meter.foreign())
+    finally:
+        old.close()
+        two.close()
+        in_process.close()
+    bus_drops = dict(two.bus_drops)
+    for reason, count in in_process.context.dropped.items():
+        bus_drops[reason] = bus_drops.get(reason, 0) + count
+    return Results(runs, threads, rounds, in_process.dropped + two.dropped,
+                   time.monotonic() - started, foreign, bus_drops)
+
+
+# ---------------------------------------------------------------------- report
+def _cell(pair: tuple[float, float]) -> str:
+    return "—" if math.isnan(pair[0]) else f"{pair[0]:.2f} / {pair[1]:.2f}"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]], markdown: bool) -> None:
+    if markdown:
+        print("| " + " | ".join(header) + " |")
+        print("| --- |" + " --: |" * (len(header) - 1))
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+        return
+    widths = [max(len(row[i]) for row in [header, *rows]) for i in range(len(header))]
+    for row in [header, *rows]:
+        print("  ".join(value.ljust(widths[i]) if i == 0 else value.rjust(widths[i])
+                        for i, value in enumerate(row)))
+
+
+def _goal(met: bool) -> str:
+    return "met" if met else "NOT met"
+
+
+def report(results: Results, markdown: bool) -> None:
+    runs = results.runs
+    bare = runs["bare"].stage("inference")[0]
+    bare_2018 = runs["bare_2018"].stage("inference")[0]
+    print(f"1920x1080 BGR + 32FC1 depth, YOLOX-Nano 416, {results.threads} inference "
+          f"thread(s), confidence {THRESHOLD}, {os.cpu_count()} cores; {results.rounds} "
+          f"rounds, {results.seconds:.0f} s\n")
+    print("Per-stage times, ms per frame, median / p90:\n")
+    keys = ("lockstep", "streaming", "in_process", "in_process_plain", "old_lockstep")
+    header: tuple[str, ...] = (
+        "stage", "ours, 2 processes", "ours, 2 processes, streaming (a)", "ours, 1 process",
+        "ours, 1 process, nothing drawn", "2018, 2 processes", "2018 / ours")
+    rows = []
+    for stage in STAGES:
+        ours, old = runs["lockstep"].stage(stage)[0], runs["old_lockstep"].stage(stage)[0]
+        ratio = f"{old / ours:.1f}x" if ours > 0 and not math.isnan(old) else ""
+        rows.append((stage, *(_cell(runs[key].stage(stage)) for key in keys), ratio))
+    sums = [sum(value for stage in STAGES if not math.isnan(value := runs[key].stage(stage)[0]))
+            for key in keys]
+    rows.append(("sum of the medians", *(f"{value:.2f}" for value in sums),
+                 f"{sums[-1] / sums[0]:.1f}x"))
+    rows.append(("detections per frame",
+                 *(f"{quantiles(runs[key].detections)[0]:.0f}" for key in keys), ""))
+    _table(header, rows, markdown)
+    print("\n(a) two frames in flight: transport includes the wait in the detector's queue while "
+          "the frame before is processed. Other columns: one frame in flight (ours, 1 process: "
+          "two, but delivery is synchronous). Nothing drawn: no subscriber to detection_image. "
+          "2018: message → frame is part of transport (unpickling).")
+
+    print("\nThroughput and latency (FPS: median over rounds, lowest and highest in brackets):\n")
+    header = ("configuration", "FPS", "ms per frame", "latency median / p90 ms",
+              "x bare inference", "x 60 FPS goal")
+    rows = [(CONFIGURATIONS["bare"], f"{1000 / bare:.1f}", f"{bare:.2f}", "", "1.00x", ""),
+            (CONFIGURATIONS["bare_2018"], f"{1000 / bare_2018:.1f}", f"{bare_2018:.2f}", "",
+             "1.00x", "")]
+    for key in ("streaming", "streaming_plain", "lockstep", "in_process", "in_process_plain",
+                "old_streaming", "old_lockstep"):
+        run = runs[key]
+        own_bare = bare_2018 if key.startswith("old") else bare
+        spread = f" ({min(run.fps_rounds):.0f} to {max(run.fps_rounds):.0f})"
+        rows.append((run.name, f"{run.fps:.1f}{spread}", f"{run.per_frame_ms:.2f}",
+                     _cell(quantiles(run.latency)), f"{run.per_frame_ms / own_bare:.2f}x",
+                     f"{run.fps / GOAL_FPS:.2f}x"))
+    _table(header, rows, markdown)
+    print("\nx bare inference: ms per frame / the bare inference of the same runtime "
+          "(ours: onnxruntime; 2018: OpenCV DNN)\n")
+    for key in ("streaming", "streaming_plain", "in_process", "in_process_plain"):
+        run = runs[key]
+        overhead = run.per_frame_ms / bare - 1
+        print(f"{run.name}: {run.fps:.1f} FPS (goal >= {GOAL_FPS:.0f}: "
+              f"{_goal(run.fps >= GOAL_FPS)}); overhead over bare inference "
+              f"{overhead * 100:.0f} % (goal <= {GOAL_OVERHEAD * 100:.0f} %: "
+              f"{_goal(overhead <= GOAL_OVERHEAD)})")
+    for key, what in (("in_process", "drawn"), ("in_process_plain", "nothing drawn")):
+        medians = {stage: runs[key].stage(stage)[0] for stage in STAGES}
+        pipeline = sum(medians[stage] for stage in STAGES[2:7])
+        node = medians["transport"] + medians["message → frame"] + medians["publish"]
+        print(f"of which, in one process, {what}: DetectionPipeline.process (preprocess to "
+              f"drawing) {pipeline:.2f} ms = {(pipeline / bare - 1) * 100:.0f} % over bare "
+              f"inference; node and bus (transport, message → frame, publish) {node:.2f} ms")
+    old = runs["old_streaming"].fps
+    latency = (quantiles(runs["old_lockstep"].latency)[0]
+               / quantiles(runs["lockstep"].latency)[0])
+    print(f"ours / 2018: {runs['streaming'].fps / old:.1f}x the frames per second (two "
+          f"processes, streaming), {runs['in_process'].fps / old:.1f}x in one process; "
+          f"{latency:.1f}x lower latency (two processes, one frame in flight)")
+    lost = ", ".join(f"{run.lost} of {run.frames + run.lost} ({run.name})"
+                     for run in runs.values() if run.lost)
+    print(f"frames without an answer: {lost or 'none'}; dropped or failed by the detector "
+          f"nodes: {results.dropped}; dropped by the bus: "
+          + (", ".join(f"{count} ({reason})" for reason, count in results.bus_drops.items())
+             or "none"))
+    shares = ", ".join(f"{share * 100:.0f} %" for share in results.foreign)
+    print(f"CPU taken by other processes, per round: {shares}"
+          + (" — DISTURBED: figures are not trustworthy; run again on a quiet machine"
+             if any(share > 0.05 for share in results.foreign) else ""))
+    print("2018 side: the same ONNX model on OpenCV DNN (the 2018 Darknet YOLOv3 weights are "
+          "not available, and OpenCV 5 removed the Darknet importer)")
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="few frames, a smoke test")
+    parser.add_argument("--markdown", action="store_true", help="print Markdown tables")
+    parser.add_argument("--threads", type=int, default=2,
+                        help="onnxruntime and OpenCV DNN threads (default 2)")
+    parser.add_argument("--model", type=Path, default=MODEL,
+                        help="a YOLOX-Nano ONNX file (default: $CYBORG_SHARED/models)")
+    parser.add_argument("--detector-peer", metavar="ENDPOINT", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.detector_peer:
+        detector_peer(args.detector_peer, args.model, args.threads)
+        return
+    if not args.model.is_file():
+        parser.error(f"model {args.model} not found (set CYBORG_SHARED or give --model)")
+    report(measure(args.model, args.threads, args.quick), args.markdown)
+
+
+if __name__ == "__main__":
+    main()
