@@ -24,9 +24,9 @@ from typing import Any
 
 from benchmarks.detector_frames import THRESHOLD, Frames, Offer, Run, offer_frames, stages_of
 from cyborg.bus import BusConfig, Context, Node, Qos
+from cyborg.vision import CameraTopics, DetectorNode
 from cyborg.vision.backends import OnnxRuntimeBackend
 from cyborg.vision.detector import Detector
-from cyborg.vision.detector_node import CameraTopics, DetectorNode
 from cyborg.vision.frames import Frame
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image, stamp_ns
 from cyborg.vision.pipeline import DetectionPipeline, Result

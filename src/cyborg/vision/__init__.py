@@ -19,9 +19,10 @@ This package uses the bus for its messages and nodes; only :mod:`cyborg.app` wir
 """
 
 from cyborg.vision.camera_node import CameraNode
+from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.depth import StereoCalibration, StereoDepth, depth_in_metres
 from cyborg.vision.detector import Detection, Detector
-from cyborg.vision.detector_node import CameraTopics, DetectorNode
+from cyborg.vision.detector_node import DetectorNode
 from cyborg.vision.distance import box_distance
 from cyborg.vision.frames import Frame, FrameSource, VisionError
 from cyborg.vision.pipeline import DetectionPipeline, Result

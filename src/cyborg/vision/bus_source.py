@@ -12,9 +12,9 @@ from collections.abc import Iterator
 from typing import Any
 
 from cyborg.bus import Node, Qos
-from cyborg.vision.detector_node import CameraTopics
+from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.frames import Frame, FrameSource, VisionError
-from cyborg.vision.image_messages import image_to_bgr, image_to_depth, stamp_ns
+from cyborg.vision.image_messages import stamp_ns
 from cyborg.vision.pairing import ExactPairer
 
 _END = object()
@@ -28,8 +28,7 @@ class BusSource(FrameSource):
         super().__init__()
         self.node, self.topics, self.idle_timeout = node, topics, idle_timeout
         self.name = f"bus {topics.image}"
-        streams = tuple(stream for stream in ("image", "depth", "right")
-                        if getattr(topics, stream))
+        streams = topics.streams()
         self.pairer = ExactPairer(streams, max_pending=10)
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=2)
         self._subscriptions = [
@@ -60,17 +59,12 @@ class BusSource(FrameSource):
                 return
             if item is _END:
                 return
-            image = item["image"]
             try:
-                yield Frame(stamp_ns(image.header), image_to_bgr(image, self.topics.image),
-                            image_to_bgr(item["right"], self.topics.right)
-                            if "right" in item else None,
-                            image_to_depth(item["depth"], self.topics.depth)
-                            if "depth" in item else None,
-                            frame_id=str(image.header.frame_id), index=self._index)
+                frame = self.topics.frame(item, self._index)
             except VisionError as exc:
                 raise VisionError(f"{self.name}: {exc}") from None
             self._index += 1
+            yield frame
 
     @property
     def total_dropped(self) -> int:

@@ -25,31 +25,17 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bus import Node, Qos
-from cyborg.vision.frames import Frame, VisionError
-from cyborg.vision.image_messages import (
-    bgr_to_image,
-    image_to_bgr,
-    image_to_depth,
-    stamp_ns,
-)
+from cyborg.vision.camera_topics import CameraTopics
+from cyborg.vision.frames import VisionError
+from cyborg.vision.image_messages import bgr_to_image, stamp_ns
 from cyborg.vision.pairing import ExactPairer
 from cyborg.vision.pipeline import DetectionPipeline, Result
 from cyborg.vision.predictions import detection_array_message, predictions_message
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class CameraTopics:
-    """Where the camera's streams are (``depth`` and ``right`` are optional)."""
-
-    image: str
-    depth: str = ""
-    right: str = ""
 
 
 class DetectorNode:
@@ -80,13 +66,12 @@ class DetectorNode:
                                                 "vision_msgs/msg/Detection2DArray", Qos(depth=5))
         self.image = node.create_publisher("detection_image", "sensor_msgs/msg/Image",
                                            Qos(depth=1))
-        streams = ("image",) + (("depth",) if topics.depth else ()) + \
-            (("right",) if topics.right else ())
+        streams = topics.streams()
         self.pairer = ExactPairer(streams, max_pending=10)
         for stream in streams:
             topic = getattr(topics, stream)
             node.create_subscription(topic, "sensor_msgs/msg/Image",
-                                     self._receiver(stream, topic), Qos(depth=2))
+                                     self._receiver(stream), Qos(depth=2))
 
     @property
     def dropped(self) -> int:
@@ -107,7 +92,7 @@ class DetectorNode:
         if "classes" in changes:
             detector.classes = frozenset(str(name) for name in changes["classes"] if name)
 
-    def _receiver(self, stream: str, topic: str) -> Callable[[Any], None]:
+    def _receiver(self, stream: str) -> Callable[[Any], None]:
         def receive(message: Any) -> None:
             complete = self.pairer.add(stream, stamp_ns(message.header), message)
             if complete is not None:
@@ -124,13 +109,7 @@ class DetectorNode:
             return
         image_message = messages["image"]
         try:
-            frame = Frame(stamp_ns(image_message.header),
-                          image_to_bgr(image_message, self.topics.image),
-                          image_to_bgr(messages["right"], self.topics.right)
-                          if "right" in messages else None,
-                          image_to_depth(messages["depth"], self.topics.depth)
-                          if "depth" in messages else None,
-                          frame_id=str(image_message.header.frame_id))
+            frame = self.topics.frame(messages)
             result = self.pipeline.process(frame, draw=self.image.subscription_count() > 0)
         except VisionError as exc:
             self.failed += 1
