@@ -196,11 +196,21 @@ def test_fetch_checks_the_sha256_and_keeps_nothing_on_a_mismatch(tmp_path: Path,
 def test_models_are_found_by_path_or_name(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
                                           ) -> None:
     monkeypatch.setenv("CYBORG_MODELS", str(tmp_path))
-    monkeypatch.delenv("CYBORG_SHARED", raising=False)
+    monkeypatch.setenv("CYBORG_SHARED", str(tmp_path / "elsewhere"))
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    with pytest.raises(VisionError, match=r"model 'yolox_nano' not found in .*cyborg detect "
-                                          r"models fetch yolox_nano"):
+    with pytest.raises(VisionError, match=r"model 'yolox_nano' not found in .*elsewhere/models,"
+                                          r" .*cache/cyborg/models; fetch it with `cyborg detect "
+                                          r"models fetch yolox_nano`"):
         find_model("yolox_nano")
+    # without CYBORG_SHARED, the shared folder beside the checkout (where the tests found it)
+    monkeypatch.delenv("CYBORG_SHARED")
+    import cyborg.vision.models as models
+    beside = Path(models.__file__).resolve().parents[3].parent / "shared" / "models"
+    if beside.is_dir():
+        assert find_model("yolox_nano") == beside / "yolox_nano.onnx"
+    else:
+        with pytest.raises(VisionError, match="not found"):
+            find_model("yolox_nano")
     (tmp_path / "yolox_nano.onnx").write_bytes(b"x")
     assert find_model("yolox_nano") == tmp_path / "yolox_nano.onnx"
     assert find_model(str(MODEL)) == MODEL

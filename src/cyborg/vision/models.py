@@ -1,8 +1,9 @@
 """Finding model files, and fetching known ones with their checksum verified.
 
 A model is given by path, or by name (``yolox_nano``) and then looked for, in order, in the
-folder named by ``CYBORG_MODELS``, in ``$CYBORG_SHARED/models`` when that is set, and in the
-user's cache (``~/.cache/cyborg/models``, or ``$XDG_CACHE_HOME/cyborg/models``).
+folder named by ``CYBORG_MODELS``, in the project's shared data (``$CYBORG_SHARED/models``, by
+default ``../shared/models`` beside a source checkout), and in the user's cache
+(``~/.cache/cyborg/models``, or ``$XDG_CACHE_HOME/cyborg/models``).
 
 ``cyborg detect models fetch yolox_nano`` downloads a known model into the cache (or
 ``--dir``), checks its SHA-256 against the catalogue and only then moves it into place, so a
@@ -56,8 +57,13 @@ def model_dirs() -> list[Path]:
     dirs = []
     if os.environ.get("CYBORG_MODELS"):
         dirs.append(Path(os.environ["CYBORG_MODELS"]).expanduser())
-    if os.environ.get("CYBORG_SHARED"):
-        dirs.append(Path(os.environ["CYBORG_SHARED"]).expanduser() / "models")
+    shared = os.environ.get("CYBORG_SHARED")
+    if shared:
+        dirs.append(Path(shared).expanduser() / "models")
+    else:
+        beside_checkout = Path(__file__).resolve().parents[3].parent / "shared" / "models"
+        if beside_checkout.is_dir():  # src/cyborg/vision/models.py → <checkout>/../shared
+            dirs.append(beside_checkout)
     dirs.append(cache_dir())
     return dirs
 
