@@ -323,6 +323,15 @@ def test_launch_kinds_refuse_bad_sources_and_models_naming_the_entry(bus: Contex
     with pytest.raises(LaunchError, match=r"robot.toml: node camera: source .*ride\.mp4: not "
                                           r"found"):
         start("camera", {"source": "ride.mp4"})
+    pair = photo("camera")
+    for name in ("l.png", "r.png"):
+        cv2.imwrite(str(tmp_path / name), pair)
+    camera = start("camera", {"source": "l.png, r.png", "rate": 50.0, "loop": False})
+    try:  # a stereo pair relative to the launch file opens from any working folder
+        assert wait_for(lambda: camera.camera.published == 1)
+        assert camera.camera.error is None
+    finally:
+        camera.stop()
     with pytest.raises(LaunchError, match="node camera: the camera needs a `source`"):
         start("camera", {})
     with pytest.raises(LaunchError, match=r"node detector: model file .*gone\.onnx: not found"):
@@ -337,6 +346,17 @@ def test_launch_kinds_refuse_bad_sources_and_models_naming_the_entry(bus: Contex
     finally:
         running.stop()
     assert wait_for(lambda: "/cyborg/detector" not in bus.graph.nodes())
+
+
+def test_sources_are_anchored_to_a_folder_except_devices_samples_and_topics() -> None:
+    from cyborg.vision.sources import anchored
+
+    base = Path("/data/run1")
+    assert anchored("ride.mp4", base) == "/data/run1/ride.mp4"
+    assert anchored("l.png, r.png", base) == "/data/run1/l.png,/data/run1/r.png"
+    assert anchored("/abs/l.png,r.png", base) == "/abs/l.png,/data/run1/r.png"
+    for untouched in ("camera:1", "0", "sample:motorcycle", "bus:/cam/image"):
+        assert anchored(untouched, base) == untouched
 
 
 def test_bus_source_pairs_camera_topics_into_frames(bus: Context) -> None:

@@ -17,6 +17,7 @@ from pathlib import Path
 from cyborg.app.node_spec import NodeSpec
 from cyborg.vision import VisionError
 from cyborg.vision.models import CATALOGUE, fetch, find_model
+from cyborg.vision.sources import anchored
 
 DEFAULT_CAMERA_SOURCE = "sample:motorcycle"
 
@@ -57,9 +58,7 @@ def vision_nodes(args: argparse.Namespace, namespace: str) -> list[NodeSpec]:
     if model is None:
         return []
     camera_ns = f"{namespace}/camera"
-    source = args.camera
-    if not source.startswith(("sample:", "camera:")) and not source.isdigit():
-        source = str(Path(source).resolve())
+    source = anchored(args.camera, Path.cwd())
     return [
         NodeSpec("camera", "camera", camera_ns, {"source": source, "rate": 5.0},
                  where="camera (--camera)"),

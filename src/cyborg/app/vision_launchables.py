@@ -39,6 +39,7 @@ from cyborg.vision import (
 )
 from cyborg.vision.camera_node import DEPTH_TOPIC, IMAGE_TOPIC
 from cyborg.vision.models import DEFAULT_MODEL, find_model
+from cyborg.vision.sources import anchored
 
 DEFAULT_CAMERA = "/cyborg/camera"
 
@@ -83,9 +84,7 @@ def start_camera(context: Context, spec: NodeSpec) -> RunningCamera:
                                       read_only=True))
         sim_time = bool(params.declare("use_sim_time", False, "stamp with /clock",
                                        read_only=True))
-        is_file = not source.startswith(("camera:", "sample:", "bus:")) and \
-            not source.isdigit() and "," not in source
-        spec_source = str(spec.path(source)) if is_file else source
+        spec_source = anchored(source, spec.base)
         options = SourceOptions(right=spec.path(right) if right else None,
                                 depth=spec.path(depth) if depth else None, side_by_side=sbs,
                                 image_topic=image_topic or None,

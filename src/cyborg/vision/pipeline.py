@@ -59,11 +59,13 @@ class DetectionPipeline:
         detections = self.detector.detect(frame.left)
         detected = time.perf_counter()
         if depth is not None:
-            detections = [dataclasses.replace(detection, distance=median, depth_fraction=share)
-                          for detection in detections
-                          for median, share in [box_distance(depth, detection.box,
-                                                             inner=self.inner,
-                                                             samples=self.samples)]]
+            measured_detections = []
+            for detection in detections:
+                median, share = box_distance(depth, detection.box, inner=self.inner,
+                                             samples=self.samples)
+                measured_detections.append(dataclasses.replace(
+                    detection, distance=median, depth_fraction=share))
+            detections = measured_detections
         measured = time.perf_counter()
         annotated = annotate(frame.left, detections) if draw else None
         drawn = time.perf_counter()

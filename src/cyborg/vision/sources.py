@@ -47,6 +47,15 @@ def camera_index(spec: str) -> int | None:
     return int(text) if text.isascii() and text.isdigit() else None
 
 
+def anchored(spec: str, base: Path) -> str:
+    """``spec`` with its file paths made absolute against ``base`` (both sides of a stereo
+    pair); cameras, samples and bus topics are left as they are."""
+    if camera_index(spec) is not None or spec.startswith(("camera:", "sample:", "bus:")):
+        return spec
+    return ",".join(str((base / Path(part.strip()).expanduser()).resolve())
+                    for part in spec.split(","))
+
+
 def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
     """The frame source ``spec`` names (see the module's table); ``bus:`` is opened by the
     caller, which owns a bus node."""
