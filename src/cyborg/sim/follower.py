@@ -4,7 +4,8 @@ The robot steers towards a point ``lookahead`` metres further along the path tha
 the path nearest to it — a carrot on the polyline, so corners are rounded by at most the
 lookahead and never cut through walls the planner kept clear of. It turns in place when the
 carrot is far off its heading, slows where the laser sees obstacles close ahead, and brakes in
-time for the goal. On arrival it turns to the goal's heading if asked.
+time for sharp corners (down to a speed at which it can take them) and for the goal. On
+arrival it turns to the goal's heading if asked.
 
 Progress is measured *along the path* (the distance still to go), never as straight-line
 distance: a path may first lead away from a goal.
@@ -34,6 +35,7 @@ class FollowerSettings:
     stop_distance: float = 0.45  # obstacle range ahead (from the scanner) where it stops
     slow_distance: float = 1.5  # obstacle range ahead below which it slows down
     deceleration: float = 0.5  # m/s^2 the robot can brake with
+    sharp_corner: float = math.radians(30)  # turns of the path above this are taken slower
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,7 @@ class PathFollower:
         self.path, self.use_heading = path, use_heading
         self.settings = settings or FollowerSettings()
         self._at_goal = False
+        self._corners, self._corner_speeds = self._sharp_corners()
 
     def update(self, pose: Pose2D, front_range: float,
                stop_range: float | None = None) -> Command:
@@ -75,7 +78,8 @@ class PathFollower:
         if abs(error) > s.turn_in_place:
             return Command(0.0, turn, remaining=remaining)
         speed = s.cruise_speed * math.cos(error)
-        speed = min(speed, math.sqrt(2 * s.deceleration * max(to_goal - 0.05, 0.0)) + 0.05)
+        speed = min(speed, math.sqrt(2 * s.deceleration * max(to_goal - 0.05, 0.0)) + 0.05,
+                    self._corner_limit(along))
         stop = front_range if stop_range is None else stop_range
         blocked = stop <= s.stop_distance and stop + 0.05 < to_goal
         if blocked:
@@ -84,6 +88,34 @@ class PathFollower:
             share = max(0.0, front_range - s.stop_distance) / (s.slow_distance - s.stop_distance)
             speed = min(speed, s.slow_speed + share * (s.cruise_speed - s.slow_speed))
         return Command(max(speed, 0.0), turn, blocked=blocked, remaining=remaining)
+
+    def _sharp_corners(self) -> tuple[np.ndarray, np.ndarray]:
+        """Where along the path it turns by more than ``sharp_corner``, and the speed for each
+        corner: the cruise speed times the cosine of the turn, at least the slow speed."""
+        s, points = self.settings, self.path.points
+        if len(points) < 3:
+            return np.zeros(0), np.zeros(0)
+        steps = np.diff(points, axis=0)
+        lengths = np.hypot(steps[:, 0], steps[:, 1])
+        headings = np.arctan2(steps[:, 1], steps[:, 0])
+        turns = np.abs((np.diff(headings) + np.pi) % (2 * np.pi) - np.pi)
+        along = np.cumsum(lengths)[:-1]  # distance to each inner vertex
+        sharp = (turns > s.sharp_corner) & (lengths[:-1] > 1e-9) & (lengths[1:] > 1e-9)
+        speeds = np.maximum(s.cruise_speed * np.cos(np.minimum(turns[sharp], np.pi / 2)),
+                            s.slow_speed)
+        return along[sharp], speeds
+
+    def _corner_limit(self, along: float) -> float:
+        """The highest speed from which the robot can still slow down to every sharp corner's
+        speed before reaching it (corners the robot is already at count from here)."""
+        limit = math.inf
+        s = self.settings
+        for at, speed in zip(self._corners, self._corner_speeds, strict=True):
+            ahead = max(float(at) - along - s.lookahead, 0.0)
+            if at + s.lookahead < along:
+                continue  # behind the robot
+            limit = min(limit, math.sqrt(float(speed) ** 2 + 2 * s.deceleration * ahead))
+        return limit
 
     def _final_turn(self, pose: Pose2D) -> Command:
         s = self.settings

@@ -19,6 +19,7 @@ from numba import njit
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
+from cyborg.sim.motion_check import Motion, Surroundings, safest_command
 
 
 class PathState(StrEnum):
@@ -86,8 +87,12 @@ class Navigator:
         self.follower = None
 
     def update(self, now: float, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
-               hits: np.ndarray) -> tuple[float, float]:
-        """Speed and turn rate for now; ``hits``: the scan's returns as map points."""
+               hits: np.ndarray, motion: Motion | None = None,
+               period: float = 0.1) -> tuple[float, float]:
+        """Speed and turn rate for the next ``period`` seconds; ``hits``: the scan's returns as
+        map points; ``motion``: how the robot moves now (its odometry). With ``motion``, a
+        command whose motion until standstill would touch a wall or a return is replaced by a
+        gentler one (:func:`cyborg.sim.motion_check.safest_command`)."""
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
         slow, stop = front_ranges(ranges, angles,
@@ -114,7 +119,14 @@ class Navigator:
         if (now - self._replanned_at >= self.settings.replan_interval
                 and (stuck or self._path_blocked(pose, hits))):
             self._replan(now, pose, hits)
-        return command.speed, command.turn_rate
+        if motion is None:
+            return command.speed, command.turn_rate
+        grid = self.planner.grid
+        around = Surroundings(self.planner.wall_clearance, (grid.origin_x, grid.origin_y),
+                              grid.resolution, hits)
+        return safest_command(pose.x, pose.y, pose.theta, motion,
+                              (command.speed, command.turn_rate), period,
+                              self.planner.footprint, around)
 
     def _path_blocked(self, pose: Pose2D, hits: np.ndarray) -> bool:
         assert self.follower is not None

@@ -27,6 +27,7 @@ from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
+from cyborg.sim.motion_check import Motion
 from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
 from cyborg.sim.robot import RobotBase
 
@@ -180,6 +181,15 @@ class Simulator:
             self.step()
         return True
 
+    @property
+    def _period(self) -> float:
+        return self.steps_per_sensor / self.settings.physics_rate
+
+    def _motion(self) -> Motion:
+        base, limits = self.base, self.base.limits
+        return Motion(base.speed, base.turn_rate, limits.acceleration, limits.turn_acceleration,
+                      1.0 / self.settings.physics_rate)
+
     def _sense(self) -> None:
         pose = self.base.pose
         self.ranges = self.laser.scan(pose.x, pose.y, pose.theta)
@@ -190,7 +200,7 @@ class Simulator:
         if self.docking.state is not DockState.UNDOCKED:
             return self._dock_step()
         return self.navigator.update(self.time, self.base.pose, self.ranges, self.angles,
-                                     self.hits)
+                                     self.hits, self._motion(), self._period)
 
     def _dock_step(self) -> tuple[float, float]:
         docking, settings, now = self.docking, self.settings.dock, self.time
@@ -198,7 +208,8 @@ class Simulator:
         travelled = math.hypot(pose.x - docking.travelled_from[0],
                                pose.y - docking.travelled_from[1])
         if docking.phase is DockPhase.APPROACH:
-            command = self.navigator.update(now, pose, self.ranges, self.angles, self.hits)
+            command = self.navigator.update(now, pose, self.ranges, self.angles, self.hits,
+                                            self._motion(), self._period)
             state = self.navigator.state
             if state is PathState.REACHED_GOAL:
                 docking.enter(DockState.DOCKING, DockPhase.DRIVE_IN, now, (pose.x, pose.y))

@@ -1,0 +1,169 @@
+"""Checking a speed command against where the robot's momentum will carry it.
+
+A robot cannot stop or turn at once: with 0.5 m/s² of braking, a robot at 1 m/s still rolls a
+metre. A command that looks right for the path (turn in place towards a new goal) can therefore
+sweep the body into a wall when it is given while the robot still moves — for instance right
+after a goal was replaced by another one. Before a command is sent, :func:`stopping_gap` plays
+it forward: the command for one control period, then braking to a standstill, both within the
+drive's acceleration limits. Along that motion it measures the smallest gap between the body
+(its covering circles) and what the robot knows about: the map's walls (a clearance grid) and
+the laser's latest returns. :func:`safest_command` keeps the wanted command when that gap stays
+open, and otherwise falls back to gentler turns or braking straight — the idea behind ARNL's
+dynamic-window velocity choice, reduced to the few candidates a path follower needs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from cyborg.nav.footprint import Footprint
+
+
+@dataclass(frozen=True)
+class Motion:
+    """How the robot moves now (m/s, rad/s), how fast it can change that (m/s², rad/s²), and
+    the step (s) at which its drive applies changes."""
+
+    speed: float
+    turn_rate: float
+    acceleration: float
+    turn_acceleration: float
+    step: float = 0.02
+
+
+@dataclass(frozen=True)
+class Surroundings:
+    """What the robot knows of the world near it: a wall clearance grid and laser returns."""
+
+    clearance: np.ndarray  # metres from each cell centre to the nearest wall
+    origin: tuple[float, float]
+    resolution: float
+    hits: np.ndarray  # (N, 2) map points of the latest scan
+
+
+MARGIN = 0.0
+"""Gap (m) a command must keep along its motion to count as safe."""
+
+CREEP = 0.1
+"""Speed (m/s) at which a robot that cannot turn where it stands backs off or edges forward."""
+
+
+def stopping_gap(x: float, y: float, theta: float, motion: Motion, command: tuple[float, float],
+                 period: float, footprint: Footprint, around: Surroundings,
+                 enough: float = math.inf) -> float:
+    """Smallest gap (m, negative when overlapping) between the body and the surroundings while
+    the robot follows ``command`` for ``period`` seconds and then brakes to a standstill.
+
+    Poses whose gap is certainly at least ``enough`` are not looked at: then the result is
+    exact only when it is below ``enough``; above, it only says "at least ``enough``"."""
+    offsets, radius = footprint.circles()
+    hits = np.ascontiguousarray(around.hits, dtype=np.float64).reshape(-1, 2)
+    return float(_stopping_gap(
+        x, y, theta, motion.speed, motion.turn_rate, command[0], command[1],
+        motion.acceleration, motion.turn_acceleration, motion.step, period, enough,
+        offsets.astype(np.float64), radius, around.clearance, around.origin[0], around.origin[1],
+        around.resolution, hits))
+
+
+def safest_command(x: float, y: float, theta: float, motion: Motion,
+                   wanted: tuple[float, float], period: float, footprint: Footprint,
+                   around: Surroundings) -> tuple[float, float]:
+    """``wanted`` when its motion keeps :data:`MARGIN` (or, where the robot is closer than
+    that already, does not get closer); otherwise the first safe of: the same speed with half
+    and a quarter of the turn; no speed with half and a quarter of the turn; when the robot
+    stands and cannot turn on the spot, :data:`CREEP` backwards or forwards while turning, then
+    straight; and at last braking straight. When none is safe, the one keeping most room (the
+    gentler one of equals)."""
+    standing = Motion(0.0, 0.0, 1.0, 1.0, motion.step)
+    needed = min(MARGIN, stopping_gap(x, y, theta, standing, (0.0, 0.0), 0.0, footprint,
+                                      around))
+    speed, turn = wanted
+    candidates = [wanted, (speed, turn / 2), (speed, turn / 4), (0.0, turn / 2), (0.0, turn / 4)]
+    if speed == 0.0 and turn != 0.0:  # a turn on the spot: or on a tight arc, or straight
+        candidates += [(CREEP, turn), (CREEP, turn / 2), (-CREEP, turn), (-CREEP, turn / 2),
+                       (CREEP, 0.0), (-CREEP, 0.0)]
+    candidates.append((0.0, 0.0))
+    best, best_gap = wanted, -math.inf
+    for candidate in candidates:
+        gap = stopping_gap(x, y, theta, motion, candidate, period, footprint, around, needed)
+        if gap >= needed:
+            return candidate
+        if gap >= best_gap:
+            best, best_gap = candidate, gap
+    return best
+
+
+@njit(cache=True)
+def _limited(value: float, most: float) -> float:  # pragma: no cover - jit
+    return max(-most, min(most, value))
+
+
+@njit(cache=True)
+def _body_gap(x: float, y: float, theta: float, offsets: np.ndarray, radius: float,
+              clearance: np.ndarray, ox: float, oy: float, resolution: float,
+              near: np.ndarray) -> float:  # pragma: no cover - jit
+    """The body's gap at one pose, looked up as the simulated drive does (cell by floor)."""
+    rows, columns = clearance.shape
+    lowest = np.inf
+    for offset in offsets:
+        cx = x + offset * math.cos(theta)
+        cy = y + offset * math.sin(theta)
+        r = int((cy - oy) // resolution)
+        c = int((cx - ox) // resolution)
+        gap = clearance[r, c] if 0 <= r < rows and 0 <= c < columns else 0.0
+        for i in range(near.shape[0]):
+            d = math.hypot(near[i, 0] - cx, near[i, 1] - cy)
+            if d < gap:
+                gap = d
+        lowest = min(lowest, gap - radius)
+    return lowest
+
+
+@njit(cache=True)
+def _stopping_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: float,
+                  cmd_w: float, accel: float, turn_accel: float, dt: float, period: float,
+                  enough: float, offsets: np.ndarray, radius: float, clearance: np.ndarray,
+                  ox: float, oy: float, resolution: float,
+                  hits: np.ndarray) -> float:  # pragma: no cover - jit
+    # only returns the body can get near matter; the stopping motion is at most ``reach``
+    stop = (abs(v) + abs(cmd_v)) * (period + (abs(v) + abs(cmd_v)) / accel)
+    turn = (abs(w) + abs(cmd_w)) * (period + (abs(w) + abs(cmd_w)) / turn_accel)
+    farthest = np.abs(offsets).max()
+    around = stop + turn * farthest + farthest + radius + 0.5
+    count = 0
+    near = np.empty_like(hits)
+    for i in range(hits.shape[0]):
+        if abs(hits[i, 0] - x) < around and abs(hits[i, 1] - y) < around:
+            near[count] = hits[i]
+            count += 1
+    near = near[:count]
+    # the motion, integrated as the simulated drive does (exact arcs per step). A body whose
+    # gap was g can move g before touching, give or take a grid cell: poses are looked at only
+    # once the way moved since the last look could have used up the room above ``enough``
+    slack = 1.5 * resolution
+    lowest = _body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
+    looked, moved, t = lowest, 0.0, 0.0
+    while t < 60.0:  # bounded: braking always ends
+        target_v, target_w = (cmd_v, cmd_w) if t < period else (0.0, 0.0)
+        v += _limited(target_v - v, accel * dt)
+        w += _limited(target_w - w, turn_accel * dt)
+        heading = theta + w * dt
+        if abs(w) > 1e-9:
+            x += v / w * (math.sin(heading) - math.sin(theta))
+            y -= v / w * (math.cos(heading) - math.cos(theta))
+        else:
+            x += v * dt * math.cos(theta)
+            y += v * dt * math.sin(theta)
+        theta = heading
+        moved += (abs(v) + abs(w) * farthest) * dt
+        t += dt
+        if looked - moved - slack < enough:
+            looked = _body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
+            lowest, moved = min(lowest, looked), 0.0
+        if t >= period and v == 0.0 and w == 0.0:
+            break
+    return lowest
