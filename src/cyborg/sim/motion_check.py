@@ -8,8 +8,9 @@ it forward: the command for one control period, then braking to a standstill, bo
 drive's acceleration limits. Along that motion it measures the smallest gap between the body
 (its covering circles) and what the robot knows about: the map's walls (a clearance grid) and
 the laser's latest returns. :func:`safest_command` keeps the wanted command when that gap stays
-open, and otherwise falls back to gentler turns or braking straight — the idea behind ARNL's
-dynamic-window velocity choice, reduced to the few candidates a path follower needs.
+open, and otherwise falls back to gentler turns, a slow creep or braking straight — the idea
+behind ARNL's dynamic-window velocity choice, reduced to the few candidates a path follower
+needs.
 """
 
 from __future__ import annotations
@@ -46,7 +47,9 @@ class Surroundings:
 
 
 MARGIN = 0.0
-"""Gap (m) a command must keep along its motion to count as safe."""
+"""Gap (m) a command must keep along its motion to count as safe. Zero suits the simulator,
+whose body and walls are exactly the ones checked here; doors the planner squeezes through
+(at the inscribed radius) leave no more. A real base would want its sensors' error here."""
 
 CREEP = 0.1
 """Speed (m/s) at which a robot that cannot turn where it stands backs off or edges forward."""
@@ -74,10 +77,13 @@ def safest_command(x: float, y: float, theta: float, motion: Motion,
                    around: Surroundings) -> tuple[float, float]:
     """``wanted`` when its motion keeps :data:`MARGIN` (or, where the robot is closer than
     that already, does not get closer); otherwise the first safe of: the same speed with half
-    and a quarter of the turn; no speed with half and a quarter of the turn; when the robot
-    stands and cannot turn on the spot, :data:`CREEP` backwards or forwards while turning, then
-    straight; and at last braking straight. When none is safe, the one keeping most room (the
-    gentler one of equals)."""
+    and a quarter of the turn; no speed with half and a quarter of the turn; when the wanted
+    turn was on the spot, :data:`CREEP` forwards, then backwards, on a tight arc (full, then
+    half turn), then straight; and at last braking straight. When none is safe, the one
+    keeping most room (the gentler one of equals).
+
+    Checked again every control period, this keeps the robot clear by induction: once a safe
+    command was chosen, braking after it was found clear, so next period braking still is."""
     standing = Motion(0.0, 0.0, 1.0, 1.0, motion.step)
     needed = min(MARGIN, stopping_gap(x, y, theta, standing, (0.0, 0.0), 0.0, footprint,
                                       around))
