@@ -218,6 +218,10 @@ def test_folder_errors(tmp_path: Path) -> None:
     write_image(tmp_path / "one" / "1.png", texture(2, 2, 0))
     with pytest.raises(VisionError, match="rate must be positive"):
         FolderSource(tmp_path / "one", rate=0.0)
+    # frames are paired by name: two images of one name cannot both be frame "1"
+    write_image(tmp_path / "one" / "1.jpg", texture(2, 2, 1))
+    with pytest.raises(VisionError, match=r"one: 1\.jpg and 1\.png have the same name"):
+        FolderSource(tmp_path / "one")
 
 
 # --------------------------------------------------------------------------- videos
@@ -265,6 +269,21 @@ def test_stereo_pair_of_videos(tmp_path: Path) -> None:
     frames = frames_of(source)
     assert mean_levels([frame.left for frame in frames]) == pytest.approx([20, 40, 60], abs=4)
     rights = [frame.right for frame in frames if frame.right is not None]
+    assert mean_levels(rights) == pytest.approx([200, 220, 240], abs=4)
+
+
+@pytest.mark.parametrize("suffix", [".avi", ".mp4"])
+def test_a_video_plays_from_the_start_each_time_it_is_iterated(tmp_path: Path,
+                                                               suffix: str) -> None:
+    left = write_video(tmp_path / f"left{suffix}", grey_levels([20, 40, 60]))
+    right = write_video(tmp_path / f"right{suffix}", grey_levels([200, 220, 240]))
+    source = VideoSource(left, right=right)
+    first = list(source.frames())
+    again = list(source.frames())
+    source.close()
+    assert [frame.stamp_ns for frame in again] == [frame.stamp_ns for frame in first]
+    assert mean_levels([frame.left for frame in again]) == pytest.approx([20, 40, 60], abs=4)
+    rights = [frame.right for frame in again if frame.right is not None]
     assert mean_levels(rights) == pytest.approx([200, 220, 240], abs=4)
 
 
@@ -421,6 +440,14 @@ def test_bag_pairs_image_and_depth_by_exact_stamp(tmp_path: Path, kind: str, col
         assert frame.right is None
         assert frame.frame_id == "camera_left"  # the image's, not the depth map's
     assert source.dropped == 2
+
+
+def test_ros1_bag_with_an_upper_case_suffix_is_named_as_a_bag_to_rename(tmp_path: Path) -> None:
+    bag, _ = camera_bag(NOETIC, "rgb8", "32FC1")
+    upper = tmp_path / "CAM.BAG"
+    bag.write(tmp_path / "cam.bag", "ros1").rename(upper)
+    with pytest.raises(VisionError, match=r"CAM\.BAG: .*rename it to CAM\.bag"):
+        open_source(str(upper))
 
 
 @pytest.mark.parametrize("kind", ["sqlite3", "mcap"])

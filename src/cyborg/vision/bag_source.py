@@ -28,18 +28,22 @@ BAG_SUFFIXES = frozenset({".bag", ".db3", ".mcap"})
 
 
 def is_bag(path: Path) -> bool:
-    return path.suffix in BAG_SUFFIXES or (path.is_dir() and (path / "metadata.yaml").is_file())
+    return (path.suffix.lower() in BAG_SUFFIXES
+            or (path.is_dir() and (path / "metadata.yaml").is_file()))
 
 
 def _bag_path(path: Path) -> Path:
     """A ROS 2 storage file is read through its bag folder (where ``metadata.yaml`` lives)."""
-    if path.suffix in (".db3", ".mcap") and path.is_file():
+    if path.suffix.lower() in (".db3", ".mcap") and path.is_file():
         if not (path.parent / "metadata.yaml").is_file():
             raise VisionError(f"bag {path}: a ROS 2 bag is a folder with metadata.yaml next to "
                               "its storage files; give the folder")
         return path.parent
     if not path.exists():
         raise VisionError(f"bag {path}: not found")
+    if path.suffix.lower() == ".bag" and path.suffix != ".bag":
+        raise VisionError(f"bag {path}: ROS 1 bags are read only with the suffix '.bag' in "
+                          f"lower case; rename it to {path.with_suffix('.bag').name}")
     return path
 
 

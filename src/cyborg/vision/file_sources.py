@@ -82,8 +82,17 @@ def _frame(stamp: int, left: np.ndarray, right: np.ndarray | None, depth: np.nda
 
 
 def _files(folder: Path, suffixes: frozenset[str]) -> dict[str, Path]:
-    return {path.stem: path for path in sorted(folder.iterdir())
-            if path.is_file() and path.suffix.lower() in suffixes}
+    """The folder's files with one of ``suffixes``, by name without suffix (which pairs a left
+    image with its right image and depth map); two files of one name are an error."""
+    found: dict[str, Path] = {}
+    for path in sorted(folder.iterdir()):
+        if not (path.is_file() and path.suffix.lower() in suffixes):
+            continue
+        if path.stem in found:
+            raise VisionError(f"image folder {folder}: {found[path.stem].name} and {path.name} "
+                              "have the same name; frames are paired by name, keep one")
+        found[path.stem] = path
+    return found
 
 
 class FolderSource(FrameSource):
@@ -162,6 +171,11 @@ class VideoSource(FrameSource):
         return capture
 
     def frames(self) -> Iterator[Frame]:
+        """The frames from the start (a video file is rewound; a camera goes on live)."""
+        if not self.camera:
+            for capture in (self.capture, self.right_capture):
+                if capture is not None:
+                    capture.set(cv2.CAP_PROP_POS_FRAMES, 0)
         index = 0
         while True:
             ok, image = self.capture.read()
