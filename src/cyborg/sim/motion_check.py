@@ -103,6 +103,14 @@ def safest_command(x: float, y: float, theta: float, motion: Motion,
     return best
 
 
+def warm_up() -> None:
+    """Compile (or load from numba's cache) the check's kernel now: the first compilation takes
+    seconds, which would otherwise fall on the robot's first move."""
+    around = Surroundings(np.ones((4, 4), np.float32), (0.0, 0.0), 1.0, np.zeros((1, 2)))
+    stopping_gap(2.0, 2.0, 0.0, Motion(0.0, 0.0, 1.0, 1.0), (0.0, 0.0), 0.1,
+                 Footprint(length=0.2, width=0.1), around)
+
+
 @njit(cache=True)
 def _limited(value: float, most: float) -> float:  # pragma: no cover - jit
     return max(-most, min(most, value))

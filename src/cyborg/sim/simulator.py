@@ -27,7 +27,7 @@ from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
-from cyborg.sim.motion_check import Motion
+from cyborg.sim.motion_check import Motion, warm_up
 from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
 from cyborg.sim.robot import RobotBase
 
@@ -59,6 +59,7 @@ class Simulator:
         self.steps_per_sensor = max(1, round(rates))
         self._command = (0.0, 0.0)
         self._after_dock: tuple[Pose2D, bool] | None = None
+        warm_up()  # the motion check's kernel, before the robot moves
         self.load_map(arnl_map, start)
 
     # ------------------------------------------------------------------ world
