@@ -239,3 +239,22 @@ def test_cyborg_monitor_serves_and_a_taken_port_is_a_clear_error() -> None:
     stats = json.loads(urllib.request.urlopen(url + "stats", timeout=5).read())
     assert stats["trees"] == ["/robot1/bt"]
     assert process.wait(timeout=60) == 0
+
+
+def test_a_stop_that_hangs_ends_the_process_and_says_where() -> None:
+    """Ctrl-C always ends `cyborg up` / `cyborg launch`: a part that does not stop within the
+    deadline is named, with every thread's stack, and the process exits."""
+    script = ("import time\n"
+              "from cyborg.app.launch import end_if_stuck\n"
+              "class Stuck:\n"
+              "    stopping = 'tree runner /cyborg/bt/tree_runner'\n"
+              "end_if_stuck(Stuck(), deadline=0.5)\n"
+              "time.sleep(60)  # a stop that never ends\n")
+    started = time.monotonic()
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=30)
+    assert time.monotonic() - started < 20
+    assert done.returncode == 1
+    assert ("still stopping after 0.5 s, at: tree runner /cyborg/bt/tree_runner"
+            in done.stderr)
+    assert "most recent call first" in done.stderr  # the threads' stacks

@@ -27,9 +27,12 @@ every node and every child cleanly. Relative paths are relative to the launch fi
 
 from __future__ import annotations
 
+import faulthandler
+import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -131,6 +134,7 @@ class Launch:
         self.description, self.context = description, context
         self.running: list[Running] = []
         self.children: list[tuple[str, subprocess.Popen[bytes]]] = []
+        self.stopping = ""
 
     def start(self, process: str = "main", *, children: list[str] | None = None,
               connect: str = "") -> None:
@@ -172,7 +176,9 @@ class Launch:
         return 0
 
     def stop(self) -> None:
-        """Stop children (SIGINT, then SIGKILL after 5 s) and this process's nodes."""
+        """Stop children (SIGINT, then SIGKILL after 5 s) and this process's nodes;
+        :attr:`stopping` says which part is stopping now."""
+        self.stopping = "child processes"
         for _name, child in self.children:
             if child.poll() is None:
                 child.send_signal(signal.SIGINT)
@@ -182,8 +188,27 @@ class Launch:
             except subprocess.TimeoutExpired:
                 child.kill()
         for item in reversed(self.running):
+            self.stopping = item.describe()
             item.stop()
+        self.stopping = "the bus and the interpreter's exit"
         self.running.clear()
+
+
+STOP_DEADLINE = 20.0
+"""Seconds a command's process may take to stop before it is ended with a report."""
+
+
+def end_if_stuck(launch: Launch, deadline: float = STOP_DEADLINE) -> None:
+    """For a command about to stop ``launch`` and exit: Ctrl-C always ends the process. If it
+    is still alive ``deadline`` seconds from now, what was stopping and every thread's stack
+    go to stderr and the process exits with code 1. (Not for a process that goes on.)"""
+    def overdue() -> None:
+        time.sleep(deadline)
+        print(f"cyborg: still stopping after {deadline:g} s, at: {launch.stopping}; the "
+              "threads' stacks follow, then the process ends", file=sys.stderr, flush=True)
+        faulthandler.dump_traceback(file=sys.stderr)
+        os._exit(1)
+    threading.Thread(target=overdue, name="stop-deadline", daemon=True).start()
 
 
 def _interrupt(signum: int, frame: object) -> None:

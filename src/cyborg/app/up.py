@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from cyborg.app.bt_commands import CommandError
-from cyborg.app.launch import Launch, LaunchDescription, read_launch
+from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck, read_launch
 from cyborg.app.launchables import LaunchError, NodeSpec, RunningTree
 from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
 from cyborg.app.status_line import StatusLine
@@ -135,6 +135,7 @@ def run(description: LaunchDescription, args: argparse.Namespace, *, title: str,
     except LaunchError as exc:
         raise CommandError(str(exc)) from exc
     finally:
+        end_if_stuck(launch)
         launch.stop()
         context.close()
     if code == 130:
