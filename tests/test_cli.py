@@ -153,7 +153,14 @@ def test_dot_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
 def _cyborg(*args: str) -> subprocess.Popen[str]:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     return subprocess.Popen([sys.executable, "-m", "cyborg", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+                            stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=_interruptible)
+
+
+def _interruptible() -> None:
+    """Ctrl-C reaches the child even when these tests run as a shell's background job (which
+    starts them, and so their children, with SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def test_ctrl_c_stops_cleanly_and_halts() -> None:

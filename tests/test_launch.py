@@ -148,7 +148,8 @@ def test_launch_across_processes_and_control_from_the_shell(
     path = _launch_file(tmp_path, shared, port=port, process="robot")
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     parent = subprocess.Popen([sys.executable, "-m", "cyborg", "launch", str(path)],
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env)
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env,
+                              preexec_fn=_interruptible)
     endpoint = f"tcp/127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + 60
@@ -258,3 +259,9 @@ def test_a_stop_that_hangs_ends_the_process_and_says_where() -> None:
     assert ("still stopping after 0.5 s, at: tree runner /cyborg/bt/tree_runner"
             in done.stderr)
     assert "most recent call first" in done.stderr  # the threads' stacks
+
+
+def _interruptible() -> None:
+    """Ctrl-C reaches the child even when these tests run as a shell's background job (which
+    starts them, and so their children, with SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

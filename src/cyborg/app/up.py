@@ -15,6 +15,7 @@ and where, then a live line of what the tree does; Ctrl-C stops everything clean
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from importlib.resources import files
 from pathlib import Path
@@ -114,6 +115,10 @@ def launch_command(args: argparse.Namespace) -> int:
         description.listen = args.listen
     if args.connect:
         description.connect = list(args.connect)
+    if args.process != "main":
+        # a launch's child is stopped by its parent's SIGINT, even when it was started where
+        # SIGINT is ignored (a shell's background job passes that on to what it starts)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     return run(description, args, title=f"cyborg launch {args.file}", process=args.process)
 
 
