@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -103,3 +104,10 @@ def write_tree(folder: Path, root: dict[str, Any], name: str = "tree.b3.json") -
     path = folder / name
     path.write_text(json.dumps(project, indent=2))
     return path
+
+
+def interruptible() -> None:
+    """For a child process a test stops with SIGINT: Ctrl-C reaches it even when the tests run
+    as a shell's background job (which starts them, and so their children, with SIGINT
+    ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -15,6 +15,7 @@ import pytest
 from cyborg.app.cli import main
 from tests.builders import N, project_json, tree_json
 from tests.conftest import shared_dir
+from tests.system import interruptible
 
 PATROL = shared_dir() / "trees" / "patrol_recharge.b3.json"
 STOCK = shared_dir() / "trees" / "stock_nodes.tree.json"
@@ -154,13 +155,9 @@ def _cyborg(*args: str) -> subprocess.Popen[str]:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     return subprocess.Popen([sys.executable, "-m", "cyborg", *args], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=env,
-                            preexec_fn=_interruptible)
+                            preexec_fn=interruptible)
 
 
-def _interruptible() -> None:
-    """Ctrl-C reaches the child even when these tests run as a shell's background job (which
-    starts them, and so their children, with SIGINT ignored)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def test_ctrl_c_stops_cleanly_and_halts() -> None:

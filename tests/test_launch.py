@@ -19,6 +19,7 @@ from cyborg.app.cli import main
 from cyborg.app.launch import Launch, read_launch
 from cyborg.app.launchables import LaunchError, RunningSimulator, RunningTree
 from cyborg.bus import BusConfig, Context
+from tests.system import interruptible
 
 
 def _free_port() -> int:
@@ -149,7 +150,7 @@ def test_launch_across_processes_and_control_from_the_shell(
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     parent = subprocess.Popen([sys.executable, "-m", "cyborg", "launch", str(path)],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env,
-                              preexec_fn=_interruptible)
+                              preexec_fn=interruptible)
     endpoint = f"tcp/127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + 60
@@ -259,9 +260,3 @@ def test_a_stop_that_hangs_ends_the_process_and_says_where() -> None:
     assert ("still stopping after 0.5 s, at: tree runner /cyborg/bt/tree_runner"
             in done.stderr)
     assert "most recent call first" in done.stderr  # the threads' stacks
-
-
-def _interruptible() -> None:
-    """Ctrl-C reaches the child even when these tests run as a shell's background job (which
-    starts them, and so their children, with SIGINT ignored)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
