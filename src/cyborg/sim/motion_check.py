@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from cyborg.nav.footprint import Footprint
+from cyborg.sim.robot import arc_step, body_gap
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ def stopping_gap(x: float, y: float, theta: float, motion: Motion, command: tupl
     return float(_stopping_gap(
         x, y, theta, motion.speed, motion.turn_rate, command[0], command[1],
         motion.acceleration, motion.turn_acceleration, motion.step, period, enough,
-        offsets.astype(np.float64), radius, around.clearance, around.origin[0], around.origin[1],
+        offsets, radius, around.clearance, around.origin[0], around.origin[1],
         around.resolution, hits))
 
 
@@ -117,27 +118,6 @@ def _limited(value: float, most: float) -> float:  # pragma: no cover - jit
 
 
 @njit(cache=True)
-def _body_gap(x: float, y: float, theta: float, offsets: np.ndarray, radius: float,
-              clearance: np.ndarray, ox: float, oy: float, resolution: float,
-              near: np.ndarray) -> float:  # pragma: no cover - jit
-    """The body's gap at one pose, looked up as the simulated drive does (cell by floor)."""
-    rows, columns = clearance.shape
-    lowest = np.inf
-    for offset in offsets:
-        cx = x + offset * math.cos(theta)
-        cy = y + offset * math.sin(theta)
-        r = int((cy - oy) // resolution)
-        c = int((cx - ox) // resolution)
-        gap = clearance[r, c] if 0 <= r < rows and 0 <= c < columns else 0.0
-        for i in range(near.shape[0]):
-            d = math.hypot(near[i, 0] - cx, near[i, 1] - cy)
-            if d < gap:
-                gap = d
-        lowest = min(lowest, gap - radius)
-    return lowest
-
-
-@njit(cache=True)
 def _stopping_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: float,
                   cmd_w: float, accel: float, turn_accel: float, dt: float, period: float,
                   enough: float, offsets: np.ndarray, radius: float, clearance: np.ndarray,
@@ -155,28 +135,21 @@ def _stopping_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: f
             near[count] = hits[i]
             count += 1
     near = near[:count]
-    # the motion, integrated as the simulated drive does (exact arcs per step). A body whose
+    # the motion, integrated as the simulated drive does (its arc_step, body_gap). A body whose
     # gap was g can move g before touching, give or take a grid cell: poses are looked at only
     # once the way moved since the last look could have used up the room above ``enough``
     slack = 1.5 * resolution
-    lowest = _body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
+    lowest = body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
     looked, moved, t = lowest, 0.0, 0.0
     while t < 60.0:  # bounded: braking always ends
         target_v, target_w = (cmd_v, cmd_w) if t < period else (0.0, 0.0)
         v += _limited(target_v - v, accel * dt)
         w += _limited(target_w - w, turn_accel * dt)
-        heading = theta + w * dt
-        if abs(w) > 1e-9:
-            x += v / w * (math.sin(heading) - math.sin(theta))
-            y -= v / w * (math.cos(heading) - math.cos(theta))
-        else:
-            x += v * dt * math.cos(theta)
-            y += v * dt * math.sin(theta)
-        theta = heading
+        x, y, theta = arc_step(x, y, theta, v, w, dt)
         moved += (abs(v) + abs(w) * farthest) * dt
         t += dt
         if looked - moved - slack < enough:
-            looked = _body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
+            looked = body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
             lowest, moved = min(lowest, looked), 0.0
         if t >= period and v == 0.0 and w == 0.0:
             break

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Pose2D, normalize_angle
@@ -62,14 +63,7 @@ class RobotBase:
         self.speed += _limited(speed - self.speed, limits.acceleration * dt)
         self.turn_rate += _limited(turn_rate - self.turn_rate, limits.turn_acceleration * dt)
         pose = self.pose
-        theta = pose.theta + self.turn_rate * dt
-        if abs(self.turn_rate) > 1e-9:
-            radius = self.speed / self.turn_rate
-            x = pose.x + radius * (math.sin(theta) - math.sin(pose.theta))
-            y = pose.y - radius * (math.cos(theta) - math.cos(pose.theta))
-        else:
-            x = pose.x + self.speed * dt * math.cos(pose.theta)
-            y = pose.y + self.speed * dt * math.sin(pose.theta)
+        x, y, theta = arc_step(pose.x, pose.y, pose.theta, self.speed, self.turn_rate, dt)
         moved = Pose2D(x, y, normalize_angle(theta))
         if self.collides(moved) and self._worse(moved):
             if self.speed or self.turn_rate:
@@ -91,16 +85,8 @@ class RobotBase:
     def body_clearance(self, pose: Pose2D) -> float:
         """Smallest gap (metres, negative when overlapping) between the body and a wall."""
         offsets, radius = self.footprint.circles()
-        rows, columns = self.clearance.shape
-        lowest = math.inf
-        for offset in offsets:
-            cx = pose.x + offset * math.cos(pose.theta)
-            cy = pose.y + offset * math.sin(pose.theta)
-            r = int((cy - self.origin[1]) // self.resolution)
-            c = int((cx - self.origin[0]) // self.resolution)
-            gap = float(self.clearance[r, c]) if 0 <= r < rows and 0 <= c < columns else 0.0
-            lowest = min(lowest, gap - radius)
-        return lowest
+        return float(body_gap(pose.x, pose.y, pose.theta, offsets, radius, self.clearance,
+                              self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
 
     def collides(self, pose: Pose2D) -> bool:
         return self.body_clearance(pose) < 0.0
@@ -112,3 +98,42 @@ class RobotBase:
 
 def _limited(change: float, most: float) -> float:
     return max(-most, min(most, change))
+
+
+_NO_POINTS = np.zeros((0, 2))
+
+
+@njit(cache=True)
+def arc_step(x: float, y: float, theta: float, speed: float, turn_rate: float,
+             dt: float) -> tuple[float, float, float]:  # pragma: no cover - jit
+    """Where unicycle motion at ``speed`` and ``turn_rate`` for ``dt`` seconds leads: an exact
+    arc (a straight line when not turning). The heading is not normalised."""
+    heading = theta + turn_rate * dt
+    if abs(turn_rate) > 1e-9:
+        radius = speed / turn_rate
+        return (x + radius * (math.sin(heading) - math.sin(theta)),
+                y - radius * (math.cos(heading) - math.cos(theta)), heading)
+    return x + speed * dt * math.cos(theta), y + speed * dt * math.sin(theta), heading
+
+
+@njit(cache=True)
+def body_gap(x: float, y: float, theta: float, offsets: np.ndarray, radius: float,
+             clearance: np.ndarray, ox: float, oy: float, resolution: float,
+             points: np.ndarray) -> float:  # pragma: no cover - jit
+    """The body's smallest gap at a pose: its circles (centres ``offsets`` along the heading)
+    against a clearance grid (looked up by the cell each centre falls in; 0 outside) and
+    against ``points`` (N x 2, e.g. laser returns; may be empty)."""
+    rows, columns = clearance.shape
+    lowest = np.inf
+    for offset in offsets:
+        cx = x + offset * math.cos(theta)
+        cy = y + offset * math.sin(theta)
+        r = int((cy - oy) // resolution)
+        c = int((cx - ox) // resolution)
+        gap = clearance[r, c] if 0 <= r < rows and 0 <= c < columns else 0.0
+        for i in range(points.shape[0]):
+            d = math.hypot(points[i, 0] - cx, points[i, 1] - cy)
+            if d < gap:
+                gap = d
+        lowest = min(lowest, gap - radius)
+    return lowest
