@@ -28,6 +28,7 @@ from cyborg.monitor.export import (
 )
 from cyborg.monitor.seat import ControlSeat, is_loopback
 from cyborg.monitor.tree_state import FRESH, StructureError, TreeState
+from cyborg.nodes.tree_runner import TreeRunnerNode
 from tests.builders import N, tree_from
 from tests.system import System, running_system, wait_until
 
@@ -271,3 +272,48 @@ def test_other_machines_watch_but_do_not_control_without_the_token(system: Syste
             assert refused.value.code == 1008, "another site's page may not connect"
     finally:
         monitor.stop()
+
+
+def _watch(socket: Any, namespace: str) -> list[dict[str, Any]]:
+    """Watch ``namespace``; returns what the server sent for it, up to its snapshot."""
+    socket.send_json({"t": "watch", "ns": namespace})
+    _receive_until(socket, "watching")
+    sent: list[dict[str, Any]] = []
+    while not sent or sent[-1]["t"] != "snapshot":
+        sent.append(socket.receive_json())
+        assert len(sent) < 50, f"no snapshot for {namespace}"
+    return sent
+
+
+def test_a_page_that_returns_to_a_robot_gets_its_tree_again(system: System,
+                                                            shared: Path) -> None:
+    other = TreeRunnerNode(Node("tree_runner", "/other/bt", context=system.context),
+                           shared / "trees" / "stock_nodes.tree.json")
+    other.start()
+    monitor = Monitor(Node("monitor", "/cyborg", context=system.context),
+                      namespaces=["/cyborg/bt", "/other/bt"])
+    try:
+        wait_until(lambda: all(source.state is not None
+                               for source in monitor.hub.sources.values()), 10, "both trees")
+        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
+                client.websocket_connect("/ws") as socket:
+            for namespace in ("/cyborg/bt", "/other/bt", "/cyborg/bt", "/other/bt"):
+                sent = _watch(socket, namespace)
+                version = monitor.hub.sources[namespace].state.version  # type: ignore[union-attr]
+                structures = [message for message in sent if message["t"] == "structure"]
+                assert [(message["ns"], message["v"]) for message in structures] == [
+                    (namespace, version)], f"the page shows another tree: {namespace} again"
+                assert sent[-1]["v"] == version
+                tick = _receive_until(socket, "tick")
+                assert (tick["ns"], tick["v"]) == (namespace, version)
+            socket.send_json({"t": "refresh"})
+            again = _receive_until(socket, "structure")
+            assert again["ns"] == "/other/bt", "Refresh sends the structure again"
+            socket.send_json({"t": "watch", "ns": "/other/bt"})
+            _receive_until(socket, "watching")
+            assert all(message["t"] != "structure"
+                       for message in [socket.receive_json() for _ in range(3)]), \
+                "watching the tree the page shows again needs no structure"
+    finally:
+        monitor.stop()
+        other.destroy()

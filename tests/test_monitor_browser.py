@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import pytest
 from playwright.sync_api import Browser, Page, sync_playwright
 
 from cyborg.app.launchables import NodeSpec, RunningTree, start_tree_runner
+from cyborg.bt.node import Node as BtNode
 from cyborg.bus import Node
 from cyborg.monitor import Monitor
 from cyborg.monitor.monitor import _lan_address
@@ -93,17 +94,29 @@ def test_renders_the_sample_trees_one_robot_each(browser: Browser, live: Live,
         for namespace, runner in extra:
             _wait_page(page, f"[...document.querySelectorAll('#robot option')].some("
                              f"o => o.value === {namespace!r})")
-            page.select_option("#robot", namespace)
-            _wait_page(page, f"window.__monitor.drawn === {len(runner.tree)}")
-            labels = set(page.locator("g.node text").all_text_contents())
-            assert {node.label for node in runner.tree} <= labels | {
-                node.label[:39] + "…" for node in runner.tree}
+            _show_robot(page, namespace, runner.tree)
             screenshot(page, namespace.strip("/").replace("/", "_"))
         assert page.locator("#robot option").count() == 3, "several robots from one page"
+        # back to robots the page has shown before: their trees are drawn and follow again
+        _show_robot(page, "/cyborg/bt", live.system.runner.tree)
+        _show_robot(page, extra[0][0], extra[0][1].tree)
         assert errors == []
     finally:
         for _namespace, runner in extra:
             runner.destroy()
+
+
+def _show_robot(page: Page, namespace: str, tree: Iterable[BtNode]) -> None:
+    """Pick ``namespace`` in the robot list; wait until its whole tree is drawn and ticks of
+    that tree arrive."""
+    nodes = list(tree)
+    page.select_option("#robot", namespace)
+    _wait_page(page, f"window.__monitor.drawn === {len(nodes)}")
+    assert page.locator("g.node").count() == len(nodes)
+    labels = set(page.locator("g.node text").all_text_contents())
+    assert {node.label for node in nodes} <= labels | {node.label[:39] + "…" for node in nodes}
+    frames = page.evaluate("window.__monitor.frames")
+    _wait_page(page, f"window.__monitor.frames > {frames + 3}")
 
 
 def test_the_active_path_follows_the_running_tree(browser: Browser, live: Live) -> None:

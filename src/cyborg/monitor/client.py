@@ -29,8 +29,10 @@ class Client:
         self.key = f"client-{number}"
         """Set by the page's hello (stable across reloads of one tab)."""
         self.watching: str | None = None
-        self.versions: set[str] = set()
-        """Structure versions this client has been sent."""
+        self.shown: tuple[str, str] | None = None
+        """(namespace, structure version) of the tree the page draws now. A page keeps only
+        the structure it draws, so any other tree, even one it was sent before, is sent
+        again; deltas go only to a page that shows their tree."""
         self.queue: asyncio.Queue[str] = asyncio.Queue(QUEUE_LIMIT)
         self.dropped = 0
         self.sent = 0

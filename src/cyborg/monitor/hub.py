@@ -7,8 +7,10 @@ bus ever waits for a browser.
 * **Ticks** are coalesced: at most one frame per :data:`FRAME_INTERVAL` per tree, each frame
   holding only the nodes whose display changed (see :mod:`cyborg.monitor.tree_state`). A frame
   is encoded once and queued to every browser watching that tree.
-* **Structures** go to a browser once per version; a restarted runner with the same tree only
-  resets the statuses.
+* **Structures** go to a browser when it starts showing a tree (a namespace and version) it
+  does not show now: once per version while it stays on one robot, again when it comes back
+  to a robot it left (the page keeps only the tree it draws). A restarted runner with the same
+  tree only resets the statuses.
 * **Commands** from browsers (run/pause, per-node control, step, resume) are checked against
   the control seat (:mod:`cyborg.monitor.seat`) and run as blocking service calls in worker
   threads; each gets a ``result`` reply.
@@ -121,8 +123,9 @@ class Hub:
         frame["ns"] = namespace
         text = encode(frame)
         self.frames += 1
+        shown = (namespace, state.version)
         for client in watchers:
-            if state.version in client.versions:
+            if client.shown == shown:
                 client.send(text)
 
     # ------------------------------------------------------------------ to browsers
@@ -140,15 +143,17 @@ class Hub:
                 "paused_at": source.paused_at, "problem": source.problem}
 
     def send_tree(self, client: Client, namespace: str) -> None:
-        """Structure (if this client lacks this version), snapshot, runner state, timings."""
+        """Structure (unless the client shows this very tree now), snapshot, runner state,
+        timings."""
         source = self.source(namespace)
         client.send(self._runner_message(source))
         state = source.state
         if state is None:
+            client.shown = None
             client.send({"t": "structure", "ns": namespace, "v": None, "tree": None})
             return
-        if state.version not in client.versions:
-            client.versions.add(state.version)
+        if client.shown != (namespace, state.version):
+            client.shown = (namespace, state.version)
             client.send('{"t":"structure","ns":' + json.dumps(namespace) + ',"v":"'
                         + state.version + '","tree":' + state.text + "}")
         snapshot = state.snapshot()
@@ -163,7 +168,7 @@ class Hub:
 
     def resync(self, client: Client) -> None:
         """Send a client that fell behind everything again."""
-        client.versions.clear()
+        client.shown = None
         if client.watching is not None:
             self.send_tree(client, client.watching)
 

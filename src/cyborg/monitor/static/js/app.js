@@ -69,8 +69,8 @@ function receive(message) {
       schedule();
       break;
     case "snapshot":
-      if (message.v !== model.version) break;
-      page.ns = message.ns;
+      // one of the robot left behind (still on its way), or a tree not drawn here
+      if (message.ns !== page.ns || message.v !== model.version) break;
       model.applySnapshot(message);
       needsLayout = true;
       schedule();
