@@ -9,13 +9,23 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cyborg.vision import DetectionPipeline, Detector, Frame, StereoDepth, VisionError
 from cyborg.vision.backends import OnnxRuntimeBackend, OpenCvBackend
-from cyborg.vision.distance import box_distance, box_mean_2018
-from cyborg.vision.layouts import Layout, decode, grid_points, guess_layout, layout_named
+from cyborg.vision.distance import box_distance, box_distances, box_mean_2018
+from cyborg.vision.layouts import (
+    Layout,
+    decode,
+    grid_points,
+    guess_layout,
+    layout_named,
+    yolox_grid,
+)
 from cyborg.vision.letterbox import InputFormat, Preprocessor
 from cyborg.vision.samples import MOTORCYCLE_CALIBRATION, motorcycle, photo
+from cyborg.vision.suppression import suppress
 
 INPUT = (64, 64)
 
@@ -123,6 +133,75 @@ def test_overlapping_boxes_of_one_class_collapse_but_other_classes_stay() -> Non
     assert detector.detect(np.zeros((64, 64, 3), np.uint8)) == []
 
 
+boxes_strategy = st.lists(
+    st.tuples(st.integers(0, 60), st.integers(0, 60), st.integers(1, 30), st.integers(1, 30),
+              st.sampled_from([0.3, 0.5, 0.55, 0.7, 0.9]), st.integers(0, 2)),
+    max_size=40)
+
+
+@settings(max_examples=200, deadline=None)
+@given(boxes_strategy, st.sampled_from([0.0, 0.3, 0.45, 0.7]))
+def test_suppression_keeps_what_opencv_keeps(boxes: list[tuple[int, int, int, int, float, int]],
+                                             iou: float) -> None:
+    """OpenCV's batched NMS is the oracle: the same boxes kept, in the same order (ties in
+    score included: the earlier box wins)."""
+    xywh = np.array([b[:4] for b in boxes], np.float32).reshape(-1, 4)
+    scores = np.array([b[4] for b in boxes], np.float32)
+    class_ids = np.array([b[5] for b in boxes], np.int32)
+    corners = xywh.copy()
+    corners[:, 2:] += corners[:, :2]
+    ours = suppress(corners, scores, class_ids, iou=iou, limit=100).tolist()
+    theirs = [int(i) for i in np.asarray(cv2.dnn.NMSBoxesBatched(
+        xywh.astype(np.float64).tolist(), scores.tolist(), class_ids.tolist(), 0.0, iou)
+        ).reshape(-1)]
+    assert ours == theirs
+
+
+def test_suppression_limits_and_rejects_mismatched_inputs() -> None:
+    boxes = np.array([[0, 0, 10, 10], [20, 20, 30, 30], [40, 40, 50, 50]], np.float32)
+    scores = np.array([0.5, 0.9, 0.7], np.float32)
+    classes = np.zeros(3, np.int32)
+    assert suppress(boxes, scores, classes, iou=0.5, limit=2).tolist() == [1, 2]
+    assert suppress(boxes, scores, classes, iou=0.5, limit=0).tolist() == []
+    with pytest.raises(ValueError, match="3 boxes, 2 scores and 3 class ids"):
+        suppress(boxes, scores[:2], classes, iou=0.5)
+
+
+def numpy_decode(layout: Layout, output: np.ndarray, input_hw: tuple[int, int],
+                 threshold: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The YOLOX / YOLOv5 decoding written out in numpy, the reference for the compiled one."""
+    rows = output.reshape(-1, output.shape[-1]).astype(np.float64)
+    if layout is Layout.YOLOX:
+        cells, strides = yolox_grid(input_hw)
+        centres = np.concatenate([(rows[:, :2] + cells) * strides,
+                                  np.exp(rows[:, 2:4]) * strides], axis=1)
+    else:
+        centres = rows[:, :4]
+    class_ids = rows[:, 5:].argmax(axis=1)
+    scores = rows[:, 4] * rows[np.arange(len(rows)), 5 + class_ids]
+    keep = (rows[:, 4] >= threshold) & (scores >= threshold)
+    boxes = np.concatenate([centres[:, :2] - centres[:, 2:] / 2,
+                            centres[:, :2] + centres[:, 2:] / 2], axis=1)
+    return boxes[keep], scores[keep], class_ids[keep]
+
+
+@pytest.mark.parametrize("layout", [Layout.YOLOX, Layout.YOLOV5])
+def test_the_compiled_decoding_matches_numpy(layout: Layout) -> None:
+    rng = np.random.default_rng(3)
+    rows = grid_points(INPUT) * (1 if layout is Layout.YOLOX else 3)
+    output = rng.uniform(0, 1, (1, rows, 85)).astype(np.float32)
+    output[..., :4] = rng.uniform(-1, 3, (1, rows, 4))
+    candidates = decode(layout, output, INPUT, 0.5)
+    boxes, scores, class_ids = numpy_decode(layout, output, INPUT, 0.5)
+    assert len(candidates) == len(scores) > 10
+    assert candidates.boxes == pytest.approx(boxes, rel=1e-5, abs=1e-4)
+    assert candidates.scores == pytest.approx(scores, rel=1e-6)
+    assert candidates.class_ids.tolist() == class_ids.tolist()
+    read_only = output.copy()
+    read_only.flags.writeable = False  # frames from the bus are read-only views
+    assert len(decode(layout, read_only, INPUT, 0.5)) == len(scores)
+
+
 def test_boxes_map_back_through_the_letterbox() -> None:
     """A 128 x 64 image in a 64 x 64 input: scale 1/2, centred with 16 px of padding on top."""
     output = v5_rows((32, 32, 16, 16, 0.9, 0))
@@ -160,6 +239,37 @@ def test_distance_is_the_median_of_valid_depth_and_never_zero() -> None:
     assert math.isnan(distance) and fraction == 0.0
     assert box_distance(depth, (250.0, 10.0, 260.0, 20.0))[0] != 0.0  # outside: NaN, not 0
     assert math.isnan(box_distance(depth, (250.0, 10.0, 260.0, 20.0))[0])
+
+
+
+def test_distances_of_many_boxes_at_once() -> None:
+    """One pass over all boxes gives what each box gives alone, on read-only and strided maps,
+    and the median of every valid pixel where the box is small enough to take them all."""
+    rng = np.random.default_rng(5)
+    depth = rng.uniform(0.5, 8.0, (120, 160)).astype(np.float32)
+    depth[rng.uniform(size=depth.shape) < 0.2] = np.nan
+    boxes = np.array([[10, 10, 50, 40], [0, 0, 160, 120], [150, 110, 400, 300],
+                      [-20, -20, -5, -5], [30, 30, 31, 31], [np.nan, 0, 10, 10]], np.float64)
+    together = box_distances(depth, boxes, inner=0.6)
+    for box, (median, share) in zip(boxes[:5], together[:5], strict=True):
+        alone = box_distance(depth, tuple(box), inner=0.6)
+        assert (median, share) == pytest.approx(alone, nan_ok=True)
+    inside = depth[16:34, 18:42]  # the first box's middle 60 %, every pixel (no stride)
+    assert together[0, 0] == pytest.approx(np.nanmedian(inside))
+    assert together[0, 1] == pytest.approx(np.isfinite(inside).mean())
+    assert math.isnan(together[3, 0]) and together[3, 1] == 0.0  # outside the image
+    assert math.isnan(together[5, 0])  # a box without coordinates has no distance
+    frozen = depth.copy()
+    frozen.flags.writeable = False  # depth from the bus is a read-only view
+    assert box_distances(frozen, boxes, inner=0.6)[:3] == pytest.approx(together[:3], nan_ok=True)
+    wide = np.zeros((120, 320), np.float32)
+    wide[:, ::2] = depth  # a strided view
+    strided = box_distances(wide[:, ::2], boxes, inner=0.6)
+    assert strided[:3] == pytest.approx(together[:3], nan_ok=True)
+    with pytest.raises(ValueError, match="inner must be in"):
+        box_distances(depth, boxes, inner=0.0)
+    with pytest.raises(ValueError, match="2-D"):
+        box_distances(depth[None], boxes)
 
 
 def test_a_small_box_is_sampled_densely_enough() -> None:

@@ -7,8 +7,8 @@
 One :class:`Detector` letterboxes the image (:mod:`~cyborg.vision.letterbox`), runs the network
 on a backend (:mod:`~cyborg.vision.backends`), decodes the family's output
 (:mod:`~cyborg.vision.layouts`), keeps the classes asked for, and applies class-aware
-non-maximum suppression — overlapping boxes of one class collapse to the best one, while a
-person in front of a car keeps both boxes.
+non-maximum suppression (:mod:`~cyborg.vision.suppression`) — overlapping boxes of one class
+collapse to the best one, while a person in front of a car keeps both boxes.
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from cyborg.vision.backends import Backend, OnnxRuntimeBackend, OpenCvBackend
@@ -26,6 +25,7 @@ from cyborg.vision.frames import VisionError, check_image
 from cyborg.vision.labels import COCO, label_of, read_labels
 from cyborg.vision.layouts import Candidates, Layout, decode, guess_layout, layout_named
 from cyborg.vision.letterbox import InputFormat, Letterbox, Preprocessor
+from cyborg.vision.suppression import suppress
 
 FORMATS = {Layout.YOLOX: InputFormat(rgb=False, scale=1.0, centred=False),
            Layout.YOLOV5: InputFormat(rgb=True, scale=1 / 255, centred=True),
@@ -136,31 +136,21 @@ class Detector:
             candidates = self._keep_classes(candidates)
         if not len(candidates):
             return []
-        if self.layout is not Layout.END2END:
-            candidates = self._suppress(candidates)
-        boxes = letterbox.to_image(candidates.boxes)
-        order = np.argsort(-candidates.scores, kind="stable")[: self.max_detections]
-        return [Detection(label_of(self.labels, int(candidates.class_ids[i])),
-                          int(candidates.class_ids[i]), float(candidates.scores[i]),
-                          (float(boxes[i, 0]), float(boxes[i, 1]), float(boxes[i, 2]),
-                           float(boxes[i, 3])))
-                for i in order]
+        # an end-to-end model has suppressed overlaps itself: only order and limit its boxes
+        iou = 1.0 if self.layout is Layout.END2END else self.iou
+        kept = suppress(candidates.boxes, candidates.scores, candidates.class_ids, iou=iou,
+                        limit=self.max_detections)
+        boxes = letterbox.to_image(candidates.boxes[kept]).tolist()
+        scores = candidates.scores[kept].tolist()
+        class_ids = candidates.class_ids[kept].tolist()
+        return [Detection(label_of(self.labels, class_id), class_id, score, tuple(box))
+                for box, score, class_id in zip(boxes, scores, class_ids, strict=True)]
 
     def _keep_classes(self, candidates: Candidates) -> Candidates:
         wanted = np.array([label_of(self.labels, int(c)) in self.classes
                            for c in candidates.class_ids], dtype=bool)
         return Candidates(candidates.boxes[wanted], candidates.scores[wanted],
                           candidates.class_ids[wanted])
-
-    def _suppress(self, candidates: Candidates) -> Candidates:
-        """Class-aware non-maximum suppression (boxes of different classes never compete)."""
-        xywh = candidates.boxes.copy()
-        xywh[:, 2:] -= xywh[:, :2]
-        kept = cv2.dnn.NMSBoxesBatched(xywh.tolist(), candidates.scores.tolist(),
-                                       candidates.class_ids.tolist(), self.confidence, self.iou)
-        index = np.asarray(kept, dtype=np.int64).reshape(-1)
-        return Candidates(candidates.boxes[index], candidates.scores[index],
-                          candidates.class_ids[index])
 
 
 def _metadata_labels(metadata: dict[str, str]) -> tuple[str, ...] | None:

@@ -24,10 +24,12 @@ raw output is shaped like YOLOv5's, so it needs the model's name or an explicit 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
+from numba import njit
 
 from cyborg.vision.frames import VisionError
 
@@ -132,15 +134,20 @@ def decode(layout: Layout, output: np.ndarray, input_hw: tuple[int, int],
         scores = chosen[np.arange(len(chosen)), 5 + class_ids]
         above = scores >= threshold
         return _from_centres(chosen[above, :4] * scale, scores[above], class_ids[above])
-    # objectness first: rows whose objectness is below the threshold can never pass it
-    kept = np.flatnonzero(rows[:, 4] >= threshold)
-    centres = (_yolox_centres(rows, kept, input_hw) if layout is Layout.YOLOX
-               else rows[kept, :4])
-    chosen = rows[kept]
-    class_ids = chosen[:, 5:].argmax(axis=1)
-    scores = chosen[:, 4] * chosen[np.arange(len(chosen)), 5 + class_ids]
-    above = scores >= threshold
-    return _from_centres(centres[above], scores[above], class_ids[above])
+    if rows.shape[1] < 6:
+        raise ValueError(f"{rows.shape[1]} columns: expected 4 box, objectness and classes")
+    if layout is Layout.YOLOX:
+        cells, strides = yolox_grid(input_hw)
+        if len(cells) != len(rows):
+            raise VisionError(f"YOLOX output has {len(rows)} anchor points, but a "
+                              f"{input_hw[1]}x{input_hw[0]} input has {len(cells)}: is this a "
+                              "YOLOX model with its head left raw?")
+    else:
+        cells, strides = _NO_GRID
+    boxes, scores, class_ids = _decode_with_objectness(
+        rows.astype(np.float32, copy=False), cells, strides[:, 0], layout is Layout.YOLOX,
+        float(threshold))
+    return Candidates(boxes, scores, class_ids)
 
 
 _GRIDS: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
@@ -160,16 +167,50 @@ def yolox_grid(input_hw: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     return _GRIDS[input_hw]
 
 
-def _yolox_centres(rows: np.ndarray, keep: np.ndarray, input_hw: tuple[int, int]) -> np.ndarray:
-    cells, strides = yolox_grid(input_hw)
-    if len(cells) != len(rows):
-        raise VisionError(f"YOLOX output has {len(rows)} anchor points, but a "
-                          f"{input_hw[1]}x{input_hw[0]} input has {len(cells)}: is this a "
-                          "YOLOX model with its head left raw?")
-    chosen, stride = rows[keep], strides[keep]
-    xy = (chosen[:, :2] + cells[keep]) * stride
-    wh = np.exp(chosen[:, 2:4]) * stride
-    return np.concatenate([xy, wh], axis=1)
+_NO_GRID = (np.zeros((0, 2), np.float32), np.zeros((0, 1), np.float32))
+
+
+@njit("Tuple((float32[:, :], float32[:], int32[:]))(Array(float32, 2, 'A', readonly=True), "
+      "Array(float32, 2, 'A', readonly=True), Array(float32, 1, 'A', readonly=True), boolean, "
+      "float64)", cache=True, nogil=True)
+def _decode_with_objectness(rows: np.ndarray, cells: np.ndarray, strides: np.ndarray,
+                            raw_grid: bool, threshold: float
+                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover
+    """YOLOX / YOLOv5 rows (``x, y, w, h, objectness, classes...``) to candidates, in one pass.
+
+    Objectness is looked at first: a row whose objectness is below the threshold can never
+    pass it (the score is objectness x class probability). The class is the first best one.
+    ``raw_grid``: YOLOX's raw head, ``(xy + cell) * stride`` and ``exp(wh) * stride``; else
+    the row's box is a centre and size in input pixels already.
+    """
+    count, columns = rows.shape
+    boxes = np.empty((count, 4), dtype=np.float32)
+    scores = np.empty(count, dtype=np.float32)
+    class_ids = np.empty(count, dtype=np.int32)
+    kept = 0
+    for i in range(count):
+        objectness = rows[i, 4]
+        if not objectness >= threshold:
+            continue
+        best = 5
+        for column in range(6, columns):
+            if rows[i, column] > rows[i, best]:
+                best = column
+        score = objectness * rows[i, best]
+        if not score >= threshold:
+            continue
+        if raw_grid:
+            stride = strides[i]
+            x, y = (rows[i, 0] + cells[i, 0]) * stride, (rows[i, 1] + cells[i, 1]) * stride
+            w, h = math.exp(rows[i, 2]) * stride, math.exp(rows[i, 3]) * stride
+        else:
+            x, y, w, h = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3]
+        boxes[kept, 0], boxes[kept, 1] = x - w / 2, y - h / 2
+        boxes[kept, 2], boxes[kept, 3] = x + w / 2, y + h / 2
+        scores[kept] = score
+        class_ids[kept] = best - 5
+        kept += 1
+    return boxes[:kept], scores[:kept], class_ids[:kept]
 
 
 def _from_centres(centres: np.ndarray, scores: np.ndarray, class_ids: np.ndarray) -> Candidates:

@@ -39,11 +39,10 @@ class Letterbox:
 
     def to_image(self, boxes: np.ndarray) -> np.ndarray:
         """``x1, y1, x2, y2`` boxes in network-input pixels → image pixels, clipped."""
-        mapped = boxes.astype(np.float32, copy=True)
-        mapped[:, (0, 2)] = (mapped[:, (0, 2)] - self.offset_x) / self.scale
-        mapped[:, (1, 3)] = (mapped[:, (1, 3)] - self.offset_y) / self.scale
-        mapped[:, (0, 2)] = np.clip(mapped[:, (0, 2)], 0, self.image_width)
-        mapped[:, (1, 3)] = np.clip(mapped[:, (1, 3)], 0, self.image_height)
+        offset = np.array([self.offset_x, self.offset_y] * 2, dtype=np.float32)
+        limits = np.array([self.image_width, self.image_height] * 2, dtype=np.float32)
+        mapped: np.ndarray = np.clip((boxes.astype(np.float32) - offset) / np.float32(self.scale),
+                                     0, limits)
         return mapped
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from cyborg.vision.annotate import annotate
 from cyborg.vision.depth import StereoDepth
 from cyborg.vision.detector import Detection, Detector
-from cyborg.vision.distance import SAMPLES, box_distance
+from cyborg.vision.distance import SAMPLES, box_distances
 from cyborg.vision.frames import Frame
 
 STAGES = ("depth", "preprocess", "inference", "postprocess", "distance", "drawing")
@@ -58,19 +58,18 @@ class DetectionPipeline:
         depth_done = time.perf_counter()
         detections = self.detector.detect(frame.left)
         detected = time.perf_counter()
-        if depth is not None:
-            measured_detections = []
-            for detection in detections:
-                median, share = box_distance(depth, detection.box, inner=self.inner,
-                                             samples=self.samples)
-                measured_detections.append(dataclasses.replace(
-                    detection, distance=median, depth_fraction=share))
-            detections = measured_detections
-        measured = time.perf_counter()
+        if depth is not None and detections:
+            measured = box_distances(depth, np.array([d.box for d in detections]),
+                                     inner=self.inner, samples=self.samples)
+            detections = [dataclasses.replace(detection, distance=float(median),
+                                              depth_fraction=float(share))
+                          for detection, (median, share) in zip(detections, measured,
+                                                                 strict=True)]
+        distanced = time.perf_counter()
         annotated = annotate(frame.left, detections) if draw else None
         drawn = time.perf_counter()
         stage = self.detector.times
         return Result(frame, detections, depth, {
             "depth": depth_done - started, "preprocess": stage.preprocess,
             "inference": stage.inference, "postprocess": stage.postprocess,
-            "distance": measured - detected, "drawing": drawn - measured}, annotated)
+            "distance": distanced - detected, "drawing": drawn - distanced}, annotated)
