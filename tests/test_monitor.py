@@ -1,5 +1,5 @@
-"""The web monitor without a browser: tree state and deltas, the control seat, exports, and the
-WebSocket protocol against a running system (Starlette's test client)."""
+"""The web monitor without a browser: tree state and deltas, exports, and the WebSocket protocol
+against a running system (Starlette's test client). The control seat: test_monitor_seat.py."""
 
 from __future__ import annotations
 
@@ -13,12 +13,10 @@ from typing import Any
 import numpy as np
 import pytest
 from starlette.testclient import TestClient
-from starlette.websockets import WebSocketDisconnect
 
 from cyborg.bt import load_tree
 from cyborg.bt.clock import ManualClock
 from cyborg.bus import Node
-from cyborg.monitor import Monitor
 from cyborg.monitor.export import (
     MAX_PNG_PIXELS,
     MIN_PX_PER_LEAF,
@@ -26,14 +24,17 @@ from cyborg.monitor.export import (
     render,
     view_dot,
 )
-from cyborg.monitor.seat import ControlSeat, is_loopback
 from cyborg.monitor.tree_state import FRESH, StructureError, TreeState
 from cyborg.nodes.tree_runner import TreeRunnerNode
 from tests.builders import N, tree_from
-from tests.system import System, running_system, wait_until
-
-CAMPUS_MAP = Path(__file__).resolve().parents[1] / "src/cyborg/app/data/campus.map"
-CAMPUS_TREE = Path(__file__).resolve().parents[1] / "src/cyborg/app/data/campus_patrol.b3.json"
+from tests.monitor_protocol import (
+    CAMPUS_TREE,
+    campus_system,
+    monitor_for,
+    receive_until,
+    watch,
+)
+from tests.system import System, wait_until
 
 
 def _structure(children: int = 2) -> str:
@@ -102,36 +103,6 @@ def test_a_structure_that_is_not_one_is_refused() -> None:
         TreeState(json.dumps({"root": {"children": []}}))
 
 
-# ---------------------------------------------------------------------------------- seat
-@pytest.mark.parametrize(("host", "local"), [
-    ("127.0.0.1", True), ("127.8.0.2", True), ("::1", True), ("::ffff:127.0.0.1", True),
-    ("192.0.2.2", False), ("10.0.0.7", False), ("testclient", False), (None, False),
-    ("::ffff:192.0.2.9", False)])
-def test_loopback_detection(host: str | None, local: bool) -> None:
-    assert is_loopback(host) is local
-
-
-def test_one_controlling_client_a_token_for_others_and_a_grace_period() -> None:
-    seat = ControlSeat(token="s3cret", grace=10.0)
-    assert seat.may_control("127.0.0.1", None)
-    assert not seat.may_control("192.0.2.9", None)
-    assert not seat.may_control("192.0.2.9", "wrong")
-    assert seat.may_control("192.0.2.9", "s3cret")
-    assert not ControlSeat().may_control("192.0.2.9", ""), "no token configured: view only"
-    assert seat.claim("a") == (True, None)
-    assert seat.claim("b") == (False, None), "one controlling client at a time"
-    seat.note_hook("/cyborg/bt", "n1", set_=True)
-    assert seat.claim("b", force=True) == (True, "a")
-    assert seat.holds("b") and not seat.holds("a")
-    seat.disconnected("b", now=100.0)
-    assert seat.expired(now=105.0) is None, "a reloading page keeps the seat"
-    assert seat.claim("b") == (True, None) and seat.holds("b")
-    seat.disconnected("b", now=200.0)
-    assert seat.expired(now=211.0) == {("/cyborg/bt", "n1")}, "its hooks are released"
-    assert seat.holder is None
-    assert seat.claim("c") == (True, None)
-
-
 # ---------------------------------------------------------------------------------- export
 def test_export_draws_what_is_shown() -> None:
     tree = load_tree(CAMPUS_TREE, clock=ManualClock())
@@ -183,60 +154,47 @@ def test_a_large_tree_still_gives_a_usable_png() -> None:
 # ---------------------------------------------------------------------------------- protocol
 @pytest.fixture
 def system() -> Iterator[System]:
-    with running_system(CAMPUS_MAP, CAMPUS_TREE, speed=10.0) as running:
+    with campus_system() as running:
         yield running
-
-
-def _monitor(system: System, token: str | None = None) -> Monitor:
-    return Monitor(Node("monitor", "/cyborg", context=system.context),
-                   namespaces=["/cyborg/bt"], token=token)
-
-
-def _receive_until(socket: Any, kind: str, limit: int = 400) -> dict[str, Any]:
-    for _ in range(limit):
-        message: dict[str, Any] = socket.receive_json()
-        if message["t"] == kind:
-            return message
-    raise AssertionError(f"no {kind!r} message in {limit} messages")
 
 
 def test_the_page_gets_structure_snapshot_and_deltas_and_controls_from_loopback(
         system: System) -> None:
-    monitor = _monitor(system)
+    monitor = monitor_for(system)
     try:
         wait_until(lambda: monitor.hub.sources["/cyborg/bt"].state is not None, 10,
                    "the structure")
         with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
                 client.websocket_connect("/ws") as socket:
             socket.send_json({"t": "hello", "key": "page-1"})
-            seat = _receive_until(socket, "seat")
+            seat = receive_until(socket, "seat")
             assert seat["may_control"] and seat["holder"] is None
             socket.send_json({"t": "watch", "ns": "/cyborg/bt"})
-            structure = _receive_until(socket, "structure")
+            structure = receive_until(socket, "structure")
             assert structure["tree"]["title"] == "Campus mission"
-            snapshot = _receive_until(socket, "snapshot")
+            snapshot = receive_until(socket, "snapshot")
             assert len(snapshot["codes"]) == structure["tree"]["node_count"] == 22
-            ticks = [_receive_until(socket, "tick") for _ in range(5)]
+            ticks = [receive_until(socket, "tick") for _ in range(5)]
             assert [frame["seq"] for frame in ticks] == sorted({f["seq"] for f in ticks})
             assert all(frame["v"] == structure["v"] for frame in ticks)
             socket.send_json({"t": "enable", "on": False, "req": 7})
-            refused = _receive_until(socket, "result")
+            refused = receive_until(socket, "result")
             assert (refused["req"], refused["ok"]) == (7, False)
             assert "take control first" in refused["message"]
             socket.send_json({"t": "claim", "req": 8})
-            assert _receive_until(socket, "result")["ok"] is True
+            assert receive_until(socket, "result")["ok"] is True
             socket.send_json({"t": "enable", "on": False, "req": 9})
-            assert _receive_until(socket, "result")["ok"] is True
+            assert receive_until(socket, "result")["ok"] is True
             wait_until(lambda: not system.runner.enabled, 5, "the tree paused")
             socket.send_json({"t": "control", "id": "nope", "action": "disable", "req": 10})
-            assert "no node 'nope'" in _receive_until(socket, "result")["message"]
+            assert "no node 'nope'" in receive_until(socket, "result")["message"]
             socket.send_json({"t": "history", "req": 11})
-            history = _receive_until(socket, "history")
+            history = receive_until(socket, "history")
             assert len(history["ticks"]) > 3
             socket.send_json({"t": "frobnicate"})
-            assert "unknown command" in _receive_until(socket, "error")["message"]
+            assert "unknown command" in receive_until(socket, "error")["message"]
             socket.send_json({"t": "enable", "on": True, "req": 12})
-            assert _receive_until(socket, "result")["ok"] is True
+            assert receive_until(socket, "result")["ok"] is True
             wait_until(lambda: system.runner.enabled, 5, "the tree running again")
             response = client.post("/api/export", json={"ns": "/cyborg/bt", "format": "dot",
                                                         "collapsed": []})
@@ -249,71 +207,35 @@ def test_the_page_gets_structure_snapshot_and_deltas_and_controls_from_loopback(
         monitor.stop()
 
 
-def test_other_machines_watch_but_do_not_control_without_the_token(system: System) -> None:
-    monitor = _monitor(system, token="s3cret")
-    try:
-        with TestClient(monitor.app, client=("192.0.2.9", 50000)) as client:
-            with client.websocket_connect("/ws") as socket:
-                socket.send_json({"t": "hello", "key": "far"})
-                assert _receive_until(socket, "seat")["may_control"] is False
-                socket.send_json({"t": "watch", "ns": "/cyborg/bt"})
-                _receive_until(socket, "tick")
-                socket.send_json({"t": "enable", "on": False, "req": 1})
-                assert "view only" in _receive_until(socket, "result")["message"]
-                socket.send_json({"t": "claim", "req": 2})
-                assert "view only" in _receive_until(socket, "error")["message"]
-            assert system.runner.enabled
-            with client.websocket_connect("/ws?token=s3cret") as socket:
-                socket.send_json({"t": "hello", "key": "far-with-token"})
-                assert _receive_until(socket, "seat")["may_control"] is True
-            with pytest.raises(WebSocketDisconnect) as refused, client.websocket_connect(
-                    "/ws", headers={"origin": "http://evil.example"}) as socket:
-                socket.receive_json()
-            assert refused.value.code == 1008, "another site's page may not connect"
-    finally:
-        monitor.stop()
-
-
-def _watch(socket: Any, namespace: str) -> list[dict[str, Any]]:
-    """Watch ``namespace``; returns what the server sent for it, up to its snapshot."""
-    socket.send_json({"t": "watch", "ns": namespace})
-    _receive_until(socket, "watching")
-    sent: list[dict[str, Any]] = []
-    while not sent or sent[-1]["t"] != "snapshot":
-        sent.append(socket.receive_json())
-        assert len(sent) < 50, f"no snapshot for {namespace}"
-    return sent
-
-
 def test_a_page_that_returns_to_a_robot_gets_its_tree_again(system: System,
                                                             shared: Path) -> None:
     other = TreeRunnerNode(Node("tree_runner", "/other/bt", context=system.context),
                            shared / "trees" / "stock_nodes.tree.json")
     other.start()
-    monitor = Monitor(Node("monitor", "/cyborg", context=system.context),
-                      namespaces=["/cyborg/bt", "/other/bt"])
+    monitor = monitor_for(system, namespaces=["/cyborg/bt", "/other/bt"])
     try:
         wait_until(lambda: all(source.state is not None
                                for source in monitor.hub.sources.values()), 10, "both trees")
         with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
                 client.websocket_connect("/ws") as socket:
             for namespace in ("/cyborg/bt", "/other/bt", "/cyborg/bt", "/other/bt"):
-                sent = _watch(socket, namespace)
+                sent = watch(socket, namespace)
                 version = monitor.hub.sources[namespace].state.version  # type: ignore[union-attr]
                 structures = [message for message in sent if message["t"] == "structure"]
                 assert [(message["ns"], message["v"]) for message in structures] == [
                     (namespace, version)], f"the page shows another tree: {namespace} again"
                 assert sent[-1]["v"] == version
-                tick = _receive_until(socket, "tick")
+                tick = receive_until(socket, "tick")
                 assert (tick["ns"], tick["v"]) == (namespace, version)
             socket.send_json({"t": "refresh"})
-            again = _receive_until(socket, "structure")
+            again = receive_until(socket, "structure")
             assert again["ns"] == "/other/bt", "Refresh sends the structure again"
             socket.send_json({"t": "watch", "ns": "/other/bt"})
-            _receive_until(socket, "watching")
+            receive_until(socket, "watching")
             assert all(message["t"] != "structure"
                        for message in [socket.receive_json() for _ in range(3)]), \
                 "watching the tree the page shows again needs no structure"
     finally:
         monitor.stop()
         other.destroy()
+

@@ -221,6 +221,10 @@ def test_pause_resume_and_disabling_a_subtree_change_what_the_robot_does(
     _wait_page(page, f"document.querySelector('g.node[data-id=\"{patrol}\"]')"
                      ".classList.contains('hooked')")
     screenshot(page, "patrol_disabled")
+    page.reload()
+    _seat_says(page, "You have control")  # this tab's seat secret took the seat back
+    assert system.runner.tree.hooks.get(patrol) is not None, "a reload keeps the page's hooks"
+    _node(page, "Patrol")
     page.click("#inspector button[data-action=clear]")
     wait_until(lambda: system.sim.base.speed > 0.2, 20, "the robot patrolling again")
     assert errors == []

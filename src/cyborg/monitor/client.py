@@ -23,11 +23,10 @@ class Client:
 
     def __init__(self, number: int, websocket: WebSocket, *, may_control: bool) -> None:
         self.number = number
+        """Unique among this monitor's connections; the control seat knows clients by it."""
         self.websocket = websocket
         self.may_control = may_control
         """Loopback, or the right token: this client may take the control seat."""
-        self.key = f"client-{number}"
-        """Set by the page's hello (stable across reloads of one tab)."""
         self.watching: str | None = None
         self.shown: tuple[str, str] | None = None
         """(namespace, structure version) of the tree the page draws now. A page keeps only

@@ -6,7 +6,9 @@ answer to a command that does something is ``{"t": "result", "req", "ok", "messa
 ===========  ==========================================  =====================================
 ``t``        fields                                      what
 ===========  ==========================================  =====================================
-hello        key, token                                  who the page is (first message)
+hello        seat                                        first message; ``seat``: the seat's
+                                                         secret, to take back the seat this
+                                                         page held before a reload
 watch        ns                                          follow the tree under ``ns``
 refresh      —                                           structure and snapshot again
 history      —                                           the recent ticks of the watched tree
@@ -32,7 +34,7 @@ from cyborg.monitor.hub import Hub
 from cyborg.monitor.source import ControlError
 
 CONTROLS = ("enable", "control", "step", "resume")
-KEY_LIMIT = 64
+SECRET_LIMIT = 64
 
 
 class CommandError(ValueError):
@@ -53,10 +55,12 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
             client.send({"t": "result", "req": request, "ok": True, "message": message})
         return
     if kind == "hello":
-        key = command.get("key")
-        if isinstance(key, str) and 0 < len(key) <= KEY_LIMIT:
-            client.key = key
-        client.send(hub.seat_message(client))
+        secret = command.get("seat")
+        if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
+                and hub.seat.resume(client.number, secret)):
+            hub.announce_seat()  # the page's old connection, if still open, hears it lost
+        else:
+            client.send(hub.seat_message(client))
         client.send(hub.robots())
     elif kind == "watch":
         namespace = command.get("ns") or hub.default_namespace
@@ -79,14 +83,14 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         if not client.may_control:
             raise CommandError("view only: control is accepted from this machine, or with "
                                "the monitor's token")
-        granted, previous = hub.seat.claim(client.key, force=bool(command.get("force")))
+        granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
         client.send({"t": "result", "req": request, "ok": granted,
                      "message": "you have control" if granted else
                      "another page has control; take it over to control from here"})
-        if granted or previous:
+        if granted:
             hub.announce_seat()
     elif kind == "release":
-        hub.seat.release(client.key)
+        hub.seat.release(client.number)
         hub.announce_seat()
     elif kind == "ping":
         client.send({"t": "pong", "req": request})
@@ -98,7 +102,7 @@ async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any])
     if not client.may_control:
         raise CommandError("view only: control is accepted from this machine, or with the "
                            "monitor's token")
-    if not hub.seat.holds(client.key):
+    if not hub.seat.holds(client.number):
         raise CommandError("another page has control (or none was taken): take control first")
     namespace = command.get("ns") or client.watching
     source = hub.sources.get(namespace or "")

@@ -13,7 +13,8 @@ bus ever waits for a browser.
   tree only resets the statuses.
 * **Commands** from browsers (run/pause, per-node control, step, resume) are checked against
   the control seat (:mod:`cyborg.monitor.seat`) and run as blocking service calls in worker
-  threads; each gets a ``result`` reply.
+  threads; each gets a ``result`` reply. The seat knows clients by their connection numbers;
+  its secret goes to its holder and nobody else.
 * Every :data:`SLOW_PERIOD` the hub sends per-node timings, polls blackboards of watched trees,
   looks for new tree runners on the bus and frees the seat of a holder gone too long.
 """
@@ -22,11 +23,14 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import itertools
 import json
 import logging
 import time
 from collections.abc import Callable
 from typing import Any
+
+from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.seat import ControlSeat
@@ -58,7 +62,7 @@ class Hub:
         self._scheduled: set[str] = set()
         self._last_frame: dict[str, float] = {}
         self._blackboards: dict[str, str] = {}
-        self._numbers = 0
+        self._numbers = itertools.count(1)
         self.frames = 0
 
     # ------------------------------------------------------------------ sources
@@ -74,7 +78,7 @@ class Hub:
         return {"t": "robots", "robots": [source.describe() for source in
                                           sorted(self.sources.values(),
                                                  key=lambda source: source.namespace)],
-                "seat": self.seat.holder.key if self.seat.holder else None}
+                "seat": self.seat.holder.client if self.seat.holder else None}
 
     # ------------------------------------------------------------------ from the bus
     def notify(self, namespace: str, what: str) -> None:
@@ -176,21 +180,27 @@ class Hub:
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         self._loop = loop
 
-    def connect(self, client: Client) -> None:
-        self._numbers += 1
+    def connect(self, websocket: WebSocket, *, may_control: bool) -> Client:
+        """A new client for an accepted ``websocket``, numbered and registered in one step
+        (no other connection can come in between and get the same number)."""
+        client = Client(next(self._numbers), websocket, may_control=may_control)
         self.clients.add(client)
-
-    def next_number(self) -> int:
-        return self._numbers + 1
+        return client
 
     def disconnect(self, client: Client) -> None:
         self.clients.discard(client)
-        self.seat.disconnected(client.key)
+        self.seat.disconnected(client.number)
 
     def seat_message(self, client: Client) -> dict[str, Any]:
-        return {"t": "seat", "may_control": client.may_control,
-                "control": self.seat.holds(client.key),
-                "holder": self.seat.holder.key if self.seat.holder else None}
+        """Who holds the seat (a connection number, which nobody can present); the seat's
+        secret only to its holder."""
+        message = {"t": "seat", "may_control": client.may_control,
+                   "control": self.seat.holds(client.number),
+                   "holder": self.seat.holder.client if self.seat.holder else None}
+        secret = self.seat.secret_for(client.number)
+        if secret is not None:
+            message["secret"] = secret
+        return message
 
     def announce_seat(self) -> None:
         for client in self.clients:

@@ -8,20 +8,26 @@ breakpoints, step) is a safety matter:
   ``CYBORG_MONITOR_TOKEN``). Everyone else is view-only.
 * Of the clients that may, one holds the **control seat** at a time. The first to ask gets it;
   another may take it over explicitly (``force``), and the previous holder is told.
-* When the holder disconnects, the seat stays reserved for it for :data:`GRACE` seconds (a
-  reload or a dropped Wi-Fi link comes back with the same client key); after that the seat is
-  free and the hooks it set are released (as Groot2 releases a silent client's hooks).
+* The seat belongs to the *connection* that took it (the number the server gave it), not to
+  anything a page could show or say: what other pages hear is only that number, which no
+  page can present. The holder alone is sent a random **secret**; a page that reloads, or whose
+  link dropped, presents it in its ``hello`` and gets the seat back on its new connection.
+* When the holder disconnects, the seat stays reserved for it for :data:`GRACE` seconds (other
+  pages may take it over only explicitly); after that the seat is free and the hooks it set are
+  released (as Groot2 releases a silent client's hooks).
 """
 
 from __future__ import annotations
 
 import hmac
 import ipaddress
+import secrets
 import time
 from dataclasses import dataclass, field
 
 GRACE = 10.0
 """Seconds the seat waits for a disconnected holder to come back."""
+SECRET_BYTES = 16
 
 
 def is_loopback(host: str | None) -> bool:
@@ -39,8 +45,10 @@ def is_loopback(host: str | None) -> bool:
 
 @dataclass
 class SeatHolder:
-    key: str
-    """The client's key (chosen by the page, kept across reloads of the same tab)."""
+    client: int
+    """The number of the connection holding the seat (given by the server, never by a page)."""
+    secret: str = field(default_factory=lambda: secrets.token_urlsafe(SECRET_BYTES), repr=False)
+    """Sent to the holder only: it takes the seat back on a new connection."""
     connected: bool = True
     left_at: float = 0.0
     hooks: set[tuple[str, str]] = field(default_factory=set)
@@ -48,7 +56,8 @@ class SeatHolder:
 
 
 class ControlSeat:
-    """See the module docstring. Not thread-safe: use it from the web server's event loop."""
+    """See the module docstring. Clients are named by their connection numbers. Not
+    thread-safe: use it from the web server's event loop."""
 
     def __init__(self, token: str | None = None, *, grace: float = GRACE) -> None:
         self.token = token or None
@@ -61,33 +70,46 @@ class ControlSeat:
             return True
         return bool(self.token and token and hmac.compare_digest(token, self.token))
 
-    def claim(self, key: str, *, force: bool = False) -> tuple[bool, str | None]:
-        """Give the seat to ``key``; returns (granted, key of the holder it was taken from)."""
+    def claim(self, client: int, *, force: bool = False) -> tuple[bool, int | None]:
+        """Give the seat to ``client``; returns (granted, the client it was taken from).
+        A seat that is held, or kept for a holder that left, goes only with ``force``."""
         holder = self.holder
-        if holder is not None and holder.key == key:
-            holder.connected = True
+        if holder is not None and holder.client == client:
             return True, None
-        if holder is not None and holder.connected and not force:
+        if holder is not None and not force:
             return False, None
-        previous = holder.key if holder is not None else None
-        self.holder = SeatHolder(key)
-        if holder is not None:
-            self.holder.hooks = holder.hooks  # hooks stay with the seat, not the person
-        return True, previous
+        self.holder = SeatHolder(client)
+        if holder is None:
+            return True, None
+        self.holder.hooks = holder.hooks  # hooks stay with the seat, not the person
+        return True, holder.client
 
-    def holds(self, key: str) -> bool:
-        return self.holder is not None and self.holder.key == key and self.holder.connected
+    def resume(self, client: int, secret: str) -> bool:
+        """Move the seat to ``client`` if ``secret`` is the holder's: the holder's page on a
+        new connection (a reload, a dropped link). The old connection loses the seat."""
+        holder = self.holder
+        if holder is None or not secret or not hmac.compare_digest(secret.encode(),
+                                                                    holder.secret.encode()):
+            return False
+        holder.client, holder.connected = client, True
+        return True
 
-    def release(self, key: str) -> None:
+    def holds(self, client: int) -> bool:
+        return self.holder is not None and self.holder.client == client and self.holder.connected
+
+    def secret_for(self, client: int) -> str | None:
+        """The seat's secret, for its holder only."""
+        return self.holder.secret if self.holds(client) and self.holder else None
+
+    def release(self, client: int) -> None:
         """The holder gives the seat up (its hooks stay set)."""
-        if self.holder is not None and self.holder.key == key:
+        if self.holder is not None and self.holder.client == client:
             self.holder = None
 
-    def disconnected(self, key: str, now: float | None = None) -> None:
-        if self.holder is not None and self.holder.key == key:
+    def disconnected(self, client: int, now: float | None = None) -> None:
+        if self.holder is not None and self.holder.client == client:
             self.holder.connected = False
             self.holder.left_at = time.monotonic() if now is None else now
-
     def expired(self, now: float | None = None) -> set[tuple[str, str]] | None:
         """Free the seat of a holder gone longer than the grace and return the hooks it set
         (to release); None when the seat did not change."""

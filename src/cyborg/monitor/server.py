@@ -102,9 +102,9 @@ def create_app(hub: Hub) -> Starlette:
             return
         token = socket.query_params.get("token")
         host = socket.client.host if socket.client else None
-        client = Client(hub.next_number(), socket, may_control=hub.seat.may_control(host, token))
+        may_control = hub.seat.may_control(host, token)
         await socket.accept()
-        hub.connect(client)
+        client = hub.connect(socket, may_control=may_control)
         writer = asyncio.create_task(_write(hub, client))
         if socket.query_params.get("watch"):  # the page's first connection: no round trip
             await handle(hub, client, {"t": "watch", "ns": hub.default_namespace})

@@ -4,7 +4,7 @@
 // repaint of the nodes they touched. `window.__monitor` exposes counters for tests and the
 // latency benchmark.
 
-import { Connection } from "./connection.js";
+import { Connection, keepSeatSecret } from "./connection.js";
 import { TreeModel, stateAt } from "./model.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
@@ -109,6 +109,7 @@ function receive(message) {
       break;
     case "seat":
       page.seat = message;
+      if (message.secret) keepSeatSecret(message.secret);
       if (message.may_control && message.holder === null) connection.post({ t: "claim" });
       toolbar();
       break;

@@ -1,11 +1,15 @@
 // The page's WebSocket to the monitor: connects, says hello, reconnects when the link drops.
 //
+// The hello carries the control seat's secret when this tab held the seat (the monitor sends
+// it to the holder only; it is kept for this tab), so a reload or a reconnect keeps control.
+//
 // `connection.send(command)` returns a promise of the `result` message answering it (commands
 // carry a request number `req`). Every other message goes to `onMessage`. `onState` hears
 // "open" and "closed" so the page can say when it is offline.
 
 const RETRY_FIRST_MS = 300;
 const RETRY_MAX_MS = 5000;
+const SEAT_ITEM = "cyborg-monitor-seat";
 
 export class Connection {
   constructor({ onMessage, onState, onOpen }) {
@@ -16,7 +20,6 @@ export class Connection {
     this.nextReq = 1;
     this.retryMs = RETRY_FIRST_MS;
     this.socket = null;
-    this.key = pageKey();
     this.token = pageToken();
   }
 
@@ -35,7 +38,7 @@ export class Connection {
     this.socket = socket;
     const opened = () => {
       this.retryMs = RETRY_FIRST_MS;
-      this.post({ t: "hello", key: this.key });
+      this.post({ t: "hello", seat: sessionStorage.getItem(SEAT_ITEM) || "" });
       this.onState("open");
       if (socket !== early?.socket) this.onOpen();
     };
@@ -88,15 +91,9 @@ export class Connection {
   }
 }
 
-// A key that stays the same across reloads of this tab, so a page that reloads keeps the
-// control seat it held.
-function pageKey() {
-  let key = sessionStorage.getItem("cyborg-monitor-key");
-  if (!key) {
-    key = `page-${Math.random().toString(36).slice(2, 10)}`;
-    sessionStorage.setItem("cyborg-monitor-key", key);
-  }
-  return key;
+// The control seat's secret, from a seat message that says this page holds the seat.
+export function keepSeatSecret(secret) {
+  sessionStorage.setItem(SEAT_ITEM, secret);
 }
 
 // The control token, from `?token=` in the page's address (kept for this tab).
