@@ -15,6 +15,7 @@ from playwright.sync_api import Browser, Page, sync_playwright
 
 from cyborg.app.launchables import NodeSpec, RunningTree, start_tree_runner
 from cyborg.bt.node import Node as BtNode
+from cyborg.bt.status import FAILURE, RUNNING, Status
 from cyborg.bus import Node
 from cyborg.monitor import Monitor
 from cyborg.monitor.monitor import _lan_address
@@ -178,6 +179,13 @@ def test_draw_depth_folding_fit_and_hover(browser: Browser, live: Live) -> None:
     assert not page.is_checked("#autofit"), "zooming by hand turns auto-fit off"
     page.click("#fit")
     assert page.get_attribute("#viewport", "transform") == before, "Fit in view fits again"
+    received = page.evaluate("window.__monitor.structures")
+    page.evaluate("document.getElementById('nodes').replaceChildren()")
+    page.click("#refresh")
+    _wait_page(page, f"window.__monitor.laidOut > {received}")  # drawn from the one re-sent
+    assert page.locator("g.node").count() == 22 == page.evaluate("window.__monitor.drawn")
+    frames = page.evaluate("window.__monitor.frames")
+    _wait_page(page, f"window.__monitor.frames > {frames + 3}")
     assert errors == []
 
 
@@ -227,7 +235,31 @@ def test_pause_resume_and_disabling_a_subtree_change_what_the_robot_does(
     _node(page, "Patrol")
     page.click("#inspector button[data-action=clear]")
     wait_until(lambda: system.sim.base.speed > 0.2, 20, "the robot patrolling again")
+    _force_failure_and_clear(page, live, patrol)
     assert errors == []
+
+
+def _force_failure_and_clear(page: Page, live: Live, uid: str) -> None:
+    """Force the selected node ``uid`` to fail: the runner's tree sees that result and so
+    does the page; Clear gives the node its own result back."""
+    tree = live.system.runner.tree
+
+    def returned() -> Status | None:
+        last = tree.last
+        return dict(last.visited).get(uid) if last is not None else None
+
+    node = f"document.querySelector('g.node[data-id=\"{uid}\"]')"
+    page.click("#inspector button[data-action=force][data-status=failure]")
+    wait_until(lambda: (hook := tree.hooks.get(uid)) is not None and hook.mode == "force"
+               and hook.status == FAILURE, 5, "the force hook")
+    wait_until(lambda: returned() == FAILURE, 5, "the node's forced result in the tree")
+    _wait_page(page, f"{node}.classList.contains('s{int(FAILURE)}')")
+    _wait_page(page, "document.getElementById('node-hook').textContent"
+                     ".startsWith('force → failure')")
+    page.click("#inspector button[data-action=clear]")
+    wait_until(lambda: tree.hooks.get(uid) is None, 5, "the hook cleared")
+    wait_until(lambda: returned() == RUNNING, 10, "the node's own result again")
+    _wait_page(page, f"{node}.classList.contains('s{int(RUNNING)}')")
 
 
 def test_breakpoint_step_resume_blackboard_timing_search_and_history(
@@ -251,6 +283,7 @@ def test_breakpoint_step_resume_blackboard_timing_search_and_history(
     ticks = system.runner.tree.ticks
     wait_until(lambda: system.runner.tree.ticks > ticks + 3, 10, "ticking again")
     _wait_page(page, "document.querySelectorAll('#bb-rows tr').length > 0")
+    _blackboard_follows_the_tree(page, system.runner)
     page.fill("#search", "MoveTo")
     moves = sum(1 for node in system.runner.tree if "MoveTo" in node.label)
     assert page.inner_text("#search-count") == f"{moves} found"
@@ -270,6 +303,30 @@ def test_breakpoint_step_resume_blackboard_timing_search_and_history(
     page.click("#live")
     assert page.is_disabled("#scrub")
     assert errors == []
+
+
+def _blackboard_follows_the_tree(page: Page, runner: TreeRunnerNode) -> None:
+    """The patrol's MemSequence keeps its running child on the blackboard: as the robot
+    moves on, the table shows the new value (marked as changed)."""
+    def in_tree() -> str | None:
+        scopes = runner.tree.blackboard.as_dict()
+        found = [values["running_child"] for values in scopes["nodes"].values()
+                 if "running_child" in values]
+        return json.dumps(found[0]) if len(found) == 1 else None
+
+    def on_page() -> tuple[str, str] | None:
+        found: list[str] | None = page.evaluate(
+            "(() => { const row = [...document.querySelectorAll('#bb-rows tr')].find("
+            "(tr) => tr.cells[1].textContent === 'running_child');"
+            " return row ? [row.cells[2].textContent, row.className] : null; })()")
+        return (found[0], found[1]) if found else None
+
+    wait_until(lambda: on_page() is not None, 5, "the running child in the table")
+    first = on_page()
+    assert first is not None
+    wait_until(lambda: (shown := on_page()) is not None and shown[0] != first[0]
+               and shown == (in_tree(), "changed"), 60,
+               f"the table to follow the running child on from {first[0]}")
 
 
 def test_the_page_follows_a_restarted_runner_a_reload_and_a_dropped_connection(

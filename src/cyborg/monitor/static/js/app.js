@@ -2,7 +2,8 @@
 //
 // Drawing is coalesced per animation frame: any number of deltas between two frames cost one
 // repaint of the nodes they touched. `window.__monitor` exposes counters for tests and the
-// latency benchmark.
+// latency benchmark (`structures`: structures received; `laidOut`: how many had been received
+// when the tree was last laid out).
 
 import { Connection, keepSeatSecret } from "./connection.js";
 import { TreeModel, stateAt } from "./model.js";
@@ -10,7 +11,7 @@ import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
 
 const $ = (id) => document.getElementById(id);
-const stats = (window.__monitor = { messages: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null, drawMs: null });
+const stats = (window.__monitor = { messages: 0, structures: 0, laidOut: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null, drawMs: null });
 
 const model = new TreeModel();
 const page = {
@@ -61,6 +62,7 @@ function receive(message) {
       page.ns = message.ns;
       break;
     case "structure":
+      stats.structures += 1;
       if (message.ns !== page.ns) page.ns = message.ns;
       model.reset(message.v, message.tree ? message.tree.root : null);
       page.title = message.tree ? message.tree.title : "";
@@ -167,6 +169,7 @@ function render(fromFrame = false) {
     // folded nodes with part of the running path inside are known only once drawn
     dirty = new Set(model.active.flatMap((id) => model.ancestors(id)));
     stats.draws += 1;
+    stats.laidOut = stats.structures;
     if ($("autofit").checked) view.fit();
     applySearch(false);
     if (page.selected) view.markClass("selected", new Set([page.selected]));
