@@ -17,6 +17,7 @@ from starlette.testclient import TestClient
 from cyborg.bt import load_tree
 from cyborg.bt.clock import ManualClock
 from cyborg.bus import Node
+from cyborg.monitor.client import QUEUE_LIMIT
 from cyborg.monitor.export import (
     MAX_PNG_PIXELS,
     MIN_PX_PER_LEAF,
@@ -239,3 +240,36 @@ def test_a_page_that_returns_to_a_robot_gets_its_tree_again(system: System,
         monitor.stop()
         other.destroy()
 
+
+def test_a_page_that_falls_behind_gets_the_tree_again_instead_of_the_backlog(
+        system: System) -> None:
+    monitor = monitor_for(system)
+    try:
+        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
+                client.websocket_connect("/ws") as socket:
+            structure = next(message for message in watch(socket, "/cyborg/bt")
+                             if message["t"] == "structure")
+            receive_until(socket, "tick")
+            page = next(iter(monitor.hub.clients))
+            burst = QUEUE_LIMIT + 10
+
+            async def flood() -> None:  # more than its queue holds, before its writer runs
+                for number in range(burst):
+                    page.send({"t": "filler", "i": number})
+
+            assert client.portal is not None
+            client.portal.call(flood)
+            fillers = []
+            while (message := socket.receive_json())["t"] != "structure":
+                if message["t"] == "filler":
+                    fillers.append(message["i"])
+                assert len(fillers) < QUEUE_LIMIT // 2, "the backlog was sent, not dropped"
+            assert fillers == list(range(burst - len(fillers), burst)), \
+                "only what came after the overflow is sent"
+            assert page.dropped >= QUEUE_LIMIT
+            assert (message["ns"], message["v"]) == ("/cyborg/bt", structure["v"]), \
+                "the tree again, though the page had it"
+            assert receive_until(socket, "snapshot")["v"] == structure["v"]
+            assert receive_until(socket, "tick")["v"] == structure["v"], "and it follows on"
+    finally:
+        monitor.stop()

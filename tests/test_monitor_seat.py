@@ -171,3 +171,35 @@ def test_pages_connecting_at_the_same_moment_are_told_apart() -> None:
 
     assert sorted(asyncio.run(both())) == [False, True], "one seat, two pages"
 
+
+def test_the_hooks_of_a_holder_that_does_not_come_back_are_released(system: System) -> None:
+    monitor = monitor_for(system)
+    monitor.hub.seat.grace = 0.2
+    hooks = system.runner.tree.hooks
+    patrol, recharge = system.uid("Patrol"), system.uid("Recharge")
+    try:
+        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client:
+            with client.websocket_connect("/ws") as holder:
+                holder.send_json({"t": "watch", "ns": "/cyborg/bt"})
+                commands: list[dict[str, Any]] = [
+                    {"t": "claim"},
+                    {"t": "control", "id": patrol, "action": "force", "status": "success"},
+                    {"t": "control", "id": recharge, "action": "disable", "keep": True}]
+                for request, command in enumerate(commands):
+                    holder.send_json({**command, "req": request})
+                    answer = receive_until(holder, "result")
+                    assert answer["ok"] is True, answer["message"]
+                assert hooks.get(patrol) is not None and hooks.get(recharge) is not None
+            with client.websocket_connect("/ws") as other:
+                other.send_json({"t": "hello"})
+                wait_until(lambda: hooks.get(patrol) is None, 5, "the holder's hook released")
+                assert hooks.get(recharge) is not None, "a hook set to be kept stays"
+                for _ in range(20):
+                    if receive_until(other, "seat")["holder"] is None:
+                        break
+                else:
+                    raise AssertionError("the pages were not told that the seat is free")
+                other.send_json({"t": "claim", "req": 9})
+                assert receive_until(other, "result")["ok"] is True, "and anyone may take it"
+    finally:
+        monitor.stop()
