@@ -293,7 +293,10 @@ def test_motorcycle_distance_from_stereo_matches_ground_truth(yolox: Detector) -
     the ground-truth median (measured: 2.368 m against 2.377 m)."""
     left, right, truth = motorcycle()
     pipeline = DetectionPipeline(yolox, stereo=StereoDepth(MOTORCYCLE_CALIBRATION))
+    original = left.copy()
     result = pipeline.process(Frame(0, left, right), draw=True)
+    assert np.array_equal(left, original), "the frame itself is never drawn on"
+    assert pipeline.process(Frame(0, left, right)).detections == result.detections
     bikes = [d for d in result.detections if d.label == "motorcycle"]
     assert len(bikes) == 1 and bikes[0].confidence > 0.8
     expected, _ = box_distance(truth, bikes[0].box, samples=10**7)

@@ -23,7 +23,11 @@ def caption(detection: Detection) -> str:
 
 def annotate(image: np.ndarray, detections: Sequence[Detection]) -> np.ndarray:
     """A copy of ``image`` with the detections drawn on it (the input is left unchanged)."""
-    drawn = image.copy()
+    return draw_detections(image.copy(), detections)
+
+
+def draw_detections(drawn: np.ndarray, detections: Sequence[Detection]) -> np.ndarray:
+    """Draws the detections on ``drawn`` itself (a writable BGR image) and returns it."""
     height, width = drawn.shape[:2]
     scale = max(0.4, min(width, height) / 1000)
     thickness = max(1, round(scale * 2))

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cyborg.vision.annotate import annotate
+from cyborg.vision.annotate import draw_detections
 from cyborg.vision.depth import StereoDepth
 from cyborg.vision.detector import Detection, Detector
 from cyborg.vision.distance import SAMPLES, box_distances
@@ -53,10 +53,16 @@ class DetectionPipeline:
         return None
 
     def process(self, frame: Frame, *, draw: bool = False) -> Result:
+        """Detections with distances for one frame; ``draw``: also the annotated image."""
         started = time.perf_counter()
+        # The annotated image needs a copy of the frame (the frame itself may be shared, e.g.
+        # with another subscriber). Copied first, the network's input is then read from the
+        # copy while it is still in the CPU's cache, which saves a cold read of the frame.
+        canvas = frame.left.copy() if draw else None
+        copied = time.perf_counter()
         depth = self.depth_of(frame)
         depth_done = time.perf_counter()
-        detections = self.detector.detect(frame.left)
+        detections = self.detector.detect(frame.left if canvas is None else canvas)
         detected = time.perf_counter()
         if depth is not None and detections:
             measured = box_distances(depth, np.array([d.box for d in detections]),
@@ -66,10 +72,12 @@ class DetectionPipeline:
                           for detection, (median, share) in zip(detections, measured,
                                                                  strict=True)]
         distanced = time.perf_counter()
-        annotated = annotate(frame.left, detections) if draw else None
+        if canvas is not None:
+            draw_detections(canvas, detections)
         drawn = time.perf_counter()
         stage = self.detector.times
         return Result(frame, detections, depth, {
-            "depth": depth_done - started, "preprocess": stage.preprocess,
+            "depth": depth_done - copied, "preprocess": stage.preprocess,
             "inference": stage.inference, "postprocess": stage.postprocess,
-            "distance": distanced - detected, "drawing": drawn - distanced}, annotated)
+            "distance": distanced - detected,
+            "drawing": (copied - started) + (drawn - distanced)}, canvas)
