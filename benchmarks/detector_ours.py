@@ -6,6 +6,8 @@
   two ``sensor_msgs/Image`` (``bgr8`` + ``32FC1``, CameraNode's topics and encodings), the
   detector node in a process of its own (``benchmarks/detector.py --detector-peer``); the camera
   hears the ``Detection2DArray`` back, which gives the latency.
+* :class:`PipelineAlone`: :class:`~cyborg.vision.DetectionPipeline` on the frames, no bus: frame
+  in, detections with distances (and the annotated image when drawn) out.
 * :class:`BareInference`: the onnxruntime session alone on a tensor prepared once.
 
 In both bus configurations a viewer in the detector's process may subscribe to
@@ -224,6 +226,32 @@ class OursTwoProcesses:
             self.peer.stdin.close()
         self.peer.wait(10)
         self.context.close()
+
+
+class PipelineAlone:
+    """The detection pipeline alone: what the detector node does between a frame's arrival and
+    its messages (preprocess, inference, postprocess, distance, drawing), on the same frames."""
+
+    def __init__(self, frames: Frames, model: Path, threads: int) -> None:
+        self.frames = [Frame(0, image, depth=depth) for image, depth in frames]
+        self.pipeline = DetectionPipeline(Detector.open(model, threads=threads,
+                                                        confidence=THRESHOLD))
+        self.run(20, draw=True)
+
+    def run(self, count: int, *, draw: bool) -> Run:
+        records = []
+        started = time.perf_counter()
+        for index in range(count):
+            result = self.pipeline.process(self.frames[index % len(self.frames)], draw=draw)
+            times = result.times
+            records.append({
+                "preprocess": times["preprocess"] * 1e3, "inference": times["inference"] * 1e3,
+                "postprocess": times["postprocess"] * 1e3,
+                "distance": (times["distance"] + times["depth"]) * 1e3,
+                "drawing": times["drawing"] * 1e3, "detections": float(len(result.detections))})
+        run = Run("", frames=count)
+        run.fps_rounds = [count / (time.perf_counter() - started)]
+        return stages_of(records, run)
 
 
 class BareInference:
