@@ -202,6 +202,24 @@ def test_the_compiled_decoding_matches_numpy(layout: Layout) -> None:
     assert len(decode(layout, read_only, INPUT, 0.5)) == len(scores)
 
 
+def test_the_yolov8_decoding_matches_the_per_anchor_reference() -> None:
+    """Reducing over classes along the output's rows gives what a per-anchor argmax gives."""
+    rng = np.random.default_rng(4)
+    anchors = grid_points(INPUT)
+    output = rng.uniform(0, 0.6, (1, 4 + 80, anchors)).astype(np.float32)
+    output[0, :4] = rng.uniform(0, 64, (4, anchors))
+    rows = output[0].T
+    class_ids = rows[:, 4:].argmax(axis=1)
+    scores = rows[np.arange(anchors), 4 + class_ids]
+    keep = scores >= 0.55
+    candidates = decode(Layout.YOLOV8, output, INPUT, 0.55)
+    assert len(candidates) == keep.sum() > 10
+    assert candidates.scores.tolist() == scores[keep].tolist()
+    assert candidates.class_ids.tolist() == class_ids[keep].tolist()
+    centres = rows[keep, :4]
+    assert candidates.boxes[:, :2] == pytest.approx(centres[:, :2] - centres[:, 2:] / 2)
+
+
 def test_boxes_map_back_through_the_letterbox() -> None:
     """A 128 x 64 image in a 64 x 64 input: scale 1/2, centred with 16 px of padding on top."""
     output = v5_rows((32, 32, 16, 16, 0.9, 0))
