@@ -112,6 +112,10 @@ def test_an_unknown_output_layout_is_a_clear_error_at_load() -> None:
         Detector(FixedBackend(np.zeros((1, 7, 7, 7), np.float32)), model_name="odd.onnx")
     with pytest.raises(VisionError, match="anchor points"):
         Detector(FixedBackend(np.zeros((1, 100, 85), np.float32)), layout=Layout.YOLOX)
+    with pytest.raises(VisionError, match=r"narrow.onnx: output \[1, 100, 5\] does not fit "
+                                          r"the yolov5 layout \(5 columns"):
+        Detector(FixedBackend(np.zeros((1, 100, 5), np.float32)), layout=Layout.YOLOV5,
+                 model_name="narrow.onnx")
 
 
 # ------------------------------------------------------------------ non-maximum suppression
@@ -288,6 +292,8 @@ def test_distances_of_many_boxes_at_once() -> None:
         box_distances(depth, boxes, inner=0.0)
     with pytest.raises(ValueError, match="2-D"):
         box_distances(depth[None], boxes)
+    with pytest.raises(ValueError, match="samples must be at least 1, not 0"):
+        box_distances(depth, boxes, samples=0)
 
 
 def test_a_small_box_is_sampled_densely_enough() -> None:

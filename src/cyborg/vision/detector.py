@@ -87,7 +87,7 @@ class Detector:
         self.classes = classes
         self.max_detections = max_detections
         self.times = StageTimes()
-        decode(self.layout, probe, self.input_hw, 1.1)  # a wrong layout fails here, clearly
+        self._decode(probe, 1.1)  # a wrong layout fails here, clearly
 
     @staticmethod
     def open(model: Path, *, backend: str = "onnxruntime", family: str | None = None,
@@ -127,11 +127,7 @@ class Detector:
 
     def postprocess(self, output: np.ndarray, letterbox: Letterbox) -> list[Detection]:
         """Decode, keep the wanted classes, suppress overlaps, map boxes to the image."""
-        try:
-            candidates = decode(self.layout, output, self.input_hw, self.confidence)
-        except (IndexError, ValueError) as exc:
-            raise VisionError(f"{self.model_name}: output {list(output.shape)} does not fit "
-                              f"the {self.layout.value} layout ({exc})") from exc
+        candidates = self._decode(output, self.confidence)
         if self.classes:
             candidates = self._keep_classes(candidates)
         if not len(candidates):
@@ -145,6 +141,14 @@ class Detector:
         class_ids = candidates.class_ids[kept].tolist()
         return [Detection(label_of(self.labels, class_id), class_id, score, tuple(box))
                 for box, score, class_id in zip(boxes, scores, class_ids, strict=True)]
+
+    def _decode(self, output: np.ndarray, threshold: float) -> Candidates:
+        """The layout's candidates; an output that does not fit it is a clear error."""
+        try:
+            return decode(self.layout, output, self.input_hw, threshold)
+        except (IndexError, ValueError) as exc:
+            raise VisionError(f"{self.model_name}: output {list(output.shape)} does not fit "
+                              f"the {self.layout.value} layout ({exc})") from exc
 
     def _keep_classes(self, candidates: Candidates) -> Candidates:
         wanted = np.array([label_of(self.labels, int(c)) in self.classes
