@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cyborg.bus import BusConfig, BusConfigError
 from cyborg.bus.graph import Graph, parse_token
@@ -93,6 +95,38 @@ def test_graph_tracks_tokens_of_its_domain() -> None:
                        "6e6a4085e77f21") == 0
     graph.remove(DESIGN_EXAMPLE)
     assert graph.topics() == {}
+    assert graph.count("/chatter", EntityKind.SUBSCRIPTION) == 0
+
+
+def _endpoint_token(zid: str, kind: str, topic: str, entity_id: int) -> str:
+    return (f"@ros2_lv/0/{zid}/1/{entity_id}/{kind}/%/%/node/%{topic}/"
+            "std_msgs::msg::dds_::String_/RIHS01_00/::,10:,:,:,,")
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.booleans(), st.sampled_from(["a", "b"]),
+                          st.sampled_from(["MP", "MS", "SS"]), st.sampled_from(["x", "y"]),
+                          st.integers(1, 3)), max_size=40))
+def test_endpoint_counts_follow_every_add_and_remove(
+        steps: list[tuple[bool, str, str, str, int]]) -> None:
+    """The per-topic index a publisher asks on every message agrees with the token set."""
+    graph, alive = Graph(domain=0), set()
+    for adding, zid, kind, topic, entity_id in steps:
+        key = _endpoint_token(zid, kind, topic, entity_id)
+        if adding:
+            graph.add(key)
+            alive.add(key)
+        else:
+            graph.remove(key)
+            alive.discard(key)
+    entities = [entity for entity in map(parse_token, alive) if entity is not None]
+    for topic in ("/x", "/y"):
+        for kind in (EntityKind.PUBLISHER, EntityKind.SUBSCRIPTION, EntityKind.SERVICE_SERVER):
+            expected = [e for e in entities if e.topic == topic and e.kind is kind]
+            assert sorted(e.key for e in graph.endpoints(topic, kind)) == sorted(
+                e.key for e in expected)
+            assert graph.count(topic, kind, exclude_zid="a") == sum(
+                e.zid != "a" for e in expected)
 
 
 # ---------------------------------------------------------------------- shared-memory slots

@@ -85,6 +85,10 @@ class Graph:
     def __init__(self, domain: int) -> None:
         self.domain = domain
         self._entities: dict[str, GraphEntity] = {}
+        # endpoints by (topic, kind): a publisher asks for its subscriptions on every message
+        self._by_endpoint: dict[tuple[str, EntityKind], dict[str, GraphEntity]] = {}
+        self.version = 0
+        """Counts changes, so a caller can keep an answer until the graph changes."""
         self._lock = threading.RLock()  # predicates of wait_for query the graph
         self._changed = threading.Condition(self._lock)
         self._listeners: list[Callable[[], None]] = []
@@ -95,16 +99,31 @@ class Graph:
         if entity is None or entity.domain != self.domain:
             return
         with self._changed:
+            self._drop(key)
             self._entities[key] = entity
+            self._by_endpoint.setdefault((entity.topic, entity.kind), {})[key] = entity
+            self.version += 1
             self._changed.notify_all()
         self._notify()
 
     def remove(self, key: str) -> None:
         with self._changed:
-            if self._entities.pop(key, None) is None:
+            if not self._drop(key):
                 return
             self._changed.notify_all()
         self._notify()
+
+    def _drop(self, key: str) -> bool:
+        entity = self._entities.pop(key, None)
+        if entity is None:
+            return False
+        index = (entity.topic, entity.kind)
+        same = self._by_endpoint[index]
+        del same[key]
+        if not same:
+            del self._by_endpoint[index]
+        self.version += 1
+        return True
 
     def on_change(self, listener: Callable[[], None]) -> Callable[[], None]:
         """Call ``listener()`` (on a Zenoh thread) whenever a token appears or vanishes.
@@ -148,7 +167,8 @@ class Graph:
         return result
 
     def endpoints(self, topic: str, kind: EntityKind) -> list[GraphEntity]:
-        return [e for e in self.entities([kind]) if e.topic == topic]
+        with self._lock:
+            return list(self._by_endpoint.get((topic, kind), {}).values())
 
     def count(self, topic: str, kind: EntityKind, *, exclude_zid: str = "") -> int:
         """How many endpoints of ``kind`` exist on ``topic`` (optionally not in one session)."""

@@ -17,14 +17,18 @@ goal, result and feedback messages plus the ``SendGoal`` and ``GetResult`` servi
 
 from __future__ import annotations
 
+import dataclasses
+import struct
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from cyborg.bus.stream_copy import STREAM_MINIMUM, stream_copy
 from cyborg.bus.type_hash import (
     EMPTY_STRUCT_FIELD,
     SERVICE_EVENT_INFO,
@@ -44,6 +48,12 @@ _KINDS = {"msg": 1, "srv": 2, "action": 3}  # file kind -> number of `---` separ
 
 
 CDR_LITTLE_ENDIAN = b"\x00\x01\x00\x00"
+
+_LENGTH = struct.Struct("<I")  # a CDR sequence's element count
+_SMALL_ELEMENTS = {"uint8": "<u1", "int8": "<i1", "byte": "<u1", "char": "<u1",
+                   "uint16": "<u2", "int16": "<i2", "uint32": "<u4", "int32": "<i4",
+                   "float32": "<f4"}
+"""Sequence element types whose elements follow the sequence's length without padding."""
 """The encapsulation header of little-endian plain CDR, as rmw_zenoh writes it."""
 
 
@@ -93,6 +103,7 @@ class MessageTypes:
 
     def __init__(self, interface_dirs: Iterable[Path] = (BUNDLED_INTERFACES,)) -> None:
         self.store = get_typestore(Stores.ROS2_JAZZY)
+        self._tails: dict[str, tuple[str, np.dtype[Any]] | None] = {}
         self._synthetic: dict[str, Fields] = {}
         self.services: set[str] = set()
         self.actions: set[str] = set()
@@ -206,8 +217,40 @@ class MessageTypes:
         """
         msgdef = self.store.get_msgdef(type_name)
         buffer[0:4] = CDR_LITTLE_ENDIAN
-        end: int = msgdef.serialize_cdr_le(buffer[4:], 0, message, self.store)
-        return end + 4
+        tail = self._large_tail(message, type_name)
+        if tail is None:
+            end: int = msgdef.serialize_cdr_le(buffer[4:], 0, message, self.store)
+            return end + 4
+        # The big array (an image's pixels) is the last field: serialise the rest with the
+        # array empty, which ends in the sequence's length, then put the real length and
+        # stream the elements after it (aligned already: elements are at most 4 bytes).
+        name, array = tail
+        end = 4 + msgdef.serialize_cdr_le(
+            buffer[4:], 0, dataclasses.replace(message, **{name: array[:0]}), self.store)
+        _LENGTH.pack_into(buffer, end - _LENGTH.size, array.size)
+        stream_copy(buffer[end:end + array.nbytes], array)
+        return end + array.nbytes
+
+    def _large_tail(self, message: Any, type_name: str) -> tuple[str, np.ndarray] | None:
+        """The last field's name and value if it is a large unbounded sequence of small
+        numbers held as a contiguous native array; None otherwise."""
+        if type_name not in self._tails:
+            fields = self.store.fielddefs[type_name][1]
+            name, (kind, detail) = fields[-1] if fields else ("", (None, None))
+            tail = None
+            if kind == Nodetype.SEQUENCE and detail[0][0] == Nodetype.BASE \
+                    and detail[0][1][0] in _SMALL_ELEMENTS:
+                tail = (name, np.dtype(_SMALL_ELEMENTS[detail[0][1][0]]))
+            self._tails[type_name] = tail
+        described = self._tails[type_name]
+        if described is None:
+            return None
+        name, dtype = described
+        array = getattr(message, name)
+        if not isinstance(array, np.ndarray) or array.dtype != dtype or array.ndim != 1 \
+                or array.nbytes < STREAM_MINIMUM or not array.flags.c_contiguous:
+            return None
+        return name, array
 
     def deserialize(self, data: bytes | bytearray | memoryview, type_name: str) -> Any:
         """A message from CDR bytes; primitive arrays are read-only numpy views on ``data``.

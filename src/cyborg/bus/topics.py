@@ -89,6 +89,7 @@ class Publisher(_Endpoint):
         super().__init__(node, topic, type_name, qos, EntityKind.PUBLISHER)
         self._class = self.context.types.message_class(type_name)
         self._sequence = 0
+        self._graph_version, self._remote_count = -1, 0
         self._lock = threading.Lock()
         session = self.context.session
         reliability = (zenoh.Reliability.RELIABLE if qos.reliability is Reliability.RELIABLE
@@ -141,13 +142,21 @@ class Publisher(_Endpoint):
                     message, self.type_name, view))
                 if ref is not None:
                     self._shm_publisher.put(ref.encode(), attachment=attachment)
-                    others = context.graph.count(self.topic, EntityKind.SUBSCRIPTION,
-                                                 exclude_zid=context.zid)
-                    if others <= readers:
+                    if self._remote_subscriptions() <= readers:
                         return
         if self.latched or self._matching():
             data = context.types.serialize(message, self.type_name)
             self._zenoh.put(data.obj, attachment=attachment)
+
+    def _remote_subscriptions(self) -> int:
+        """Subscriptions of other sessions, counted again only when the graph has changed."""
+        graph = self.context.graph
+        version = graph.version  # read first: a change during the count makes the next recount
+        if version != self._graph_version:
+            self._remote_count = graph.count(self.topic, EntityKind.SUBSCRIPTION,
+                                             exclude_zid=self.context.zid)
+            self._graph_version = version
+        return self._remote_count
 
     def _matching(self) -> bool:
         publisher = self._zenoh
