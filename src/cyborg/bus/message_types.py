@@ -231,17 +231,22 @@ class MessageTypes:
         stream_copy(buffer[end:end + array.nbytes], array)
         return end + array.nbytes
 
+    def _tail_field(self, type_name: str) -> tuple[str, np.dtype[Any]] | None:
+        """The last field's name and element type if it is a sequence of small numbers."""
+        fields: list[tuple[str, Any]] = self.store.fielddefs[type_name][1]
+        if not fields:
+            return None
+        name, (kind, detail) = fields[-1]
+        if kind != Nodetype.SEQUENCE or detail[0][0] != Nodetype.BASE:
+            return None
+        element: str = detail[0][1][0]
+        return (name, np.dtype(_SMALL_ELEMENTS[element])) if element in _SMALL_ELEMENTS else None
+
     def _large_tail(self, message: Any, type_name: str) -> tuple[str, np.ndarray] | None:
         """The last field's name and value if it is a large unbounded sequence of small
         numbers held as a contiguous native array; None otherwise."""
         if type_name not in self._tails:
-            fields = self.store.fielddefs[type_name][1]
-            name, (kind, detail) = fields[-1] if fields else ("", (None, None))
-            tail = None
-            if kind == Nodetype.SEQUENCE and detail[0][0] == Nodetype.BASE \
-                    and detail[0][1][0] in _SMALL_ELEMENTS:
-                tail = (name, np.dtype(_SMALL_ELEMENTS[detail[0][1][0]]))
-            self._tails[type_name] = tail
+            self._tails[type_name] = self._tail_field(type_name)
         described = self._tails[type_name]
         if described is None:
             return None
