@@ -48,13 +48,13 @@ _KINDS = {"msg": 1, "srv": 2, "action": 3}  # file kind -> number of `---` separ
 
 
 CDR_LITTLE_ENDIAN = b"\x00\x01\x00\x00"
+"""The encapsulation header of little-endian plain CDR, as rmw_zenoh writes it."""
 
 _LENGTH = struct.Struct("<I")  # a CDR sequence's element count
 _SMALL_ELEMENTS = {"uint8": "<u1", "int8": "<i1", "byte": "<u1", "char": "<u1",
                    "uint16": "<u2", "int16": "<i2", "uint32": "<u4", "int32": "<i4",
                    "float32": "<f4"}
 """Sequence element types whose elements follow the sequence's length without padding."""
-"""The encapsulation header of little-endian plain CDR, as rmw_zenoh writes it."""
 
 
 class InterfaceError(ValueError):
@@ -243,7 +243,7 @@ class MessageTypes:
         return (name, np.dtype(_SMALL_ELEMENTS[element])) if element in _SMALL_ELEMENTS else None
 
     def _large_tail(self, message: Any, type_name: str) -> tuple[str, np.ndarray] | None:
-        """The last field's name and value if it is a large unbounded sequence of small
+        """The last field's name and value if it is a large sequence of small
         numbers held as a contiguous native array; None otherwise."""
         if type_name not in self._tails:
             self._tails[type_name] = self._tail_field(type_name)
