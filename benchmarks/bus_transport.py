@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from cyborg.bus import BusConfig, Context, Node, Qos
+from cyborg.vision.image_messages import bgr_to_image, depth_to_image, stamp_ns
 
 WIDTH, HEIGHT = 1920, 1080
 FRAME_PERIOD = 1 / 30
@@ -42,24 +43,9 @@ SMALL = "x" * 64
 
 def frame_arrays() -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng(1)
-    image = rng.integers(0, 255, HEIGHT * WIDTH * 3, dtype=np.uint8)
-    depth = rng.random(HEIGHT * WIDTH, dtype=np.float32)
+    image = rng.integers(0, 255, (HEIGHT, WIDTH, 3), dtype=np.uint8)
+    depth = rng.random((HEIGHT, WIDTH), dtype=np.float32)
     return image, depth
-
-
-def image_message(node: Node, data: np.ndarray, encoding: str, step: int, stamp: int) -> Any:
-    """A frame as a camera driver builds it: the message classes, no field-by-field checks."""
-    get = node.types.message_class
-    header = get("std_msgs/msg/Header")(
-        stamp=get("builtin_interfaces/msg/Time")(sec=stamp // 1_000_000_000,
-                                                 nanosec=stamp % 1_000_000_000),
-        frame_id="zed_left")
-    return get("sensor_msgs/msg/Image")(header=header, height=HEIGHT, width=WIDTH,
-                                        encoding=encoding, is_bigendian=0, step=step, data=data)
-
-
-def stamp_ns(message: Any) -> int:
-    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
 
 
 def summary(samples_ns: list[int]) -> dict[str, float]:
@@ -81,7 +67,7 @@ def sink(endpoint: str) -> None:
     pending: dict[int, Any] = {}
 
     def arrived(message: Any) -> None:
-        stamp = stamp_ns(message)
+        stamp = stamp_ns(message.header)
         other = pending.pop(stamp, None)
         if other is None:
             pending[stamp] = message
@@ -142,8 +128,9 @@ def frames_over_bus(node: Node, frames: int) -> tuple[list[int], list[int]]:
         time.sleep(FRAME_PERIOD)  # a camera's pace, so each frame finds the last one released
         done.clear()
         stamp = time.monotonic_ns()
-        image_pub.publish(image_message(node, image, "bgr8", WIDTH * 3, stamp))
-        depth_pub.publish(image_message(node, depth.view(np.uint8), "32FC1", WIDTH * 4, stamp))
+        # built as the camera node builds them, sharing the arrays' memory
+        image_pub.publish(bgr_to_image(node.types, image, stamp, "zed_left"))
+        depth_pub.publish(depth_to_image(node.types, depth, stamp, "zed_left"))
         if not done.wait(5):
             raise RuntimeError("no frame latency reported within 5 s")
         time.sleep(FRAME_PERIOD)
@@ -165,7 +152,7 @@ def in_process(frames: int) -> tuple[list[int], list[int]]:
             got.set()
 
         def on_image(message: Any) -> None:
-            big.append(time.monotonic_ns() - stamp_ns(message))
+            big.append(time.monotonic_ns() - stamp_ns(message.header))
             got.set()
         target.create_subscription("small", "std_msgs/msg/String", on_small)
         target.create_subscription("image", "sensor_msgs/msg/Image", on_image)
@@ -179,8 +166,8 @@ def in_process(frames: int) -> tuple[list[int], list[int]]:
             got.wait(1)
         for _ in range(frames * 10):
             got.clear()
-            image_pub.publish(image_message(source, image, "bgr8", WIDTH * 3,
-                                            time.monotonic_ns()))
+            image_pub.publish(bgr_to_image(context.types, image, time.monotonic_ns(),
+                                           "zed_left"))
             got.wait(1)
         return small, big
 
@@ -195,7 +182,7 @@ def pipe_peer(conn: Connection) -> None:
             conn.send(item)
             continue
         stamp, image, depth = item
-        conn.send(time.monotonic_ns() - stamp + 0 * int(image[0] + depth[-1]))
+        conn.send(time.monotonic_ns() - stamp + 0 * int(image.flat[0] + depth.flat[-1]))
 
 
 def pipe_baseline(rounds: int, frames: int) -> tuple[list[int], list[int]]:
