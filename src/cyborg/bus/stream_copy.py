@@ -17,9 +17,9 @@ llvmlite cannot compile it, :func:`stream_copy` is a plain ``numpy.copyto``.
 from __future__ import annotations
 
 import ctypes
+import functools
 import logging
 import platform
-import threading
 from collections.abc import Callable
 
 import numpy as np
@@ -65,13 +65,12 @@ _X86_FENCE = ("call void @llvm.x86.sse.sfence()", "declare void @llvm.x86.sse.sf
 _OTHER_FENCE = ("fence seq_cst", "")
 
 _Kernel = Callable[[int, int, int], None]
-_kernel: _Kernel | None = None
-_tried = False
-_lock = threading.Lock()
 _keep: list[object] = []  # the JIT engine owns the machine code: keep it alive
 
 
-def _compile() -> _Kernel | None:
+@functools.cache
+def kernel() -> _Kernel | None:
+    """The compiled copy loop, built on first call; None where it cannot be built."""
     try:
         import llvmlite.binding as llvm
 
@@ -96,17 +95,6 @@ def _compile() -> _Kernel | None:
     function = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(address)
     _keep.append(function)
     return function
-
-
-def kernel() -> _Kernel | None:
-    """The compiled copy loop, built on first call; None where it cannot be built."""
-    global _kernel, _tried
-    if not _tried:
-        with _lock:
-            if not _tried:
-                _kernel = _compile()
-                _tried = True
-    return _kernel
 
 
 def stream_copy(destination: memoryview | np.ndarray, source: np.ndarray) -> None:
