@@ -26,6 +26,7 @@ from cyborg.bus import (
     ServiceError,
     new_message,
 )
+from cyborg.bus.doorbell import supported as doorbell_supported
 from cyborg.bus.parameter_client import ParameterClient, ParameterError
 
 pytestmark = pytest.mark.heavy
@@ -235,3 +236,19 @@ def test_large_messages_go_through_shared_memory(bus: Context, spawn: Any) -> No
     assert type(frame.data.base.obj).__name__ == "ndarray"
     with pytest.raises(ValueError, match="read-only"):
         frame.data[0] = 1
+    if doorbell_supported():  # the slot references came by Unix datagram, not through Zenoh
+        assert bus.doorbell is not None and bus.doorbell.answered >= 5
+
+
+def test_without_a_doorbell_slot_references_come_through_zenoh(endpoint: str,
+                                                               spawn: Any) -> None:
+    with Context(BusConfig(connect=(endpoint,), doorbell=False)) as bus:
+        assert bus.doorbell is None
+        node = Node("viewer", context=bus)
+        received, _ = collect(node, "/robot/camera/image", "sensor_msgs/msg/Image",
+                              Qos(depth=2))
+        spawn("image")
+        assert wait_until(lambda: len(received) >= 3, 15)
+        frame = received[-1]
+        assert int(frame.data[-1]) == int(frame.header.frame_id) % 256
+        assert type(frame.data.base.obj).__name__ == "ndarray"  # still shared memory

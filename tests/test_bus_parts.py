@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from cyborg.bus import BusConfig, BusConfigError
 from cyborg.bus.graph import Graph, parse_token
-from cyborg.bus.shm import PREFIX, SlotReader, SlotRef, SlotWriter, remove_stale_slots
+from cyborg.bus.shm import PREFIX, SHM_DIR, SlotReader, SlotRef, SlotWriter, remove_stale_slots
 from cyborg.bus.wire import EntityKind
 
 DESIGN_EXAMPLE = ("@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/10/MS/%/%/listener/%chatter/"
@@ -220,6 +220,14 @@ def test_bad_slot_references_are_refused() -> None:
         SlotRef.decode(b"xx")
     with pytest.raises(ValueError, match="not a cyborg"):
         SlotRef.decode(SlotRef("/etc/passwd", 1, 4).encode())
+    for elsewhere in (f"/tmp/{PREFIX}1-x", f"{SHM_DIR}/deeper/{PREFIX}1-x",
+                      f"{SHM_DIR}/{PREFIX}1-x/../../etc/passwd"):
+        with pytest.raises(ValueError, match="not a cyborg"):  # only slot files in SHM_DIR
+            SlotRef.decode(SlotRef(elsewhere, 1, 4).encode())
+    good = SlotRef(f"{SHM_DIR}/{PREFIX}1-x", 1, 4)
+    assert SlotRef.decode(good.encode()) == good
+    with pytest.raises(ValueError, match="not a cyborg"):  # the length disagrees
+        SlotRef.decode(good.encode()[:-1])
 
 
 def test_slots_of_dead_processes_are_removed(tmp_path: Path) -> None:

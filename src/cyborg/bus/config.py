@@ -46,6 +46,8 @@ class BusConfig:
     """Where a session listens and connects, and in which Zenoh mode.
 
     ``mode="router"`` makes the session itself a router (``cyborg router`` and ``cyborg up``).
+    ``doorbell=False`` sends shared-memory slot references to processes on this machine
+    through Zenoh instead of by Unix datagram (:mod:`cyborg.bus.doorbell`).
     """
 
     mode: str = "peer"
@@ -54,6 +56,7 @@ class BusConfig:
     config_file: Path | None = None
     overrides: tuple[tuple[str, str], ...] = ()
     extra: Mapping[str, object] = field(default_factory=dict)
+    doorbell: bool = True
 
     @classmethod
     def from_environment(cls, connect: Sequence[str] = (),

@@ -27,6 +27,7 @@ from weakref import WeakSet
 import zenoh
 
 from cyborg.bus.config import BusConfig
+from cyborg.bus.doorbell import Doorbell, supported
 from cyborg.bus.graph import Graph
 from cyborg.bus.message_types import MessageTypes
 from cyborg.bus.readonly import ReadonlyCopier
@@ -77,11 +78,12 @@ class Context:
         self._lock = threading.Lock()
         self._local: dict[str, list[Any]] = {}
         self._latched: dict[str, list[Any]] = {}
-        self._shm_readers: dict[str, set[str]] = {}
+        self._shm_readers: dict[str, set[tuple[str, int]]] = {}
         self._nodes: list[Any] = []
         self._warned: set[str] = set()
         self._closed = False
         self.calls = ThreadPoolExecutor(max_workers=8, thread_name_prefix="cyborg-call")
+        self.doorbell = self._open_doorbell()
         _OPEN.add(self)  # closed at exit if the program forgets to
         liveliness = self.session.liveliness()
         self._graph_sub = liveliness.declare_subscriber(
@@ -94,6 +96,15 @@ class Context:
         """A fresh node or entity id, unique in this session."""
         with self._lock:
             return next(self._ids)
+
+    def _open_doorbell(self) -> Doorbell | None:
+        if not (self.config.doorbell and supported()):
+            return None
+        try:
+            return Doorbell(self.domain, self.zid, self.drop)
+        except OSError as exc:  # slot references then travel through Zenoh
+            log.warning("no doorbell for shared-memory references (%s)", exc)
+            return None
 
     # ------------------------------------------------------------------ graph feed
     def _on_token(self, sample: zenoh.Sample) -> None:
@@ -108,7 +119,9 @@ class Context:
         chunks = str(sample.key_expr).split("/")
         if len(chunks) != 6:
             return
-        topic, reader = chunks[5].replace("%", "/"), f"{chunks[3]}/{chunks[4]}"
+        if not chunks[4].isdigit():
+            return
+        topic, reader = chunks[5].replace("%", "/"), (chunks[3], int(chunks[4]))
         with self._lock:
             readers = self._shm_readers.setdefault(topic, set())
             if sample.kind == zenoh.SampleKind.PUT:
@@ -116,10 +129,15 @@ class Context:
             else:
                 readers.discard(reader)
 
-    def shm_reader_count(self, topic: str) -> int:
-        """Subscriptions of other sessions on this machine that take ``topic`` via shared memory."""
+    def shm_readers(self, topic: str) -> tuple[tuple[str, int], ...]:
+        """(session id, entity id) of the subscriptions of other sessions on this machine that
+        take ``topic`` through shared memory."""
         with self._lock:
-            return sum(1 for r in self._shm_readers.get(topic, ()) if not r.startswith(self.zid))
+            return tuple(r for r in self._shm_readers.get(topic, ()) if r[0] != self.zid)
+
+    def shm_reader_count(self, topic: str) -> int:
+        """How many :meth:`shm_readers` ``topic`` has."""
+        return len(self.shm_readers(topic))
 
     def shm_token(self, entity_id: int, topic: str) -> str:
         return f"{SHM_PREFIX}/{self.domain}/{self.host}/{self.zid}/{entity_id}/" + \
@@ -193,6 +211,8 @@ class Context:
         self.calls.shutdown(wait=False, cancel_futures=True)
         for declared in (self._graph_sub, self._shm_sub):
             declared.undeclare()
+        if self.doorbell is not None:
+            self.doorbell.close()
         self.session.close()
 
     def __enter__(self) -> Context:

@@ -5,7 +5,8 @@ How a message travels depends on where its subscribers are:
 * same :class:`~cyborg.bus.context.Context` (same process): handed over as a read-only sharing
   copy (:mod:`cyborg.bus.readonly`), never serialised;
 * another process on this machine, for messages of ``SHM_THRESHOLD`` bytes or more: serialised
-  once into a shared-memory slot (:mod:`cyborg.bus.shm`); only a slot reference crosses Zenoh;
+  once into a shared-memory slot (:mod:`cyborg.bus.shm`); only a slot reference travels, by
+  Unix datagram (:mod:`cyborg.bus.doorbell`) or else through Zenoh;
 * anyone else (other machines, ROS 2 nodes): CDR on the rmw_zenoh data key with the 33-byte
   attachment, so ``ros2 topic echo`` reads it.
 
@@ -132,7 +133,7 @@ class Publisher(_Endpoint):
 
     def _publish_remote(self, message: Any, attachment: bytes) -> None:
         context = self.context
-        readers = 0 if self.latched else context.shm_reader_count(self.topic)
+        readers = () if self.latched else context.shm_readers(self.topic)
         if readers:
             size = context.types.cdr_size(message, self.type_name)
             if size >= SHM_THRESHOLD:
@@ -141,8 +142,10 @@ class Publisher(_Endpoint):
                 ref = self._slots.write(size, lambda view: context.types.serialize_into(
                     message, self.type_name, view))
                 if ref is not None:
-                    self._shm_publisher.put(ref.encode(), attachment=attachment)
-                    if self._remote_subscriptions() <= readers:
+                    reference, doorbell = ref.encode(), context.doorbell
+                    if doorbell is None or not doorbell.ring(readers, attachment, reference):
+                        self._shm_publisher.put(reference, attachment=attachment)
+                    if self._remote_subscriptions() <= len(readers):
                         return
         if self.latched or self._matching():
             data = context.types.serialize(message, self.type_name)
@@ -215,6 +218,8 @@ class Subscription(_Endpoint):
                 any_hash, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
         self._shm_subscriber = session.declare_subscriber(
             self.context.shm_key(self.key), self._on_slot, allowed_origin=zenoh.Locality.REMOTE)
+        if self.context.doorbell is not None:
+            self.context.doorbell.register(self.entity_id, self._on_doorbell)
         self._shm_token = session.liveliness().declare_token(
             self.context.shm_token(self.entity_id, self.topic))
         for _publisher, (message, attachment) in self.context.add_local(self.topic, self):
@@ -238,14 +243,21 @@ class Subscription(_Endpoint):
             self.callback(message)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        if self._accept(sample):
+        attachment = sample.attachment
+        if self._accept(None if attachment is None else attachment.to_bytes()):
             self._decode(sample.payload.to_bytes())
 
     def _on_slot(self, sample: zenoh.Sample) -> None:
-        if not self._accept(sample):
+        attachment = sample.attachment
+        self._on_doorbell(None if attachment is None else attachment.to_bytes(),
+                          sample.payload.to_bytes())
+
+    def _on_doorbell(self, attachment: bytes | None, reference: bytes) -> None:
+        """A slot reference, by Zenoh or by the doorbell: lease the slot, decode in place."""
+        if not self._accept(attachment):
             return
         try:
-            ref = SlotRef.decode(sample.payload.to_bytes())
+            ref = SlotRef.decode(reference)
         except ValueError as exc:
             self.context.drop(f"{self.topic}: bad slot reference", str(exc))
             return
@@ -255,16 +267,16 @@ class Subscription(_Endpoint):
             return
         self._decode(lease.data)
 
-    def _accept(self, sample: zenoh.Sample) -> bool:
+    def _accept(self, attachment: bytes | None) -> bool:
         """False for a malformed attachment (counted) or a message already delivered."""
-        if sample.attachment is None:  # not rmw_zenoh, but harmless
+        if attachment is None:  # not rmw_zenoh, but harmless
             return True
         try:
-            attachment = Attachment.decode(sample.attachment.to_bytes())
+            decoded = Attachment.decode(attachment)
         except ValueError as exc:
             self.context.drop(f"{self.topic}: bad attachment", str(exc))
             return False
-        return self._fresh(attachment)
+        return self._fresh(decoded)
 
     def _fresh(self, attachment: Attachment) -> bool:
         """False for a sequence number already seen from this publisher (via another path)."""
@@ -300,6 +312,8 @@ class Subscription(_Endpoint):
         if not self._withdraw():
             return
         self.context.remove_local(self.topic, self)
+        if self.context.doorbell is not None:
+            self.context.doorbell.unregister(self.entity_id)
         self._shm_token.undeclare()
         self._shm_subscriber.undeclare()
         self._zenoh.undeclare()
