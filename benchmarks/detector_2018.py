@@ -6,7 +6,8 @@
 * the 2018 per-row Python loop over the output with no non-maximum suppression (every row above
   the threshold kept); YOLOX's raw head is first turned into what OpenCV's Darknet Region layer
   handed the 2018 node (:func:`region_output`);
-* distance as the mean depth over the whole box, and the same drawing;
+* distance as the mean depth over the whole box; drawing as the 2018 node drew, with OpenCV's
+  ``rectangle`` and ``putText`` on a copy of the frame (:func:`draw_2018`);
 * transport: the frame is sent to the detector's process as a pickled ``multiprocessing`` Pipe
   ``send((stamp, image, depth))``, standing in for the 2018 node's serialised ROS 1 transport.
 """
@@ -27,11 +28,21 @@ import cv2
 import numpy as np
 
 from benchmarks.detector_frames import THRESHOLD, Frames, Offer, Run, offer_frames, stages_of
-from cyborg.vision.annotate import annotate
+from cyborg.vision.annotate import BOX_COLOUR, FONT, caption
 from cyborg.vision.detector import Detection
 from cyborg.vision.distance import box_mean_2018
 from cyborg.vision.labels import COCO
 from cyborg.vision.layouts import yolox_grid
+
+
+def draw_2018(image: np.ndarray, detections: list[Detection]) -> np.ndarray:
+    """A copy of the frame with each box and caption drawn by OpenCV, one call after another."""
+    drawn = image.copy()
+    for detection in detections:
+        x1, y1, x2, y2 = (round(value) for value in detection.box)
+        cv2.rectangle(drawn, (x1, y1), (x2, y2), BOX_COLOUR, 2)
+        cv2.putText(drawn, caption(detection), (x1, max(y1 - 5, 15)), FONT, 1.0, (0, 0, 0), 2)
+    return drawn
 
 
 def region_output(raw: np.ndarray, grid: tuple[np.ndarray, np.ndarray],
@@ -112,7 +123,7 @@ def peer_2018(frames_in: Connection, answers: Connection, model: str, threads: i
         detections = [dataclasses.replace(found, distance=box_mean_2018(depth, found.box))
                       for found in detections]
         t4 = time.perf_counter()
-        annotate(image, detections)
+        draw_2018(image, detections)
         t5 = time.perf_counter()
         answers.send((stamp, [{"label": found.label, "confidence": found.confidence,
                                "distance": found.distance, "polygon": found.corners}

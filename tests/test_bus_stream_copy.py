@@ -22,12 +22,15 @@ def types() -> MessageTypes:
 def test_the_streaming_loop_compiles_here() -> None:
     """numba brings llvmlite, so the fast path must exist wherever cyborg is installed."""
     assert kernel() is not None
+    assert kernel(keep_source=True) is not None
+    assert kernel(keep_source=True) is not kernel()  # two loops: the source kept or passed by
 
 
 @settings(max_examples=40, deadline=None)
 @given(offset=st.integers(0, 130), extra=st.integers(-70, 4096),
-       seed=st.integers(0, 2**32 - 1))
-def test_the_copy_is_exact_at_any_alignment(offset: int, extra: int, seed: int) -> None:
+       seed=st.integers(0, 2**32 - 1), keep_source=st.booleans())
+def test_the_copy_is_exact_at_any_alignment(offset: int, extra: int, seed: int,
+                                            keep_source: bool) -> None:
     """The unaligned head, the 64-byte body and the tail together give the source's bytes,
     and nothing outside the destination is touched."""
     size = STREAM_MINIMUM + extra
@@ -35,7 +38,7 @@ def test_the_copy_is_exact_at_any_alignment(offset: int, extra: int, seed: int) 
     shared = mmap.mmap(-1, size + 256)  # page-aligned, like a shared-memory slot
     shared.write(b"\xab" * len(shared))
     with memoryview(shared) as whole, whole[offset:offset + size] as window:
-        stream_copy(window, source)
+        stream_copy(window, source, keep_source=keep_source)
     assert shared[offset:offset + size] == source.tobytes()
     assert shared[:offset] == b"\xab" * offset
     assert shared[offset + size:] == b"\xab" * (len(shared) - offset - size)

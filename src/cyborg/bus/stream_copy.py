@@ -43,7 +43,7 @@ loop:
   %from = getelementptr i8, ptr %src, i64 %offset
   %to = getelementptr i8, ptr %dst, i64 %offset
   %ahead = getelementptr i8, ptr %from, i64 1024
-  call void @llvm.prefetch.p0(ptr %ahead, i32 0, i32 0, i32 1)
+  call void @llvm.prefetch.p0(ptr %ahead, i32 0, i32 LOCALITY, i32 1)
   %line = load <16 x i32>, ptr %from, align 1
   store <16 x i32> %line, ptr %to, align 64, !nontemporal !0
   %next = add i64 %i, 1
@@ -57,10 +57,11 @@ FENCE_DECLARATION
 declare void @llvm.prefetch.p0(ptr, i32, i32, i32)
 !0 = !{i32 1}
 """
-# The source is read ahead with a non-temporal prefetch (which never faults, even past the
-# end), so it too passes by the caches. Non-temporal stores are weakly ordered: on x86 only
-# SFENCE (or MFENCE) makes them visible before the stores that announce them; elsewhere
-# LLVM's fence covers them.
+# The source is read ahead with a prefetch (which never faults, even past the end): a
+# non-temporal one (locality 0), so it too passes by the caches, or one that keeps it in them
+# (locality 3) for a caller that reads the source again right after. Non-temporal stores are
+# weakly ordered: on x86 only SFENCE (or MFENCE) makes them visible before the stores that
+# announce them; elsewhere LLVM's fence covers them.
 _X86_FENCE = ("call void @llvm.x86.sse.sfence()", "declare void @llvm.x86.sse.sfence()")
 _OTHER_FENCE = ("fence seq_cst", "")
 
@@ -69,8 +70,12 @@ _keep: list[object] = []  # the JIT engine owns the machine code: keep it alive
 
 
 @functools.cache
-def kernel() -> _Kernel | None:
-    """The compiled copy loop, built on first call; None where it cannot be built."""
+def kernel(keep_source: bool = False) -> _Kernel | None:
+    """The compiled copy loop, built on first call; None where it cannot be built.
+
+    ``keep_source``: read the source into the caches (for a caller that reads it again next)
+    instead of past them.
+    """
     try:
         import llvmlite.binding as llvm
 
@@ -78,7 +83,8 @@ def kernel() -> _Kernel | None:
         llvm.initialize_native_asmprinter()
         x86 = platform.machine().lower() in ("x86_64", "amd64")
         fence, declaration = _X86_FENCE if x86 else _OTHER_FENCE
-        source = _IR.replace("FENCE_DECLARATION", declaration).replace("FENCE", fence)
+        source = _IR.replace("FENCE_DECLARATION", declaration).replace("FENCE", fence) \
+            .replace("LOCALITY", "3" if keep_source else "0")
         machine = llvm.Target.from_default_triple().create_target_machine(
             cpu=llvm.get_host_cpu_name(), features=llvm.get_host_cpu_features().flatten(),
             opt=3)
@@ -97,8 +103,11 @@ def kernel() -> _Kernel | None:
     return function
 
 
-def stream_copy(destination: memoryview | np.ndarray, source: np.ndarray) -> None:
+def stream_copy(destination: memoryview | np.ndarray, source: np.ndarray, *,
+                keep_source: bool = False) -> None:
     """Copy ``source``'s bytes into ``destination`` (writable, exactly as many bytes).
+
+    ``keep_source``: leave the source in the CPU's caches (see :func:`kernel`).
 
     Large contiguous sources go through the non-temporal loop; the unaligned head and the tail
     of the destination, small sources and strided ones take ``numpy.copyto``.
@@ -108,7 +117,7 @@ def stream_copy(destination: memoryview | np.ndarray, source: np.ndarray) -> Non
     if target.nbytes != source.nbytes:
         raise ValueError(f"stream_copy: destination holds {target.nbytes} bytes, "
                          f"source {source.nbytes}")
-    run = kernel() if source.nbytes >= STREAM_MINIMUM else None
+    run = kernel(keep_source) if source.nbytes >= STREAM_MINIMUM else None
     if run is None or not source.flags.c_contiguous or not target.flags.writeable:
         np.copyto(target, source.reshape(-1).view(np.uint8))
         return

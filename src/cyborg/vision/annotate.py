@@ -1,18 +1,36 @@
-"""The annotated image: each detection's box with its label, confidence and distance."""
+"""The annotated image: each detection's box with its label, confidence and distance.
+
+    annotated = annotate(frame, detections)   # a new image; the frame is left as it is
+
+The frame is copied with non-temporal stores (:func:`cyborg.bus.stream_copy.stream_copy`):
+6 MB written through the caches would push the network's weights and the next frame's data out
+of them, which costs more in the next inference than the copy itself. The boxes and labels are
+then drawn on the copy in one compiled pass over its rows; only the captions are rendered by
+OpenCV (``putText``, anti-aliased), all on one small atlas of label patches.
+
+Boxes are outlines ``thickness`` pixels wide centred on the box's edges; each label, white with
+black text, sits on top of its box's top-left corner (inside the box when there is no room
+above). Labels are drawn over boxes, later detections over earlier ones.
+"""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
+from cyborg.bus.stream_copy import stream_copy
 from cyborg.vision.detector import Detection
 
 BOX_COLOUR = (0, 200, 0)
-TEXT_COLOUR = (0, 0, 0)
-LABEL_BACKGROUND = (255, 255, 255)
+TEXT_GREY = 0
+LABEL_GREY = 255
+"""Labels are grey levels (black on white): one channel to render, copied to all three."""
+FONT = cv2.FONT_HERSHEY_SIMPLEX
 
 
 def caption(detection: Detection) -> str:
@@ -21,24 +39,125 @@ def caption(detection: Detection) -> str:
     return f"{detection.label}: {detection.confidence:.2f} ({distance} m)"
 
 
+@dataclass(frozen=True)
+class Overlay:
+    """What is drawn on one image: box outlines and label patches, in image pixels."""
+
+    boxes: np.ndarray
+    """``N x 4`` int64: the outlines' outer left, top, right and bottom (exclusive) edges."""
+    thickness: int
+    labels: np.ndarray
+    """``N x 5`` int64: left, top, width, height of each label, and its first row in ``atlas``."""
+    atlas: np.ndarray
+    """The label patches stacked on top of each other, grey levels (``rows x widest`` uint8:
+    white background, black text), copied to all three channels when drawn."""
+
+    @classmethod
+    def of(cls, width: int, height: int, detections: Sequence[Detection]) -> Overlay:
+        """The overlay of ``detections`` on a ``width`` x ``height`` image."""
+        scale = max(0.4, min(width, height) / 1000)
+        thickness = max(1, round(scale * 2))
+        before = thickness // 2  # outline pixels on the outer side of an edge
+        boxes: list[tuple[int, int, int, int]] = []
+        labels: list[tuple[int, int, int, int, int]] = []
+        captions: list[tuple[str, int]] = []
+        row = widest = 0
+        for detection in detections:
+            x1, y1, x2, y2 = (round(value) if math.isfinite(value) else 0
+                              for value in detection.box)
+            x1, x2, y1, y2 = min(x1, x2), max(x1, x2), min(y1, y2), max(y1, y2)
+            boxes.append((x1 - before, y1 - before, x2 - before + thickness,
+                          y2 - before + thickness))
+            text = caption(detection)
+            (text_w, text_h), baseline = cv2.getTextSize(text, FONT, scale, 1)
+            label_w, label_h = text_w + 3, text_h + baseline + 3
+            top = y1 - label_h + 1 if y1 - label_h + 1 >= 0 else y1
+            labels.append((x1, top, label_w, label_h, row))
+            captions.append((text, text_h))
+            row += label_h
+            widest = max(widest, label_w)
+        atlas = np.full((row, widest), LABEL_GREY, dtype=np.uint8)
+        for (_x, _y, label_w, label_h, first), (text, text_h) in zip(labels, captions,
+                                                                     strict=True):
+            cv2.putText(atlas[first:first + label_h, :label_w], text, (1, text_h + 1), FONT,
+                        scale, TEXT_GREY, 1, cv2.LINE_AA)
+        return cls(np.array(boxes, dtype=np.int64).reshape(-1, 4), thickness,
+                   np.array(labels, dtype=np.int64).reshape(-1, 5), atlas)
+
+
 def annotate(image: np.ndarray, detections: Sequence[Detection]) -> np.ndarray:
-    """A copy of ``image`` with the detections drawn on it (the input is left unchanged)."""
-    return draw_detections(image.copy(), detections)
+    """A copy of the BGR ``image`` with the detections drawn on it."""
+    return draw_detections(copy_frame(image, np.empty(image.shape, dtype=np.uint8)),
+                           detections)
+
+
+def copy_frame(image: np.ndarray, into: np.ndarray) -> np.ndarray:
+    """Copy the BGR ``image`` into ``into`` (writable, C-contiguous, same shape) and return it.
+
+    Non-temporal stores: the copy does not push the network's data out of the CPU's caches; the
+    image itself is read into them, for the resize to the network's input that follows.
+    """
+    _rows(image)  # checks that it is a BGR image
+    if into.shape != image.shape or into.dtype != np.uint8 or not into.flags.c_contiguous \
+            or not into.flags.writeable:
+        raise ValueError(f"copy_frame: into must be a writable C-contiguous uint8 array of "
+                         f"shape {image.shape}, not {into.dtype} {into.shape}")
+    stream_copy(into, image, keep_source=True)  # the network's input is read from it next
+    return into
 
 
 def draw_detections(drawn: np.ndarray, detections: Sequence[Detection]) -> np.ndarray:
     """Draws the detections on ``drawn`` itself (a writable BGR image) and returns it."""
-    height, width = drawn.shape[:2]
-    scale = max(0.4, min(width, height) / 1000)
-    thickness = max(1, round(scale * 2))
-    for detection in detections:
-        x1, y1, x2, y2 = (round(value) for value in detection.box)
-        cv2.rectangle(drawn, (x1, y1), (x2, y2), BOX_COLOUR, thickness)
-        text = caption(detection)
-        (text_w, text_h), baseline = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)
-        top = y1 - text_h - baseline - 2 if y1 - text_h - baseline - 2 >= 0 else y1
-        cv2.rectangle(drawn, (x1, top), (x1 + text_w + 2, top + text_h + baseline + 2),
-                      LABEL_BACKGROUND, cv2.FILLED)
-        cv2.putText(drawn, text, (x1 + 1, top + text_h + 1), cv2.FONT_HERSHEY_SIMPLEX, scale,
-                    TEXT_COLOUR, 1, cv2.LINE_AA)
+    if not drawn.flags.writeable:
+        raise ValueError("draw_detections: the image is read-only (annotate() draws on a copy)")
+    rows = _rows(drawn)
+    overlay = Overlay.of(drawn.shape[1], drawn.shape[0], detections)
+    _draw_rows(rows, overlay.boxes, overlay.thickness, np.array(BOX_COLOUR, dtype=np.uint8),
+               overlay.labels, overlay.atlas)
+    if not np.shares_memory(rows, drawn):  # not C-contiguous: drawn on a copy, put it back
+        drawn[...] = rows.reshape(drawn.shape)
     return drawn
+
+
+def _rows(image: np.ndarray) -> np.ndarray:
+    """``image`` as ``height x (width * 3)`` bytes (a view when it is contiguous)."""
+    if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
+        raise ValueError(f"annotate: expected a BGR uint8 image (H x W x 3), "
+                         f"not {image.dtype} {image.shape}")
+    return np.ascontiguousarray(image).reshape(image.shape[0], image.shape[1] * 3)
+
+
+@njit("void(uint8[:, ::1], int64[:, ::1], int64, uint8[::1], int64[:, ::1], "
+      "Array(uint8, 2, 'C', readonly=True))", cache=True, nogil=True)
+def _draw_rows(target: np.ndarray, boxes: np.ndarray, thickness: int, colour: np.ndarray,
+               labels: np.ndarray, atlas: np.ndarray) -> None:  # pragma: no cover - compiled
+    height, width = target.shape[0], target.shape[1] // 3
+    for y in range(height):
+        row = target[y]
+        for b in range(boxes.shape[0]):
+            left, top = max(boxes[b, 0], 0), boxes[b, 1]
+            right, bottom = min(boxes[b, 2], width), boxes[b, 3]
+            if y < top or y >= bottom or left >= right:
+                continue
+            if y < top + thickness or y >= bottom - thickness:  # top or bottom edge
+                spans = ((left, right), (0, 0))
+            else:  # the left and right edges
+                spans = ((left, min(boxes[b, 0] + thickness, right)),
+                         (max(boxes[b, 2] - thickness, left), right))
+            for start, end in spans:
+                for x in range(start, end):
+                    row[3 * x] = colour[0]
+                    row[3 * x + 1] = colour[1]
+                    row[3 * x + 2] = colour[2]
+        for n in range(labels.shape[0]):
+            x0, y0, label_w, label_h, first = (labels[n, 0], labels[n, 1], labels[n, 2],
+                                               labels[n, 3], labels[n, 4])
+            if y < y0 or y >= y0 + label_h:
+                continue
+            start, end = max(x0, 0), min(x0 + label_w, width)
+            patch = atlas[first + y - y0]
+            for x in range(start, end):
+                grey = patch[x - x0]
+                row[3 * x] = grey
+                row[3 * x + 1] = grey
+                row[3 * x + 2] = grey

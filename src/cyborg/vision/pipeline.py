@@ -11,13 +11,13 @@ pipeline has a :class:`~cyborg.vision.depth.StereoDepth`, else distances are NaN
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from cyborg.vision.annotate import draw_detections
+from cyborg.vision.annotate import copy_frame, draw_detections
+from cyborg.vision.canvases import Canvases
 from cyborg.vision.depth import StereoDepth
 from cyborg.vision.detector import Detection, Detector
 from cyborg.vision.distance import SAMPLES, box_distances
@@ -44,6 +44,7 @@ class DetectionPipeline:
                  inner: float = 0.5, samples: int = SAMPLES) -> None:
         self.detector, self.stereo = detector, stereo
         self.inner, self.samples = inner, samples
+        self.canvases = Canvases()
 
     def depth_of(self, frame: Frame) -> np.ndarray | None:
         if frame.depth is not None:
@@ -55,22 +56,21 @@ class DetectionPipeline:
     def process(self, frame: Frame, *, draw: bool = False) -> Result:
         """Detections with distances for one frame; ``draw``: also the annotated image."""
         started = time.perf_counter()
-        # The annotated image needs a copy of the frame (the frame itself may be shared, e.g.
-        # with another subscriber). Copied first, the network's input is then read from the
-        # copy while it is still in the CPU's cache, which saves a cold read of the frame.
-        canvas = frame.left.copy() if draw else None
+        # The annotated image is drawn on a copy (the frame itself may be shared, e.g. with
+        # another subscriber), made first: the copy's reads bring the frame into the cache for
+        # the network's input, and its non-temporal writes leave the cache alone.
+        canvas = copy_frame(frame.left, self.canvases.take(frame.left.shape)) if draw else None
         copied = time.perf_counter()
         depth = self.depth_of(frame)
         depth_done = time.perf_counter()
-        detections = self.detector.detect(frame.left if canvas is None else canvas)
+        detections = self.detector.detect(frame.left)
         detected = time.perf_counter()
         if depth is not None and detections:
             measured = box_distances(depth, np.array([d.box for d in detections]),
                                      inner=self.inner, samples=self.samples)
-            detections = [dataclasses.replace(detection, distance=float(median),
-                                              depth_fraction=float(share))
-                          for detection, (median, share) in zip(detections, measured,
-                                                                 strict=True)]
+            detections = [Detection(d.label, d.class_id, d.confidence, d.box, median, share)
+                          for d, (median, share) in zip(detections, measured.tolist(),
+                                                        strict=True)]
         distanced = time.perf_counter()
         if canvas is not None:
             draw_detections(canvas, detections)
