@@ -177,9 +177,7 @@ class Approach2018:
 
     def bare(self, count: int) -> Run:
         """OpenCV DNN's ``forward`` alone on a prepared blob, in the detector's process."""
-        run = Run("")
-        run.stages["inference"] = self._ask(("bare", count, self.frames[0][0]))
-        return run
+        return Run.inference_alone(self._ask(("bare", count, self.frames[0][0])))
 
     def run(self, count: int, window: int) -> Run:
         self._ask("report")

@@ -129,6 +129,25 @@ class Run:
     def per_frame_ms(self) -> float:
         return 1000.0 / self.fps if self.fps > 0 else math.nan
 
+    @classmethod
+    def inference_alone(cls, samples_ms: list[float]) -> Run:
+        """One round of bare inference: its calls' times, and as FPS the rate of the median
+        call (so that bare inference, like the configurations, is a median over rounds)."""
+        run = cls("")
+        run.stages["inference"] = samples_ms
+        run.fps_rounds = [1000.0 / float(np.median(samples_ms))] if samples_ms else []
+        return run
+
+    def overhead_over(self, bare: Run) -> tuple[float, float, float]:
+        """Per round, ms per frame over that round's bare inference, minus 1: the median, the
+        lowest and the highest. Each round compares two measurements taken a few seconds
+        apart, so a slow spell of the machine touches both alike."""
+        ratios = [bare_fps / fps - 1 for fps, bare_fps in zip(self.fps_rounds, bare.fps_rounds,
+                                                              strict=True) if fps > 0]
+        if not ratios:
+            return math.nan, math.nan, math.nan
+        return float(np.median(ratios)), min(ratios), max(ratios)
+
 
 Frames = list[tuple[np.ndarray, np.ndarray]]
 

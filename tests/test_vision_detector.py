@@ -244,6 +244,28 @@ def test_the_input_tensor_follows_the_family() -> None:
     assert rgb[0, 0, 0, 0] == pytest.approx(114 / 255) and box.offset_y == 10
 
 
+@pytest.mark.parametrize("input_format", [InputFormat(), InputFormat(rgb=True, scale=1 / 255,
+                                                                     centred=True)])
+def test_the_input_tensor_is_the_letterboxed_image_frame_after_frame(
+        input_format: InputFormat) -> None:
+    """Against a plain numpy reference, for several frames in a row and a change of size (the
+    preprocessor reuses its buffers between calls)."""
+    preprocess = Preprocessor((64, 96), input_format)
+    rng = np.random.default_rng(3)
+    for shape in ((120, 200, 3), (120, 200, 3), (90, 60, 3), (120, 200, 3)):
+        image = rng.integers(0, 256, shape, dtype=np.uint8)
+        tensor, box = preprocess(image)
+        resized = cv2.resize(image, (round(shape[1] * box.scale), round(shape[0] * box.scale)),
+                             interpolation=cv2.INTER_LINEAR)
+        planes = resized.transpose(2, 0, 1)[::-1] if input_format.rgb else \
+            resized.transpose(2, 0, 1)
+        expected = np.full((1, 3, 64, 96), 114 * input_format.scale, dtype=np.float32)
+        expected[0, :, box.offset_y:box.offset_y + resized.shape[0],
+                 box.offset_x:box.offset_x + resized.shape[1]] = planes * np.float32(
+                     input_format.scale)
+        assert np.array_equal(tensor, expected), shape
+
+
 # ------------------------------------------------------------------ distance
 def test_distance_is_the_median_of_valid_depth_and_never_zero() -> None:
     depth = np.full((100, 200), 3.0, np.float32)

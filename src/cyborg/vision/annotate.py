@@ -112,8 +112,17 @@ def draw_detections(drawn: np.ndarray, detections: Sequence[Detection]) -> np.nd
         raise ValueError("draw_detections: the image is read-only (annotate() draws on a copy)")
     rows = _rows(drawn)
     overlay = Overlay.of(drawn.shape[1], drawn.shape[0], detections)
-    _draw_rows(rows, overlay.boxes, overlay.thickness, np.array(BOX_COLOUR, dtype=np.uint8),
-               overlay.labels, overlay.atlas)
+    _draw_boxes(rows, overlay.boxes, overlay.thickness, np.array(BOX_COLOUR, dtype=np.uint8))
+    if overlay.atlas.size:  # the labels: one block copy per label, by numpy
+        atlas = cv2.cvtColor(overlay.atlas, cv2.COLOR_GRAY2BGR)
+        height, width = drawn.shape[:2]
+        image = rows.reshape(drawn.shape)
+        for x0, y0, label_w, label_h, first in overlay.labels.tolist():
+            left, top = max(x0, 0), max(y0, 0)
+            right, bottom = min(x0 + label_w, width), min(y0 + label_h, height)
+            if left < right and top < bottom:
+                image[top:bottom, left:right] = atlas[first + top - y0:first + bottom - y0,
+                                                      left - x0:right - x0]
     if not np.shares_memory(rows, drawn):  # not C-contiguous: drawn on a copy, put it back
         drawn[...] = rows.reshape(drawn.shape)
     return drawn
@@ -127,19 +136,19 @@ def _rows(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(image).reshape(image.shape[0], image.shape[1] * 3)
 
 
-@njit("void(uint8[:, ::1], int64[:, ::1], int64, uint8[::1], int64[:, ::1], "
-      "Array(uint8, 2, 'C', readonly=True))", cache=True, nogil=True)
-def _draw_rows(target: np.ndarray, boxes: np.ndarray, thickness: int, colour: np.ndarray,
-               labels: np.ndarray, atlas: np.ndarray) -> None:  # pragma: no cover - compiled
+@njit("void(uint8[:, ::1], int64[:, ::1], int64, uint8[::1])", cache=True, nogil=True)
+def _draw_boxes(target: np.ndarray, boxes: np.ndarray, thickness: int,
+                colour: np.ndarray) -> None:  # pragma: no cover - compiled
+    """The outlines, row by row: top and bottom edges as runs, the sides as short ones."""
     height, width = target.shape[0], target.shape[1] // 3
-    for y in range(height):
-        row = target[y]
-        for b in range(boxes.shape[0]):
-            left, top = max(boxes[b, 0], 0), boxes[b, 1]
-            right, bottom = min(boxes[b, 2], width), boxes[b, 3]
-            if y < top or y >= bottom or left >= right:
-                continue
-            if y < top + thickness or y >= bottom - thickness:  # top or bottom edge
+    for b in range(boxes.shape[0]):
+        left, top = max(boxes[b, 0], 0), max(boxes[b, 1], 0)
+        right, bottom = min(boxes[b, 2], width), min(boxes[b, 3], height)
+        if left >= right:
+            continue
+        for y in range(top, bottom):
+            row = target[y]
+            if y < boxes[b, 1] + thickness or y >= boxes[b, 3] - thickness:  # top or bottom
                 spans = ((left, right), (0, 0))
             else:  # the left and right edges
                 spans = ((left, min(boxes[b, 0] + thickness, right)),
@@ -149,15 +158,3 @@ def _draw_rows(target: np.ndarray, boxes: np.ndarray, thickness: int, colour: np
                     row[3 * x] = colour[0]
                     row[3 * x + 1] = colour[1]
                     row[3 * x + 2] = colour[2]
-        for n in range(labels.shape[0]):
-            x0, y0, label_w, label_h, first = (labels[n, 0], labels[n, 1], labels[n, 2],
-                                               labels[n, 3], labels[n, 4])
-            if y < y0 or y >= y0 + label_h:
-                continue
-            start, end = max(x0, 0), min(x0 + label_w, width)
-            patch = atlas[first + y - y0]
-            for x in range(start, end):
-                grey = patch[x - x0]
-                row[3 * x] = grey
-                row[3 * x + 1] = grey
-                row[3 * x + 2] = grey

