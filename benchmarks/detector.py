@@ -41,11 +41,11 @@ Stages: transport (header stamp taken just before the camera publishes → both 
 detector's callback), message → frame (numpy views of the messages, frame checks),
 preprocess, inference, postprocess (decode, NMS), distance, drawing, publish (building and
 publishing the output messages). Throughput: frames answered per second. Configurations run
-round-robin, several rounds; FPS is the median over rounds, and bare inference the median over
-rounds of each round's median call. Overhead = time per frame / bare inference - 1; the
-pipeline's is taken per round against the same round's bare inference and the median over
-rounds is the figure (the ratio of the two medians is printed beside it). CPU used by other
-processes is measured per round and reported.
+round-robin, several rounds; FPS is the median over rounds, a round's FPS being frames (or,
+for bare inference, calls) per second of the round. Overhead = time per frame / bare
+inference - 1; the pipeline's is taken per round against the same round's bare inference and
+the median over rounds is the figure (the ratio of the two medians is printed beside it). CPU
+used by other processes is measured per round and reported.
 
 Goals: >= 60 FPS end to end with onnxruntime on 2 cores; the pipeline's overhead (our pipeline
 alone, drawn or not) <= 20 % over bare inference. The end-to-end configurations' overhead, which

@@ -131,11 +131,11 @@ class Run:
 
     @classmethod
     def inference_alone(cls, samples_ms: list[float]) -> Run:
-        """One round of bare inference: its calls' times, and as FPS the rate of the median
-        call (so that bare inference, like the configurations, is a median over rounds)."""
+        """One round of bare inference: its calls' times, and its rate, calls per second of
+        calls (the mean, like the configurations' frames per second: a slow call counts)."""
         run = cls("")
         run.stages["inference"] = samples_ms
-        run.fps_rounds = [1000.0 / float(np.median(samples_ms))] if samples_ms else []
+        run.fps_rounds = [1000.0 * len(samples_ms) / sum(samples_ms)] if samples_ms else []
         return run
 
     def overhead_over(self, bare: Run) -> tuple[float, float, float]:
