@@ -15,6 +15,7 @@ from cyborg.vision.annotate import (
     Overlay,
     annotate,
     caption,
+    copy_frame,
     draw_detections,
 )
 from cyborg.vision.detector import Detection
@@ -115,6 +116,22 @@ def test_images_that_are_not_bgr_are_refused_clearly() -> None:
         annotate(np.zeros((480, 640), dtype=np.uint8), [])
     with pytest.raises(ValueError, match="float32"):
         annotate(np.zeros((480, 640, 3), dtype=np.float32), [])
+
+
+def test_a_frame_is_only_copied_into_a_buffer_that_fits() -> None:
+    image = photo(320, 240)
+    assert copy_frame(image, np.empty_like(image)).tobytes() == image.tobytes()
+    for wrong in (np.empty((240, 321, 3), np.uint8), np.empty((240, 320, 3), np.float32),
+                  np.empty((240, 640, 3), np.uint8)[:, ::2]):
+        with pytest.raises(ValueError, match=r"copy_frame: into must be a writable "
+                                             r"C-contiguous uint8 array of shape \(240, 320, 3\)"):
+            copy_frame(image, wrong)
+    read_only = np.empty_like(image)
+    read_only.flags.writeable = False
+    with pytest.raises(ValueError, match="writable"):
+        copy_frame(image, read_only)
+    with pytest.raises(ValueError, match="BGR uint8 image"):
+        copy_frame(image[:, :, 0], np.empty((240, 320), np.uint8))
 
 
 def test_no_detections_gives_an_exact_copy() -> None:

@@ -4,9 +4,10 @@
 
 The frame is copied with non-temporal stores (:func:`cyborg.bus.stream_copy.stream_copy`):
 6 MB written through the caches would push the network's weights and the next frame's data out
-of them, which costs more in the next inference than the copy itself. The boxes and labels are
-then drawn on the copy in one compiled pass over its rows; only the captions are rendered by
-OpenCV (``putText``, anti-aliased), all on one small atlas of label patches.
+of them, which costs more in the next inference than the copy itself. The box outlines are then
+drawn on the copy by one compiled loop; the captions are rendered by OpenCV (``putText``,
+anti-aliased) on one small atlas of label patches, and each label goes onto the image as one
+block copy.
 
 Boxes are outlines ``thickness`` pixels wide centred on the box's edges; each label, white with
 black text, sits on top of its box's top-left corner (inside the box when there is no room
@@ -97,7 +98,7 @@ def copy_frame(image: np.ndarray, into: np.ndarray) -> np.ndarray:
     Non-temporal stores: the copy does not push the network's data out of the CPU's caches; the
     image itself is read into them, for the resize to the network's input that follows.
     """
-    _rows(image)  # checks that it is a BGR image
+    _check_bgr(image)
     if into.shape != image.shape or into.dtype != np.uint8 or not into.flags.c_contiguous \
             or not into.flags.writeable:
         raise ValueError(f"copy_frame: into must be a writable C-contiguous uint8 array of "
@@ -128,18 +129,23 @@ def draw_detections(drawn: np.ndarray, detections: Sequence[Detection]) -> np.nd
     return drawn
 
 
-def _rows(image: np.ndarray) -> np.ndarray:
-    """``image`` as ``height x (width * 3)`` bytes (a view when it is contiguous)."""
+def _check_bgr(image: np.ndarray) -> None:
     if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
         raise ValueError(f"annotate: expected a BGR uint8 image (H x W x 3), "
                          f"not {image.dtype} {image.shape}")
+
+
+def _rows(image: np.ndarray) -> np.ndarray:
+    """``image`` as ``height x (width * 3)`` bytes (a view when it is contiguous)."""
+    _check_bgr(image)
     return np.ascontiguousarray(image).reshape(image.shape[0], image.shape[1] * 3)
 
 
 @njit("void(uint8[:, ::1], int64[:, ::1], int64, uint8[::1])", cache=True, nogil=True)
 def _draw_boxes(target: np.ndarray, boxes: np.ndarray, thickness: int,
                 colour: np.ndarray) -> None:  # pragma: no cover - compiled
-    """The outlines, row by row: top and bottom edges as runs, the sides as short ones."""
+    """The outlines, box by box and row by row: the top and bottom edges as long runs of
+    pixels, the sides as short ones."""
     height, width = target.shape[0], target.shape[1] // 3
     for b in range(boxes.shape[0]):
         left, top = max(boxes[b, 0], 0), max(boxes[b, 1], 0)
