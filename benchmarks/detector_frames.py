@@ -107,6 +107,8 @@ class Run:
     detections: list[float] = field(default_factory=list)
     frames: int = 0
     lost: int = 0
+    paired: list[float] = field(default_factory=list)
+    """Overheads over bare inference measured in adjacent blocks (:meth:`PipelineAlone.paired`)."""
 
     def add(self, other: Run) -> None:
         for stage, samples in other.stages.items():
@@ -116,6 +118,7 @@ class Run:
         self.detections += other.detections
         self.frames += other.frames
         self.lost += other.lost
+        self.paired += other.paired
 
     def stage(self, name: str) -> tuple[float, float]:
         return quantiles(self.stages.get(name, []))
@@ -137,16 +140,6 @@ class Run:
         run.stages["inference"] = samples_ms
         run.fps_rounds = [1000.0 * len(samples_ms) / sum(samples_ms)] if samples_ms else []
         return run
-
-    def overhead_over(self, bare: Run) -> tuple[float, float, float]:
-        """Per round, ms per frame over that round's bare inference, minus 1: the median, the
-        lowest and the highest. Each round compares two measurements taken a few seconds
-        apart, so a slow spell of the machine touches both alike."""
-        ratios = [bare_fps / fps - 1 for fps, bare_fps in zip(self.fps_rounds, bare.fps_rounds,
-                                                              strict=True) if fps > 0]
-        if not ratios:
-            return math.nan, math.nan, math.nan
-        return float(np.median(ratios)), min(ratios), max(ratios)
 
 
 Frames = list[tuple[np.ndarray, np.ndarray]]

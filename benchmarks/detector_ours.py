@@ -254,6 +254,27 @@ class PipelineAlone:
         return stages_of(records, run)
 
 
+    def paired(self, bare: BareInference, pairs: int, frames: int, *, draw: bool) -> Run:
+        """``pairs`` times, ``frames`` frames through the pipeline next to ``frames`` bare
+        inferences (in turn first and second): each pair gives the pipeline's overhead over
+        bare inference, measured within half a second, when the machine is in the same state.
+        """
+        run = Run("")
+        spent = 0.0
+        for index in range(pairs):
+            if index % 2:
+                alone = bare.run(frames)
+                ours = self.run(frames, draw=draw)
+            else:
+                ours = self.run(frames, draw=draw)
+                alone = bare.run(frames)
+            spent += frames / ours.fps_rounds[0]
+            run.add(ours)
+            run.paired.append(alone.fps_rounds[0] / ours.fps_rounds[0] - 1)
+        run.fps_rounds = [pairs * frames / spent]  # the round's rate, over all its blocks
+        return run
+
+
 class BareInference:
     """The onnxruntime session alone, on a tensor prepared once."""
 
