@@ -127,3 +127,27 @@ def test_unregistered_subscriptions_get_nothing(pair: tuple[Doorbell, Doorbell, 
     assert ringer.ring([("bb02", 9), ("bb02", 10)], b"", b"ref")
     assert arrived.wait(2)
     assert got == [] and second == [(b"", b"ref")]
+
+
+@pytest.mark.filterwarnings("error::pytest.PytestUnhandledThreadExceptionWarning")
+def test_close_returns_even_when_a_handler_hangs_with_a_full_queue() -> None:
+    drops = Drops()
+    ringer, stuck = Doorbell(5, "ee05", drops), Doorbell(5, "ff06", drops)
+    release, entered = threading.Event(), threading.Event()
+
+    def hang(_attachment: bytes, _reference: bytes) -> None:
+        entered.set()
+        release.wait(10)
+    stuck.register(1, hang)
+    assert ringer.ring([("ff06", 1)], b"", b"first")
+    assert entered.wait(2)
+    while ringer.ring([("ff06", 1)], b"", b"more"):  # until its queue is full
+        pass
+    closing = threading.Thread(target=stuck.close)
+    closing.start()
+    closing.join(5)
+    assert not closing.is_alive(), "close() waited for the hanging handler's full queue"
+    release.set()
+    stuck._thread.join(2)  # the handler returns, the closed socket ends the thread quietly
+    assert not stuck._thread.is_alive()
+    ringer.close()

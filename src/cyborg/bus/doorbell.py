@@ -23,6 +23,7 @@ second copy by its sequence number. Malformed datagrams are counted as dropped i
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import socket
 import struct
@@ -98,7 +99,10 @@ class Doorbell:
 
     def _answer(self) -> None:
         while True:
-            datagram = self._inbox.recv(_MAX_DATAGRAM)
+            try:
+                datagram = self._inbox.recv(_MAX_DATAGRAM)
+            except OSError:  # closed under a handler that outlived close()'s wait
+                return
             if self._closed:
                 return
             try:
@@ -136,7 +140,9 @@ class Doorbell:
             return
         self._closed = True
         with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as waker:
-            waker.sendto(_STOP, self.address)
+            waker.setblocking(False)
+            with contextlib.suppress(OSError):  # a full queue: the thread reads on, sees closed
+                waker.sendto(_STOP, self.address)
         if threading.current_thread() is not self._thread:
             self._thread.join(2.0)
         self._inbox.close()
