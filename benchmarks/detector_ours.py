@@ -253,7 +253,6 @@ class PipelineAlone:
         run.fps_rounds = [count / (time.perf_counter() - started)]
         return stages_of(records, run)
 
-
     def paired(self, bare: BareInference, pairs: int, frames: int, *, draw: bool) -> Run:
         """``pairs`` times, ``frames`` frames through the pipeline next to ``frames`` bare
         inferences (in turn first and second): each pair gives the pipeline's overhead over

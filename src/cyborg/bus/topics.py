@@ -219,7 +219,7 @@ class Subscription(_Endpoint):
         self._shm_subscriber = session.declare_subscriber(
             self.context.shm_key(self.key), self._on_slot, allowed_origin=zenoh.Locality.REMOTE)
         if self.context.doorbell is not None:
-            self.context.doorbell.register(self.entity_id, self._on_doorbell)
+            self.context.doorbell.register(self.entity_id, self._on_reference)
         self._shm_token = session.liveliness().declare_token(
             self.context.shm_token(self.entity_id, self.topic))
         for _publisher, (message, attachment) in self.context.add_local(self.topic, self):
@@ -249,10 +249,10 @@ class Subscription(_Endpoint):
 
     def _on_slot(self, sample: zenoh.Sample) -> None:
         attachment = sample.attachment
-        self._on_doorbell(None if attachment is None else attachment.to_bytes(),
+        self._on_reference(None if attachment is None else attachment.to_bytes(),
                           sample.payload.to_bytes())
 
-    def _on_doorbell(self, attachment: bytes | None, reference: bytes) -> None:
+    def _on_reference(self, attachment: bytes | None, reference: bytes) -> None:
         """A slot reference, by Zenoh or by the doorbell: lease the slot, decode in place."""
         if not self._accept(attachment):
             return
