@@ -1,9 +1,10 @@
-"""The annotated image: outlines, labels, and the one-pass copy-and-draw kernel."""
+"""The annotated image: outlines, labels composed from the font's characters, and the copy."""
 
 from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -11,14 +12,17 @@ from hypothesis import strategies as st
 
 from cyborg.vision.annotate import (
     BOX_COLOUR,
+    FONT,
     LABEL_GREY,
     Overlay,
     annotate,
     caption,
     copy_frame,
     draw_detections,
+    line_sizes,
 )
 from cyborg.vision.detector import Detection
+from cyborg.vision.glyphs import FIRST, GlyphFont, encode
 
 WIDTH, HEIGHT = 1920, 1080
 
@@ -47,11 +51,28 @@ def reference(image: np.ndarray, overlay: Overlay) -> np.ndarray:
         fill(left, bottom - t, right, bottom)
         fill(left, top, left + t, bottom)
         fill(right - t, top, right, bottom)
-    for x0, y0, w, h, first in overlay.labels.tolist():
+    for index, (x0, y0, w, h) in enumerate(overlay.labels.tolist()):
+        patch = label_patch(overlay.font, overlay.caption_codes(index), w, h)
         for y in range(max(y0, 0), min(y0 + h, height)):
             for x in range(max(x0, 0), min(x0 + w, width)):
-                drawn[y, x] = overlay.atlas[first + y - y0, x - x0]  # grey: all three channels
+                drawn[y, x] = patch[y - y0, x - x0]  # grey: all three channels
     return drawn
+
+
+def label_patch(font: GlyphFont, codes: np.ndarray, width: int, height: int) -> np.ndarray:
+    """A label composed with numpy: white, each character's cell at its pen (rounded), the
+    darker grey wherever cells overlap."""
+    canvas = np.full((height + 2 * font.cells.shape[1], width + 2 * font.cells.shape[2]),
+                     LABEL_GREY, dtype=np.uint8)
+    top, left = font.cells.shape[1:]  # the patch's origin in the canvas: room for any cell
+    pen = 1.0
+    for code in codes.tolist():
+        cell = font.cells[code - FIRST]
+        y, x = top + font.height + 1 - font.pen_y, left + round(pen) - font.pen_x
+        region = canvas[y:y + cell.shape[0], x:x + cell.shape[1]]
+        np.minimum(region, cell, out=region)
+        pen += font.advances[code - FIRST]
+    return canvas[top:top + height, left:left + width]
 
 
 def test_the_frame_is_copied_and_left_as_it_was() -> None:
@@ -78,12 +99,49 @@ def test_the_label_sits_above_the_box_with_its_caption() -> None:
     image = photo()
     detection = person((100.0, 200.0, 500.0, 900.0))
     overlay = Overlay.of(WIDTH, HEIGHT, [detection])
-    x0, y0, w, h, _first = overlay.labels[0].tolist()
+    x0, y0, w, h = overlay.labels[0].tolist()
     assert (x0, y0 + h - 1) == (100, 200) and w > 200 and 20 < h < 60
     label = annotate(image, [detection])[y0:y0 + h, x0:x0 + w]
     white = np.all(label == LABEL_GREY, axis=2).mean()
     dark = np.all(label < 100, axis=2).mean()
     assert white > 0.6 and dark > 0.03  # a white patch with black text on it
+
+
+def test_labels_are_sized_and_drawn_as_opencv_sizes_and_draws_text() -> None:
+    """Each label is ``getTextSize``'s text size plus a 1-pixel margin, with the caption where
+    ``putText`` puts it: pixel for pixel where the font advances by whole pixels (OpenCV 5),
+    within half a pixel per character where it does not."""
+    image = np.full((HEIGHT, WIDTH, 3), 90, dtype=np.uint8)
+    detections = [person((100.0, 200.0, 500.0, 900.0), distance=2.371),
+                  Detection("motorcycle", 3, 0.5049, (900.0, 300.0, 1500.0, 700.0), math.nan),
+                  Detection("bål|{~}", 80, 1.0, (40.0, 700.0, 80.0, 800.0), 12.0)]
+    annotated = annotate(image, detections)
+    overlay = Overlay.of(WIDTH, HEIGHT, detections)
+    scale, _thickness = line_sizes(WIDTH, HEIGHT)
+    whole_pixels = np.array_equal(overlay.font.advances, np.round(overlay.font.advances))
+    for (x0, y0, w, h), detection in zip(overlay.labels.tolist(), detections, strict=True):
+        text = caption(detection).encode("ascii", "replace").decode()  # as the label shows it
+        (text_w, text_h), baseline = cv2.getTextSize(text, FONT, scale, 1)
+        assert (w, h) == (text_w + 3, text_h + baseline + 3), text
+        expected = np.full((h, w), LABEL_GREY, dtype=np.uint8)
+        cv2.putText(expected, text, (1, text_h + 1), FONT, scale, 0, 1, cv2.LINE_AA)
+        label = annotated[y0:y0 + h, x0:x0 + w]
+        assert np.array_equal(label[..., 0], label[..., 2])  # grey
+        difference = np.abs(label[..., 0].astype(int) - expected)
+        if whole_pixels:
+            assert not difference.any(), text
+        else:
+            assert difference.mean() < 8, text
+
+
+def test_captions_outside_printable_ascii_are_drawn_with_question_marks() -> None:
+    codes, ends = encode(["bål", "a\tb", "", "ok"])
+    assert codes.tobytes() == b"b?la?bok" and ends.tolist() == [3, 6, 6, 8]
+
+
+def test_font_scales_that_are_not_positive_are_refused() -> None:
+    with pytest.raises(ValueError, match="font scale must be positive, not 0"):
+        GlyphFont.at(0.0)
 
 
 def test_a_label_without_room_above_goes_inside_the_box() -> None:
