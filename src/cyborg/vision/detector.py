@@ -136,10 +136,10 @@ class Detector:
         iou = 1.0 if self.layout is Layout.END2END else self.iou
         kept = suppress(candidates.boxes, candidates.scores, candidates.class_ids, iou=iou,
                         limit=self.max_detections)
-        boxes = letterbox.to_image(candidates.boxes[kept]).tolist()
+        boxes = letterbox.to_image(candidates.boxes[kept].tolist())
         scores = candidates.scores[kept].tolist()
         class_ids = candidates.class_ids[kept].tolist()
-        return [Detection(label_of(self.labels, class_id), class_id, score, tuple(box))
+        return [Detection(label_of(self.labels, class_id), class_id, score, box)
                 for box, score, class_id in zip(boxes, scores, class_ids, strict=True)]
 
     def _decode(self, output: np.ndarray, threshold: float) -> Candidates:
