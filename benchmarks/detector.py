@@ -43,11 +43,12 @@ preprocess, inference, postprocess (decode, NMS), distance, drawing, publish (bu
 publishing the output messages). Throughput: frames answered per second. Configurations run
 round-robin, several rounds; FPS is the median over rounds, a round's FPS being frames (or,
 for bare inference, calls) per second of the round. Overhead = time per frame / bare
-inference - 1. The pipeline's overhead is measured in pairs of adjacent blocks, 20 frames
-through the pipeline next to 20 bare inferences (in turn first and second), so that both halves
-of a pair see the same state of the machine; the figure is the median over the pairs (the
-ratio of the table's medians is printed beside it). CPU used by other processes is measured
-per round and reported.
+inference - 1. The pipeline's overhead is measured in pairs: one frame through the pipeline,
+then one bare inference on the pipeline's own session, so that both halves of a pair see the
+same state of the machine. The figure is the median over the pairs, over all of them and over
+those at full speed (see :data:`FULL_SPEED`); the goal is judged on the larger. The ratio of
+the table's medians is printed beside it. CPU used by other processes is measured per round
+and reported.
 
 Goals: >= 60 FPS end to end with onnxruntime on 2 cores; the pipeline's overhead (our pipeline
 alone, drawn or not) <= 20 % over bare inference. The end-to-end configurations' overhead, which
@@ -170,8 +171,8 @@ def measure(model: Path, threads: int, quick: bool) -> Results:
             meter.restart()
             runs["bare"].add(bare.run(100 // scale))
             runs["bare_2018"].add(old.bare(40 // scale))
-            runs["pipeline"].add(pipeline.paired(bare, max(2, 10 // scale), 20, draw=True))
-            runs["pipeline_plain"].add(pipeline.paired(bare, max(2, 10 // scale), 20, draw=False))
+            runs["pipeline"].add(pipeline.paired(200 // scale, draw=True))
+            runs["pipeline_plain"].add(pipeline.paired(200 // scale, draw=False))
             runs["in_process"].add(in_process.run(200 // scale, 2))
             runs["in_process_plain"].add(in_process.run(200 // scale, 2, draw=False))
             runs["lockstep"].add(two.run(100 // scale, 1))
@@ -192,6 +193,42 @@ def measure(model: Path, threads: int, quick: bool) -> Results:
 
 
 # ---------------------------------------------------------------------- report
+FULL_SPEED = 1.25
+"""A pair ran at full speed when its bare inference took at most this times the run's fastest
+tenth: this host's second core is now and then taken from it, and inference (on two threads)
+then slows by up to 2x while the single-threaded rest of the pipeline does not, which makes
+the overhead look smaller than it is."""
+
+
+@dataclass(frozen=True)
+class Overhead:
+    """The pipeline's overhead over bare inference, from pairs: median and middle half."""
+
+    median: float
+    low: float
+    high: float
+    pairs: int
+
+    @staticmethod
+    def of(ratios: Sequence[float]) -> Overhead:
+        if not ratios:
+            return Overhead(math.nan, math.nan, math.nan, 0)
+        low, median, high = np.percentile(ratios, [25, 50, 75])
+        return Overhead(float(median), float(low), float(high), len(ratios))
+
+    @staticmethod
+    def at_full_speed(run: Run) -> Overhead:
+        if not run.paired_bare:
+            return Overhead.of([])
+        limit = FULL_SPEED * float(np.percentile(run.paired_bare, 10))
+        return Overhead.of([ratio for ratio, bare in zip(run.paired, run.paired_bare,
+                                                         strict=True) if bare <= limit])
+
+    def __str__(self) -> str:
+        return (f"{self.median * 100:.1f} % (median of {self.pairs} pairs, middle half "
+                f"{self.low * 100:.1f} to {self.high * 100:.1f} %)")
+
+
 def _cell(pair: tuple[float, float]) -> str:
     return "—" if math.isnan(pair[0]) else f"{pair[0]:.2f} / {pair[1]:.2f}"
 
@@ -261,11 +298,12 @@ def report(results: Results, markdown: bool) -> None:
           "(ours: onnxruntime; 2018: OpenCV DNN)\n")
     for key in ("pipeline", "pipeline_plain"):
         run = runs[key]
-        overhead, quartiles = quantiles(run.paired)[0], np.percentile(run.paired, [25, 75])
-        print(f"{run.name}: pipeline overhead over bare inference {overhead * 100:.0f} % "
-              f"(median of {len(run.paired)} paired blocks, middle half {quartiles[0] * 100:.0f} "
-              f"to {quartiles[1] * 100:.0f} %; from the table's medians "
-              f"{(run.per_frame_ms / bare - 1) * 100:.0f} %) "
+        every, full_speed = Overhead.of(run.paired), Overhead.at_full_speed(run)
+        overhead = max(every.median, full_speed.median)
+        print(f"{run.name}: pipeline overhead over bare inference {every} of all pairs, "
+              f"{full_speed} of the pairs at full speed (bare inference within "
+              f"{FULL_SPEED - 1:.0%} of the run's fastest tenth); from the table's medians "
+              f"{(run.per_frame_ms / bare - 1) * 100:.0f} % "
               f"(goal <= {GOAL_OVERHEAD * 100:.0f} %: {_goal(overhead <= GOAL_OVERHEAD)})")
     for key in ("streaming", "streaming_plain", "in_process", "in_process_plain"):
         run = runs[key]

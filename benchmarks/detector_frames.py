@@ -108,7 +108,9 @@ class Run:
     frames: int = 0
     lost: int = 0
     paired: list[float] = field(default_factory=list)
-    """Overheads over bare inference measured in adjacent blocks (:meth:`PipelineAlone.paired`)."""
+    """Overheads over bare inference measured in pairs (:meth:`PipelineAlone.paired`)."""
+    paired_bare: list[float] = field(default_factory=list)
+    """The bare inference of each pair, ms."""
 
     def add(self, other: Run) -> None:
         for stage, samples in other.stages.items():
@@ -119,6 +121,7 @@ class Run:
         self.frames += other.frames
         self.lost += other.lost
         self.paired += other.paired
+        self.paired_bare += other.paired_bare
 
     def stage(self, name: str) -> tuple[float, float]:
         return quantiles(self.stages.get(name, []))
