@@ -234,6 +234,15 @@ def test_boxes_map_back_through_the_letterbox() -> None:
     assert found.corners == ((48, 16), (80, 16), (80, 48), (48, 48))
 
 
+def test_boxes_reaching_into_the_padding_are_clipped_to_the_image() -> None:
+    """Same letterbox: one box over the top-left corner, one over the bottom-right one."""
+    output = v5_rows((4, 20, 24, 24, 0.9, 0), (60, 60, 16, 16, 0.8, 0))
+    detector = Detector(FixedBackend(output), layout=Layout.YOLOV5, labels=("a",))
+    first, second = detector.detect(np.zeros((64, 128, 3), np.uint8))
+    assert first.box == pytest.approx((0, 0, 32, 32), abs=1e-4)
+    assert second.box == pytest.approx((104, 64, 128, 64), abs=1e-4)
+
+
 def test_the_input_tensor_follows_the_family() -> None:
     image = np.zeros((20, 40, 3), np.uint8)
     image[:, :] = (10, 20, 30)  # B, G, R

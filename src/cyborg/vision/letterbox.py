@@ -7,15 +7,13 @@ YOLOX was trained with the image in the top-left corner; the Ultralytics familie
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
 PAD_VALUE = 114
-
-Box = tuple[float, float, float, float]
 
 
 @dataclass(frozen=True)
@@ -40,18 +38,20 @@ class Letterbox:
     image_width: int
     image_height: int
 
-    def to_image(self, boxes: Iterable[Sequence[float]]) -> list[Box]:
-        """``x1, y1, x2, y2`` boxes in network-input pixels → image pixels, clipped to it.
 
-        Plain Python: a frame has a handful of boxes, and right after the network has run a
-        chain of numpy calls on them costs more than the arithmetic (0.1 against 0.04 ms).
-        """
-        scale, x0, y0 = self.scale, self.offset_x, self.offset_y
-        width, height = float(self.image_width), float(self.image_height)
-        return [(min(max((x1 - x0) / scale, 0.0), width),
-                 min(max((y1 - y0) / scale, 0.0), height),
-                 min(max((x2 - x0) / scale, 0.0), width),
-                 min(max((y2 - y0) / scale, 0.0), height)) for x1, y1, x2, y2 in boxes]
+@njit("void(Array(float32, 2, 'A', readonly=True), int64[:], float64, float64, float64, "
+      "float64, float64, float64[:, :])", cache=True, nogil=True)
+def to_image(boxes: np.ndarray, chosen: np.ndarray, scale: float, offset_x: float,
+             offset_y: float, width: float, height: float,
+             into: np.ndarray) -> None:  # pragma: no cover - compiled
+    """``x1, y1, x2, y2`` boxes ``chosen`` from network-input pixels → image pixels, clipped to
+    the image, into the first four columns of ``into``'s rows (for compiled callers, with a
+    :class:`Letterbox`'s scale and offsets and its image's size)."""
+    for row in range(len(chosen)):
+        for column in range(4):
+            offset, limit = (offset_x, width) if column % 2 == 0 else (offset_y, height)
+            into[row, column] = min(max((boxes[chosen[row], column] - offset) / scale, 0.0),
+                                    limit)
 
 
 class Preprocessor:

@@ -30,7 +30,7 @@ def suppress(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, *, io
                          "class ids: one of each per box")
     if limit < 0:
         raise ValueError(f"limit must not be negative, not {limit}")
-    kept: np.ndarray = _suppress(np.asarray(boxes, np.float32).reshape(-1, 4),
+    kept: np.ndarray = greedy(np.asarray(boxes, np.float32).reshape(-1, 4),
                                  np.asarray(scores, np.float32),
                                  np.asarray(class_ids, np.int32), float(iou), int(limit))
     return kept
@@ -38,8 +38,9 @@ def suppress(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, *, io
 
 @njit("int64[:](Array(float32, 2, 'A', readonly=True), Array(float32, 1, 'A', readonly=True), "
       "Array(int32, 1, 'A', readonly=True), float64, int64)", cache=True, nogil=True)
-def _suppress(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, iou: float,
-              limit: int) -> np.ndarray:  # pragma: no cover - compiled
+def greedy(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, iou: float,
+           limit: int) -> np.ndarray:  # pragma: no cover - compiled
+    """:func:`suppress` without its checks, for compiled callers."""
     order = np.argsort(-scores, kind="mergesort")  # stable: ties keep their input order
     kept = np.empty(min(limit, len(order)), dtype=np.int64)
     count = 0
