@@ -111,6 +111,8 @@ class Run:
     """Overheads over bare inference measured in pairs (:meth:`PipelineAlone.paired`)."""
     paired_bare: list[float] = field(default_factory=list)
     """The bare inference of each pair, ms."""
+    inference_rounds: list[float] = field(default_factory=list)
+    """Per round, the median time of the network's inference, ms (NaN where not measured)."""
 
     def add(self, other: Run) -> None:
         for stage, samples in other.stages.items():
@@ -122,6 +124,8 @@ class Run:
         self.lost += other.lost
         self.paired += other.paired
         self.paired_bare += other.paired_bare
+        self.inference_rounds += other.inference_rounds or [
+            quantiles(other.stages.get("inference", []))[0]] * len(other.fps_rounds)
 
     def stage(self, name: str) -> tuple[float, float]:
         return quantiles(self.stages.get(name, []))
@@ -130,6 +134,13 @@ class Run:
     def fps(self) -> float:
         """The median over rounds (a round's rate: frames answered per second)."""
         return quantiles(self.fps_rounds)[0]
+
+    def fps_at_full_speed(self, limit_ms: float) -> tuple[float, int]:
+        """The median FPS over the rounds whose inference took at most ``limit_ms`` (the
+        machine's two cores at work), and how many rounds that is."""
+        rates = [fps for fps, inference in zip(self.fps_rounds, self.inference_rounds,
+                                               strict=True) if inference <= limit_ms]
+        return quantiles(rates)[0], len(rates)
 
     @property
     def per_frame_ms(self) -> float:
