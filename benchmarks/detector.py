@@ -44,13 +44,12 @@ publishing the output messages). Throughput: frames answered per second. Configu
 round-robin, several rounds; FPS is the median over rounds, a round's FPS being frames (or,
 for bare inference, calls) per second of the round; it is also given over the rounds whose
 inference ran at full speed (see :data:`FULL_SPEED`), and the FPS goal, which is about two
-cores, is judged on that. Overhead = time per frame / bare
-inference - 1. The pipeline's overhead is measured in pairs: one frame through the pipeline,
-then one bare inference on the pipeline's own session, so that both halves of a pair see the
-same state of the machine. The figure is the median over the pairs, over all of them and over
-those at full speed (see :data:`FULL_SPEED`); the goal is judged on the larger. The ratio of
-the table's medians is printed beside it. CPU used by other processes is measured per round
-and reported.
+cores, is judged on that. Overhead = time per frame / bare inference - 1. The pipeline's
+overhead is measured in pairs: one frame through the pipeline, then one bare inference on the
+pipeline's own session, so that both halves of a pair see the same state of the machine. The
+figure is the median over the pairs, over all of them and over those at full speed; the goal
+is judged on the larger. The ratio of the table's medians is printed beside it. CPU used by
+other processes is measured per round and reported.
 
 Goals: >= 60 FPS end to end with onnxruntime on 2 cores; the pipeline's overhead (our pipeline
 alone, drawn or not) <= 20 % over bare inference. The end-to-end configurations' overhead, which

@@ -31,8 +31,8 @@ def suppress(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, *, io
     if limit < 0:
         raise ValueError(f"limit must not be negative, not {limit}")
     kept: np.ndarray = greedy(np.asarray(boxes, np.float32).reshape(-1, 4),
-                                 np.asarray(scores, np.float32),
-                                 np.asarray(class_ids, np.int32), float(iou), int(limit))
+                              np.asarray(scores, np.float32),
+                              np.asarray(class_ids, np.int32), float(iou), int(limit))
     return kept
 
 
