@@ -116,6 +116,11 @@ def _show_robot(page: Page, namespace: str, tree: Iterable[BtNode]) -> None:
     assert page.locator("g.node").count() == len(nodes)
     labels = set(page.locator("g.node text").all_text_contents())
     assert {node.label for node in nodes} <= labels | {node.label[:39] + "…" for node in nodes}
+    left = page.evaluate("Object.fromEntries([...document.querySelectorAll('g.node')].map(g => "
+                         "[g.dataset.id, g.transform.baseVal[0].matrix.e]))")
+    for node in nodes:  # children laid out left to right in tick order
+        xs = [left[child.uid] for child in node.children]
+        assert xs == sorted(xs) and len(set(xs)) == len(xs), node.label
     frames = page.evaluate("window.__monitor.frames")
     _wait_page(page, f"window.__monitor.frames > {frames + 3}")
 

@@ -1,12 +1,13 @@
 """Graphviz DOT export of a tree structure.
 
-Nodes are drawn top-down in child order, shaped by category (composites as boxes, decorators as
-hexagons, actions as rounded boxes, conditions as ellipses) and each subtree instance is a
-labelled cluster. Pass ``statuses`` (node id -> status name) to colour a tick's result, and
-``active`` to draw the running path as rqt_bt did: active nodes outlined in green, the edges
-between them dashed red. ``collapsed`` ids are drawn as one node standing for their whole
-subtree ("+N" nodes hidden), which is how a monitor exports what it shows; ``rankdir="LR"``
-lays a wide tree out left to right.
+Nodes are drawn top-down with siblings left to right in tick order, shaped by category
+(composites as boxes, decorators as hexagons, actions as rounded boxes, conditions as
+ellipses), and each subtree instance is a labelled cluster. Pass ``statuses`` (node id ->
+status name) to colour a tick's result, and ``active`` to draw the running path as rqt_bt did:
+active nodes outlined in green, the edges between them dashed red. ``collapsed`` ids are drawn
+as one node standing for their whole subtree ("+N" nodes hidden), which is how a monitor
+exports what it shows; ``rankdir="LR"`` lays a wide tree out left to right, siblings then
+running top to bottom.
 """
 
 from __future__ import annotations
@@ -63,12 +64,17 @@ def structure_to_dot(structure: Mapping[str, Any], *,
         bold = ', color="#188038", penwidth=3' if uid in active_ids else ""
         lines.append(f"{indent}{quote(uid)} [label={quote(label)}, {attributes}, "
                      f"fillcolor={quote(fill)}{bold}];")
-        for child in children:
-            if child["category"] == "tree" and child.get("children"):
+        # ordering=out alone lets Graphviz swap siblings once clusters are involved; a cluster
+        # per sibling (invisible unless it is a subtree instance) keeps them in tick order. A
+        # left-to-right drawing stacks sibling clusters bottom-up, so they are written reversed.
+        for child in (children[::-1] if rankdir == "LR" else children):
+            subtree = child["category"] == "tree" and child.get("children")
+            if subtree or len(children) > 1:
                 cluster[0] += 1
+                frame = (f'label={quote(child["label"])}; style=dashed; color="#9aa0a6"; '
+                         "peripheries=1;" if subtree else 'label=""; peripheries=0;')
                 lines.append(f"{indent}subgraph cluster_{cluster[0]} {{")
-                lines.append(f"{indent}  label={quote(child['label'])}; style=dashed; "
-                             'color="#9aa0a6";')
+                lines.append(f"{indent}  {frame}")
                 emit(child, indent + "  ")
                 lines.append(f"{indent}}}")
             else:
@@ -78,7 +84,9 @@ def structure_to_dot(structure: Mapping[str, Any], *,
                          if uid in active_ids and child["id"] in active_ids else "")
             lines.append(f"{indent}{quote(uid)} -> {quote(child['id'])}{edge_bold};")
 
-    emit(structure["root"], "  ")
+    lines.append('  subgraph cluster_0 { label=""; peripheries=0;')  # nesting alike at all depths
+    emit(structure["root"], "    ")
+    lines.append("  }")
     lines.append("}")
     return "\n".join(lines) + "\n"
 
