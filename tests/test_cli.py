@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import signal
 import socket
 import subprocess
@@ -175,3 +176,52 @@ def test_ctrl_c_stops_cleanly_and_halts() -> None:
     assert process.returncode == 130, err
     assert "cyborg up: stopped" in err
     assert "Traceback" not in err
+
+
+def test_run_of_a_tree_that_needs_a_robot_stops_before_ticking(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "run", str(PATROL), "--tree", "Patrol tree", "--ticks", "3"]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1, "one clear line, no traceback"
+    assert lines[0].startswith(f"{PATROL}: 4 nodes (MoveTo) need a robot")
+    for way in ("cyborg up", "cyborg bt serve", "--stub-missing"):
+        assert way in lines[0]
+    assert "tick" not in captured.out, "nothing was ticked"
+    assert main(["bt", "run", str(PATROL), "--ticks", "3"]) == 2
+    assert "7 nodes (Charge, CheckBattery, MoveTo) need a robot" in capsys.readouterr().err
+
+
+def test_stub_missing_stands_in_for_nodes_without_a_robot(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bt", "run", str(PATROL), "--tree", "Patrol tree", "--fast", "--ticks", "3",
+                 "--stub-missing", "success"]) == 0
+    out = capsys.readouterr().out
+    assert "tick      1  RUNNING  Patrol tree > Repeat -1x > MemSequence > Wait 2000ms" in out
+
+
+def test_a_run_whose_root_ends_in_error_fails(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    path = _write(tmp_path, project_json([tree_json(N("Sequence", N("Error", id="e"),
+                                                      id="s"))]))
+    assert main(["bt", "run", str(path), "--fast", "--ticks", "2"]) == 1
+    assert "last root status ERROR" in capsys.readouterr().out
+
+
+def test_the_readme_bt_commands_work_as_written(capsys: pytest.CaptureFixture[str]) -> None:
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    commands = [line.split("#")[0].split("|")[0].split() for line in readme.splitlines()
+                if line.startswith("cyborg bt ") and "patrol.b3.json" in line]
+    assert len(commands) >= 4
+    for words in commands:
+        args = [str(PATROL) if word == "patrol.b3.json" else word.strip('"')
+                for word in _joined_quotes(words[1:])]
+        if args[1] == "run":
+            args.append("--fast")  # the same ticks on simulated time
+        assert main(args) == 0, " ".join(words)
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def _joined_quotes(words: list[str]) -> list[str]:
+    """Shell-like words: ``"Patrol`` ``tree"`` -> ``"Patrol tree"``."""
+    return shlex.split(" ".join(words))

@@ -25,6 +25,7 @@ from cyborg.bt import (
 )
 from cyborg.bt.problems import Problem
 from cyborg.bt.registry import NodeModuleError
+from cyborg.nodes.robot import ROBOT
 
 
 def add_parser(commands: Any) -> None:
@@ -160,12 +161,37 @@ def run_command(args: argparse.Namespace) -> int:
     tree = _load(args, clock=run_clock(args))
     if tree is None:
         return 1
+    lacking = missing_resources_line(tree, str(args.file))
+    if lacking:
+        print(lacking, file=sys.stderr)
+        return 2
     return run_tree(tree, rate_hz=args.rate, max_ticks=args.ticks, until_done=args.until_done)
+
+
+_HOW_TO_GIVE = {
+    ROBOT: "run it on the simulated robot with `cyborg up --tree FILE` (or `cyborg bt serve "
+           "FILE` beside `cyborg sim`), or stand stubs in with --stub-missing running",
+}
+
+
+def missing_resources_line(tree: Tree, source: str) -> str:
+    """One line naming the nodes that need a resource the tree lacks and how to give it;
+    empty when nothing is missing."""
+    parts = []
+    for key, nodes in tree.missing_resources().items():
+        names = sorted({node.name for node in nodes})
+        how = _HOW_TO_GIVE.get(key, f"give the tree a {key!r} resource, or stand stubs in "
+                                    "with --stub-missing running")
+        parts.append(f"{len(nodes)} node{'s' if len(nodes) != 1 else ''} "
+                     f"({', '.join(names)}) need a {key} and `cyborg bt run` has none: {how}")
+    return f"{source}: " + "; ".join(parts) if parts else ""
 
 
 def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
              until_done: bool = False, stream: TextIO | None = None) -> int:
-    """Tick ``tree`` in the foreground with a status line until done or Ctrl-C."""
+    """Tick ``tree`` in the foreground with a status line until done or Ctrl-C.
+
+    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0."""
     stream = stream or sys.stdout
     runner = TreeRunner(tree, rate_hz=rate_hz)
     line = StatusLine(tree, stream)
@@ -182,7 +208,9 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
     finally:
         signal.signal(signal.SIGTERM, previous)
     line.finish(interrupted=interrupted)
-    return 130 if interrupted else 0
+    if interrupted:
+        return 130
+    return 1 if tree.last is not None and tree.last.status is Status.ERROR else 0
 
 
 def _raise_interrupt(signum: int, frame: object) -> None:

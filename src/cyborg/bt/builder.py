@@ -8,6 +8,8 @@
   (nested references add more prefixes). A cycle of references is an error naming the trees.
 * Every other node is looked up in the :class:`~cyborg.bt.registry.NodeRegistry`; its
   properties are checked against the class's signature and passed to its constructor.
+* With ``stub_missing``, a stub stands in for each node without a class, and for each node
+  whose :attr:`~cyborg.bt.node.Node.requires` names a resource the blackboard lacks.
 
 Every problem found is collected, and :class:`~cyborg.bt.problems.TreeLoadError` lists them all.
 """
@@ -17,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from cyborg.bt.blackboard import Blackboard
-from cyborg.bt.editor_format import NodeSpec, ProjectSpec, TreeSpec
+from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 from cyborg.bt.node import Category, Node, TickRecord
 from cyborg.bt.problems import Problem, Severity
 from cyborg.bt.properties import bind
@@ -201,6 +203,13 @@ class _Builder:
             self.report(f"unknown node name {spec.name!r}{declared}; registered: "
                         f"{', '.join(self.registry.names())}", tree, spec, "name")
             return None
+        absent = [key for key in node_type.cls.requires if key not in self.blackboard.resources]
+        if absent and self.stub_missing is not None:
+            needs = " and ".join(repr(key) for key in absent)
+            self.report(f"node {spec.name!r} needs a {needs} resource and this tree has none; a "
+                        "stub stands in", tree, spec, "name", Severity.WARNING)
+            declared = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
+            return stub_class(spec, declared, self.stub_missing)()
         binding = bind(node_type.signature, spec.properties)
         for field, message in binding.warnings:
             self.report(message, tree, spec, field, Severity.WARNING)

@@ -79,6 +79,11 @@ class Node:
     """The node's category, fixed by the base class it derives from."""
     _starts: ClassVar[bool] = False
     _ends: ClassVar[bool] = False
+    requires: ClassVar[tuple[str, ...]] = ()
+    """Keys of :attr:`Blackboard.resources <cyborg.bt.blackboard.Blackboard.resources>` the
+    node cannot work without (the robot's nodes need ``"robot"``). A tree tells which of its
+    nodes lack theirs (:meth:`Tree.missing_resources <cyborg.bt.tree.Tree.missing_resources>`),
+    and ``stub_missing`` stands stubs in for them."""
 
     # Identity and wiring, bound by the builder after construction (see `bind`).
     uid: str = ""

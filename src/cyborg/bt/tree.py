@@ -100,6 +100,16 @@ class Tree:
         self._running = []
         return halted
 
+    def missing_resources(self) -> dict[str, list[Node]]:
+        """Resource key -> the nodes that need it (:attr:`Node.requires`) but find none in the
+        blackboard's resources; empty when every node has what it needs."""
+        missing: dict[str, list[Node]] = {}
+        for node in self.nodes:
+            for key in node.requires:
+                if key not in self.blackboard.resources:
+                    missing.setdefault(key, []).append(node)
+        return missing
+
     @property
     def structure(self) -> TreeStructure:
         """The tree's shape, for monitors and exports (built once)."""

@@ -17,7 +17,7 @@ from __future__ import annotations
 import logging
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Decorator, Status, register
-from cyborg.nodes.robot import DockState, robot_of
+from cyborg.nodes.robot import ROBOT, DockState, robot_of
 
 log = logging.getLogger("cyborg.nodes")
 
@@ -28,6 +28,8 @@ DOCK_START_TIMEOUT = 10.0
 @register
 class CheckBattery(Decorator):
     """Tick the child while the battery is below ``threshold`` % or the child runs."""
+
+    requires = (ROBOT,)
 
     def __init__(self, threshold: float = 25.0) -> None:
         if not 0 <= threshold <= 100:
@@ -45,6 +47,8 @@ class CheckBattery(Decorator):
 @register
 class Charge(Action):
     """Dock if needed, then RUNNING until the battery holds ``target`` %."""
+
+    requires = (ROBOT,)
 
     def __init__(self, target: float = 95.0) -> None:
         if not 0 < target <= 100:

@@ -9,10 +9,11 @@ drive to the dock.
 from __future__ import annotations
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
-from cyborg.nodes.robot import DockState, robot_of
+from cyborg.nodes.robot import ROBOT, DockState, robot_of
 
 
 class _DockAction(Action):
+    requires = (ROBOT,)
     wanted: DockState
     on_the_way: DockState
 

@@ -19,7 +19,7 @@ from concurrent.futures import Future
 from typing import Any
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Condition, Status, register
-from cyborg.nodes.robot import robot_of
+from cyborg.nodes.robot import ROBOT, robot_of
 
 
 class _Query:
@@ -38,6 +38,8 @@ class _Query:
 @register
 class ClosestGoal(Action, _Query):
     """Write the closest reachable goal (by path length) to the blackboard."""
+
+    requires = (ROBOT,)
 
     def __init__(self, key: str = "closest_goal") -> None:
         if not key:
@@ -60,6 +62,8 @@ class ClosestGoal(Action, _Query):
 @register
 class DistanceToGoal(Condition, _Query):
     """Write the path length to ``location``; succeed when it is below ``below`` metres."""
+
+    requires = (ROBOT,)
 
     def __init__(self, location: str, key: str = "", below: float = math.inf) -> None:
         if not location:

@@ -27,6 +27,7 @@ import logging
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
 from cyborg.nodes.robot import (
+    ROBOT,
     DockState,
     Goal,
     Move,
@@ -45,6 +46,8 @@ PROGRESS_EPSILON = 0.01
 @register
 class MoveTo(Action):
     """Drive to the map goal ``location``; see the module docstring."""
+
+    requires = (ROBOT,)
 
     def __init__(self, location: str, radius: float = 0.5, start_timeout: float = 10.0,
                  progress_timeout: float = 15.0, retries: int = 2,
