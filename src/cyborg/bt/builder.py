@@ -208,8 +208,8 @@ class _Builder:
             needs = " and ".join(repr(key) for key in absent)
             self.report(f"node {spec.name!r} needs a {needs} resource and this tree has none; a "
                         "stub stands in", tree, spec, "name", Severity.WARNING)
-            declared = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
-            return stub_class(spec, declared, self.stub_missing)()
+            same_kind = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
+            return stub_class(spec, same_kind, self.stub_missing)()
         binding = bind(node_type.signature, spec.properties)
         for field, message in binding.warnings:
             self.report(message, tree, spec, field, Severity.WARNING)
