@@ -114,3 +114,67 @@ def test_unknown_goal_lists_the_names(shared: Path) -> None:
     arnl_map = read_map(shared / "maps" / "AMROffice.map")
     with pytest.raises(KeyError, match=r"no goal named 'kitchen'.*'room1'"):
         arnl_map.goal("kitchen")
+
+
+# ---------------------------------------------------------------------- bytes on disk
+def test_a_byte_order_mark_changes_nothing(shared: Path, tmp_path: Path) -> None:
+    original = shared / "maps" / "columbia.map"
+    copy = tmp_path / "columbia.map"
+    copy.write_bytes(b"\xef\xbb\xbf" + original.read_bytes())  # as a public copy has it
+    plain, marked = read_map(original), read_map(copy)
+    assert marked.intro == "2D-Map" and marked.header == plain.header
+    assert marked.objects == plain.objects  # same kinds, names, poses and line numbers
+    np.testing.assert_array_equal(marked.points, plain.points)
+    np.testing.assert_array_equal(marked.lines, plain.lines)
+    assert parse_map("\ufeff2D-Map\nDATA\n1 2\n").points.tolist() == [[0.001, 0.002]]
+
+
+NORDIC = '2D-Map\nCairn: Goal 1000 2000 0 "Stue øst" ICON "Kjøkken"\n' \
+         'Cairn: GoalWithHeading 0 0 90 "" ICON "Åpent område"\nDATA\n'
+
+
+@pytest.mark.parametrize("encoding", ["latin-1", "cp1252", "utf-8", "utf-8-sig", "utf-16"])
+def test_non_ascii_names_read_right_in_any_encoding_arnl_tools_write(
+        tmp_path: Path, encoding: str) -> None:
+    path = tmp_path / "nordic.map"
+    path.write_bytes(NORDIC.encode(encoding))
+    arnl_map = read_map(path)
+    assert [item.name for item in arnl_map.goals()] == ["Kjøkken", "Åpent område"]
+    assert arnl_map.goal("Kjøkken").description == "Stue øst"
+
+
+def test_windows_punctuation_and_mixed_lines(tmp_path: Path) -> None:
+    """A Windows editor writes "…" as byte 0x85, which Latin-1 would make a line break; a
+    file edited by two tools may hold UTF-8 and Latin-1 lines side by side."""
+    path = tmp_path / "mixed.map"
+    path.write_bytes(b'2D-Map\nCairn: Goal 0 0 0 "" ICON "Kaffe\x85"\n'
+                     + 'Cairn: Goal 0 0 0 "" ICON "Møterom"\n'.encode()
+                     + b'Cairn: Goal 0 0 0 "" ICON "Sm\xf8rbr\xf8d"\nnot a key\n')
+    with pytest.raises(MapError) as caught:
+        read_map(path)
+    assert caught.value.line == 5  # 0x85 did not split line 2
+    path.write_bytes(path.read_bytes().removesuffix(b"not a key\n"))
+    assert [item.name for item in read_map(path).goals()] == ["Kaffe…", "Møterom", "Smørbrød"]
+
+
+@pytest.mark.parametrize("encoding", ["latin-1", "utf-8"])
+@pytest.mark.parametrize(("row", "words"), [
+    ('Cairn: Goal 1x 2000 0 "" ICON "Kjøkken"', "Cairn Goal 'Kjøkken': a coordinate"),
+    ("Stue øst", "found 'Stue øst'"),
+])
+def test_bad_line_in_a_non_ascii_file_names_file_and_line_without_mojibake(
+        tmp_path: Path, encoding: str, row: str, words: str) -> None:
+    path = tmp_path / "nordic.map"
+    path.write_bytes(f"2D-Map\nResolution: 20\n{row}\nDATA\n".encode(encoding))
+    with pytest.raises(MapError) as caught:
+        read_map(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}:3: ") and words in message
+    assert "Ã" not in message and "\\x" not in message
+
+
+def test_broken_utf16_is_a_map_error(tmp_path: Path) -> None:
+    path = tmp_path / "half.map"
+    path.write_bytes("2D-Map\n".encode("utf-16")[:-1])  # odd length: cut mid-character
+    with pytest.raises(MapError, match=r"half\.map: starts with a UTF-16 byte-order mark"):
+        read_map(path)

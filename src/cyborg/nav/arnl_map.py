@@ -15,12 +15,18 @@ A map file is text, one record per line::
 Files store millimetres and degrees; :func:`read_map` converts to metres and radians, so nothing
 beyond this module ever sees a millimetre. Errors are :class:`MapError` naming file and line.
 
+The format is ASCII, but names and descriptions are free text, and the tools that write maps
+disagree on how to store "ø": ARIA copies bytes, Windows editors write the ANSI code page
+(Windows-1252, a superset of Latin-1), newer editors UTF-8, some with a byte-order mark.
+:func:`decode_map_bytes` reads all of these without mojibake (see there).
+
 Map objects (cairns) are :class:`MapObject`; see :mod:`cyborg.nav.map_objects` for what each
 kind means (goals, docks, forbidden lines and areas, simulator boxes).
 """
 
 from __future__ import annotations
 
+import codecs
 import math
 import shlex
 from dataclasses import dataclass, field
@@ -126,15 +132,57 @@ def read_map(path: str | Path) -> ArnlMap:
     """Read an ARNL map file; :class:`MapError` (file and line) if it is not one."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="latin-1")
+        raw = path.read_bytes()
     except OSError as exc:
         raise MapError(str(path), 0, f"cannot read the map: {exc.strerror or exc}") from exc
+    try:
+        text = decode_map_bytes(raw)
+    except UnicodeDecodeError as exc:
+        raise MapError(str(path), 0, f"starts with a UTF-16 byte-order mark but is not UTF-16 "
+                                     f"({exc.reason} at byte {exc.start})") from exc
     return parse_map(text, str(path))
 
 
+def decode_map_bytes(raw: bytes) -> str:
+    """The text of a map file, whichever way its non-ASCII characters were written.
+
+    * A UTF-8 byte-order mark is dropped (it is not part of ``2D-Map``).
+    * A file that is valid UTF-8 is read as UTF-8. Latin-1 text is practically never valid
+      UTF-8 (every accented letter would need the right continuation bytes after it), while
+      UTF-8 read as Latin-1 turns "ø" (bytes C3 B8) into "Ã" and a cedilla.
+    * Otherwise each line on its own is UTF-8 if it can be, else Windows-1252 (Latin-1 plus
+      printable characters, such as "…" and "€", where Latin-1 has invisible control codes),
+      else Latin-1 (for the five bytes Windows-1252 leaves undefined). Line by line, because a
+      file edited by two tools may hold both.
+    * A UTF-16 file (a byte-order mark ``FF FE`` or ``FE FF``, as Notepad's "Unicode" writes)
+      is decoded as such; UnicodeDecodeError if it is broken.
+    """
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return raw.decode("utf-16")
+    raw = raw.removeprefix(codecs.BOM_UTF8)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return "\n".join(_decode_line(line) for line in raw.split(b"\n"))
+
+
+def _decode_line(line: bytes) -> str:
+    for encoding in ("utf-8", "cp1252"):
+        try:
+            return line.decode(encoding)
+        except UnicodeDecodeError:
+            pass
+    return line.decode("latin-1")  # never fails: every byte is a character
+
+
 def parse_map(text: str, source: str = "<map>") -> ArnlMap:
-    """Parse the text of a map file; ``source`` names it in error messages."""
-    rows = text.splitlines()
+    """Parse the text of a map file; ``source`` names it in error messages.
+
+    Lines end at LF, CR LF or CR, and nowhere else: ``str.splitlines`` would also break at
+    characters such as U+0085 or U+2028 inside a name, and shift every later line number.
+    """
+    text = text.removeprefix("\ufeff")
+    rows = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     first = next((index for index, row in enumerate(rows) if row.strip()), None)
     if first is None:
         raise MapError(source, 0, "empty file, expected a '2D-Map' line")
@@ -190,7 +238,8 @@ def _cairn(tokens: list[str], line: int, source: str) -> MapObject:
     if len(tokens) < 7:
         raise MapError(source, line, f"Cairn needs at least 7 fields (type x y heading "
                                      f"\"description\" icon \"name\"), found {len(tokens)}")
-    kind = tokens[0]
+    kind, name = tokens[0], tokens[6]
+    what = f"Cairn {kind} {name!r}" if name else f"Cairn {kind}"
     try:
         x, y, heading = (float(value) for value in tokens[1:4])
         region = None
@@ -198,11 +247,11 @@ def _cairn(tokens: list[str], line: int, source: str) -> MapObject:
             fx, fy, tx, ty = (float(value) / 1000 for value in tokens[7:11])
             region = (fx, fy, tx, ty)
     except ValueError as exc:
-        raise MapError(source, line, f"Cairn {kind}: a coordinate is not a number ({exc})") from exc
+        raise MapError(source, line, f"{what}: a coordinate is not a number ({exc})") from exc
     if not all(math.isfinite(value) for value in (x, y, heading)):
-        raise MapError(source, line, f"Cairn {kind}: coordinates must be finite")
+        raise MapError(source, line, f"{what}: coordinates must be finite")
     return MapObject(kind=kind, x=x / 1000, y=y / 1000, theta=math.radians(heading),
-                     description=tokens[4], icon=tokens[5], name=tokens[6], region=region,
+                     description=tokens[4], icon=tokens[5], name=name, region=region,
                      line=line)
 
 

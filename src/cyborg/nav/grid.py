@@ -8,18 +8,30 @@ column ``c`` hold the cell whose lower-left corner is ``origin + (c, r) * resolu
 * ``forbidden``: cells crossed by a forbidden line or inside a forbidden area;
 * :meth:`clearance`: metres from each cell's centre to the nearest blocked cell — what the
   planner inflates by and the simulator checks collisions with.
+
+:meth:`MapGrid.nearest_clear` answers "where near here can the robot stand?" on a clearance
+layer, e.g. a start for a map that does not name one.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from scipy import ndimage
 
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.map_objects import MapObject
+
+
+class ClearPoint(NamedTuple):
+    """A point with room for the robot; ``enclosed``: inside the map's walls, not around them."""
+
+    x: float
+    y: float
+    enclosed: bool
 
 
 @dataclass
@@ -135,6 +147,32 @@ class MapGrid:
             return np.full(self.shape, np.float32(1e6))
         distance: np.ndarray = ndimage.distance_transform_edt(~blocked)
         return (distance * self.resolution).astype(np.float32)
+
+    def nearest_clear(self, clearance: np.ndarray, x: float, y: float, needed: float,
+                      within: np.ndarray | None = None) -> ClearPoint | None:
+        """The centre of the cell nearest ``(x, y)`` whose ``clearance`` is at least ``needed``
+        metres (and that is in the ``within`` mask, if given); None if there is none.
+
+        Cells *enclosed* by the map win over cells outside its walls: free space that reaches
+        the grid's border runs around the outside of the building, so a building shaped like
+        an L, whose extent's centre lies in the open, still gets a point indoors. Only when
+        no enclosed cell qualifies (an open map, walls with gaps, a room too small for the
+        clearance) do outside cells count, and the answer says so (``enclosed`` False).
+        """
+        free = clearance >= needed
+        labels, _count = ndimage.label(free)
+        border = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
+        outside = np.isin(labels, border[border > 0])
+        allowed = free if within is None else free & within
+        candidates = allowed & ~outside
+        enclosed = bool(candidates.any())
+        rows, columns = np.nonzero(candidates if enclosed else allowed)
+        if len(rows) == 0:
+            return None
+        centres_x = self.origin_x + (columns + 0.5) * self.resolution
+        centres_y = self.origin_y + (rows + 0.5) * self.resolution
+        best = int(np.argmin(np.hypot(centres_x - x, centres_y - y)))
+        return ClearPoint(float(centres_x[best]), float(centres_y[best]), enclosed)
 
     def clearance_at(self, clearance: np.ndarray, x: float, y: float) -> float:
         """Clearance at a point, 0 outside the grid."""

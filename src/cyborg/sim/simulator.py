@@ -14,6 +14,7 @@ times faster, or as fast as possible)::
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -30,6 +31,9 @@ from cyborg.sim.laser import Laser, LaserSpec
 from cyborg.sim.motion_check import Motion, warm_up
 from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
 from cyborg.sim.robot import RobotBase
+from cyborg.sim.start import StartChoice, choose_start
+
+log = logging.getLogger("cyborg.sim")
 
 
 @dataclass(frozen=True)
@@ -66,10 +70,13 @@ class Simulator:
     def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
                  planner: Planner | None = None) -> None:
         """Switch to another map; the robot starts at ``start`` (a pose or a goal name), or at
-        the map's home, or its dock, or the middle of the map."""
+        the map's home, or its dock, or a free point near the middle of the map
+        (:mod:`cyborg.sim.start`). The choice is in ``start_choice`` and in the log: a warning
+        when the map names no start, so ``cyborg sim`` shows it."""
         settings = self.settings
         world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
         planner = planner or Planner(arnl_map)
+        choice = choose_start(arnl_map, planner, start)  # an unknown name changes nothing
         self.map, self.world, self.planner = arnl_map, world, planner
         self.base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
                               world.resolution)
@@ -79,22 +86,10 @@ class Simulator:
         self.navigator = Navigator(planner, settings.navigator)
         self.docking = Docking(settings.dock)
         self.battery.charging = False
-        self.base.place(self.start_pose(start))
+        self.start_choice: StartChoice = choice
+        log.log(logging.WARNING if choice.invented else logging.INFO, "%s", choice.reason)
+        self.base.place(choice.pose)
         self._sense()
-
-    def start_pose(self, start: Pose2D | str | None) -> Pose2D:
-        if isinstance(start, Pose2D):
-            return start
-        if start is not None:
-            item = self.map.goal(start)
-            return Pose2D(item.x, item.y, item.theta)
-        for item in self.map.homes():
-            if item.region is None:
-                return Pose2D(item.x, item.y, item.theta)
-        for item in self.map.docks() + self.map.goals():
-            return Pose2D(item.x, item.y, item.theta)
-        min_x, min_y, max_x, max_y = self.map.bounds()
-        return Pose2D((min_x + max_x) / 2, (min_y + max_y) / 2)
 
     @property
     def pose(self) -> Pose2D:
