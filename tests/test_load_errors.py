@@ -201,7 +201,8 @@ def test_constructor_that_raises_is_reported_with_its_node() -> None:
     ({"hello": 1}, "not a behavior3editor export"),
     ("[1, 2]", "custom node #1 has no 'name'"),
     ('"text"', "expected a JSON object or array"),
-    ({"root": {"id": 1, "children": []}}, "behavior3 v1"),
+    ({"root": {"id": 1, "children": []}}, "node has no 'name'"),  # behavior3 v1
+    ({"root": {"id": 1, "name": "Log", "args": []}}, "'args' must be an object"),
     ({"version": "0.3.0", "scope": "project", "trees": {}}, "'trees' must be an array"),
     ({"scope": "tree", "id": "t", "root": "a", "nodes": []}, "'nodes' must be an object"),
 ])

@@ -16,11 +16,15 @@ Every problem found is collected, and :class:`~cyborg.bt.problems.TreeLoadError`
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
+from cyborg.bt.editor_v1_names import REPLACED_IN_CYBORG
 from cyborg.bt.node import Category, Node, TickRecord
+from cyborg.bt.ports import bind_ports
 from cyborg.bt.problems import Problem, Severity
 from cyborg.bt.properties import bind
 from cyborg.bt.registry import NodeRegistry
@@ -105,8 +109,9 @@ class _Builder:
             return
         self._seen.add(key)
         line = spec.line if spec else (tree.line if tree else None)
+        source = tree.source if tree and tree.source else self.project.source
         self.problems.append(Problem(
-            message, self.project.source, line, None, tree.display_name if tree else None,
+            message, source, line, None, tree.display_name if tree else None,
             spec.id if spec else None, spec.label if spec else None, field, severity))
 
     # ------------------------------------------------------------------ trees
@@ -167,11 +172,35 @@ class _Builder:
                   label=spec.label, description=spec.description, properties=spec.properties,
                   tree_uid=tree_uid, subtree_depth=depth, blackboard=self.blackboard,
                   record=self.record)
+        self.wire(tree, spec, node)
         if len(children) == len(spec.children):
             node.adopt(children)
             for message in node.check():
                 self.report(message, tree, spec)
         return node
+
+    def wire(self, tree: TreeSpec, spec: NodeSpec, node: Node) -> None:
+        """Bind the file's input/output keys to the node's ports (see :mod:`cyborg.bt.ports`);
+        a stub is checked against the ports its definition declares."""
+        cls = type(node)
+        declared: tuple[Sequence[str], Sequence[str]] = (cls.inputs, cls.outputs)
+        if cls.__module__ == stub_class.__module__:
+            definition = self.definitions.get(spec.name)
+            if definition is None:
+                return
+            declared = (definition.inputs, definition.outputs)
+        if not (spec.inputs or spec.outputs or declared[0] or declared[1]):
+            return
+        ports: dict[str, str] = {}
+        for direction, ports_declared, keys in (("input", declared[0], spec.inputs),
+                                                ("output", declared[1], spec.outputs)):
+            bound, errors, ignored = bind_ports(ports_declared, keys, direction)
+            ports.update(bound)
+            for message in errors:
+                self.report(message, tree, spec, direction)
+            for message in ignored:
+                self.report(message, tree, spec, direction, Severity.WARNING)
+        node.ports = ports
 
     def reference(self, tree: TreeSpec, spec: NodeSpec, prefix: str, depth: int,
                   stack: tuple[TreeSpec, ...], outer_uid: str) -> Node | None:
@@ -192,14 +221,24 @@ class _Builder:
         if not spec.name:
             return None
         node_type = self.registry.get(spec.name)
+        if spec.foreign and node_type is not None and node_type.origin == "stock" \
+                and spec.name in REPLACED_IN_CYBORG:
+            node_type = None  # cyborg's node of that name means something else
         if node_type is None:
             definition = self.definitions.get(spec.name)
             if self.stub_missing is not None:
                 self.report(f"node {spec.name!r} is not implemented; a stub stands in",
                             tree, spec, "name", Severity.WARNING)
                 return stub_class(spec, definition, self.stub_missing)()
-            declared = " (declared in custom_nodes, but no Python class is registered for " \
-                       "it)" if definition else ""
+            where = Path(definition.source).name if definition and definition.source \
+                else "custom_nodes"
+            declared = f" (declared in {where}, but no Python class is registered for it)" \
+                if definition else ""
+            if spec.foreign:
+                self.report(f"behavior3 v1's {spec.name!r} ({spec.foreign}) has no equivalent "
+                            "in cyborg: register a node class named "
+                            f"{spec.name!r}, or run with --stub-missing", tree, spec, "name")
+                return None
             self.report(f"unknown node name {spec.name!r}{declared}; registered: "
                         f"{', '.join(self.registry.names())}", tree, spec, "name")
             return None
@@ -253,11 +292,17 @@ def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = No
 
 
 def _check_definitions(builder: _Builder) -> None:
-    for definition in builder.project.definitions:
+    project = builder.project
+    # a v1 node-config file is the editor's whole palette: only the nodes used are checked
+    used = {node.name for tree in project.trees for node in tree.nodes.values()}
+    for definition in project.definitions:
+        if project.kind == "v1" and definition.name not in used:
+            continue
         node_type = builder.registry.get(definition.name)
-        where = Problem("", builder.project.source, definition.line, node_title=definition.name)
+        where = Problem("", definition.source or project.source, definition.line,
+                        node_title=definition.name)
         if node_type is None:
-            if builder.stub_missing is None:
+            if builder.stub_missing is None and project.kind != "v1":  # v1: an error per use
                 builder.problems.append(_at(where, f"custom node {definition.name!r} is declared "
                                                "but no Python class is registered for it",
                                             Severity.WARNING))

@@ -12,6 +12,9 @@ Four shapes are accepted (see the editor's export manager):
 Unknown keys (``display``, ``version``, ``scope``, a hand-added ``category``) are ignored.
 Children keep the order of the file, which is what the editor exported. Every node, tree and
 definition remembers the line it starts on, so problems can point into the file.
+Two older forms load with a warning: a tree without ``id`` (early exports) gets one derived
+from its title, else the file name, made unique; settings under ``parameters`` (the older name
+of ``properties``) are used, with ``properties`` winning where both set a key.
 """
 
 from __future__ import annotations
@@ -19,93 +22,15 @@ from __future__ import annotations
 import bisect
 import json
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from cyborg.bt.editor_v1 import V1Reader, is_v1, is_v1_definitions, parse_definitions
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
+from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec, render_title
 
-_PLACEHOLDER = re.compile(r"<(\w+)>")
-
-
-def render_title(title: str, properties: dict[str, Any]) -> str:
-    """Fill ``<prop>`` placeholders from ``properties``, as the editor displays titles.
-
-    ``render_title("MoveTo <location>", {"location": "home"}) == "MoveTo home"``; placeholders
-    without a matching property stay as they are.
-    """
-
-    def fill(match: re.Match[str]) -> str:
-        key = match.group(1)
-        return str(properties[key]) if key in properties else match.group(0)
-
-    return _PLACEHOLDER.sub(fill, title)
-
-
-@dataclass
-class NodeSpec:
-    """One node block as exported."""
-
-    id: str
-    name: str
-    title: str
-    description: str
-    properties: dict[str, Any]
-    children: list[str]
-    line: int | None = None
-    shape: str = "leaf"
-    """How the block was exported: ``composite`` (``children``), ``decorator`` (``child``) or
-    ``leaf`` (neither). Used only for nodes with no Python class."""
-
-    @property
-    def label(self) -> str:
-        return render_title(self.title, self.properties)
-
-
-@dataclass
-class TreeSpec:
-    """One tree: a flat map of nodes and the id of the node under the Root block."""
-
-    id: str
-    title: str
-    description: str
-    root: str | None
-    properties: dict[str, Any]
-    nodes: dict[str, NodeSpec]
-    line: int | None = None
-
-    @property
-    def display_name(self) -> str:
-        return self.title or self.id
-
-
-@dataclass
-class NodeDefinition:
-    """A custom node declared in the file (the editor's palette entry)."""
-
-    name: str
-    category: str
-    title: str
-    properties: dict[str, Any]
-    line: int | None = None
-
-
-@dataclass
-class ProjectSpec:
-    """Everything read from one export file."""
-
-    source: str
-    kind: str
-    """``project``, ``tree``, ``nodes`` or ``desktop``."""
-    trees: list[TreeSpec] = field(default_factory=list)
-    selected_tree: str | None = None
-    definitions: list[NodeDefinition] = field(default_factory=list)
-    problems: list[Problem] = field(default_factory=list)
-    """Warnings found while reading (errors raise :class:`TreeLoadError` instead)."""
-
-    def tree_by_id(self) -> dict[str, TreeSpec]:
-        return {tree.id: tree for tree in self.trees}
-
+__all__ = ["NodeDefinition", "NodeSpec", "ProjectSpec", "TreeSpec", "parse_project",
+           "read_project", "render_title"]
 
 class _Lines:
     """Line numbers of object keys and ``"id"`` values in the raw JSON text."""
@@ -134,6 +59,7 @@ class _Reader:
         self.source = source
         self.lines = _Lines(text)
         self.problems: list[Problem] = []
+        self._derived_tree_ids: set[str] = set()
 
     def problem(self, message: str, *, line: int | None = None, tree: TreeSpec | None = None,
                 node: str | None = None, title: str | None = None, key: str | None = None,
@@ -157,8 +83,6 @@ class _Reader:
         if "trees" in data:
             return self.project(data)
         if "nodes" in data and "root" in data:
-            if isinstance(data["root"], dict):
-                return self.unsupported_dialect()
             project = ProjectSpec(self.source, "tree")
             tree = self.tree(data, index=0)
             if tree is not None:
@@ -166,15 +90,9 @@ class _Reader:
                 project.selected_tree = tree.id
             project.definitions = self.definitions(data.get("custom_nodes") or [])
             return project
-        if isinstance(data.get("root"), dict):
-            return self.unsupported_dialect()
         self.problem("not a behavior3editor export: expected a project (with 'trees'), a tree "
-                     "(with 'root' and 'nodes'), or an array of node definitions", line=1)
-        return ProjectSpec(self.source, "unknown")
-
-    def unsupported_dialect(self) -> ProjectSpec:
-        self.problem("this is the 'behavior3 v1' format (nodes nested under root.children); "
-                     "only behavior3editor 0.3.0 exports are supported", line=1)
+                     "(with 'root' and 'nodes' or, for 1.x, the root node), or an array of node "
+                     "definitions", line=1)
         return ProjectSpec(self.source, "unknown")
 
     def project(self, data: dict[str, Any]) -> ProjectSpec:
@@ -208,17 +126,47 @@ class _Reader:
         if not isinstance(raw, dict):
             self.problem(f"tree #{index + 1} is not a JSON object")
             return None
-        tree_id = raw.get("id")
-        if not isinstance(tree_id, str) or not tree_id:
-            tree_id = f"tree-{index + 1}"
-            if raw.get("scope") != "tree" or "id" in raw:
-                self.problem(f"tree #{index + 1} has no 'id'", key="id")
         title = _text(raw.get("title"))
+        nodes = raw.get("nodes")
+        tree_id = raw.get("id")
+        derived_from = ""
+        if tree_id is None or tree_id == "":
+            # Early behavior3editor exports (behavior3py's test fixture is one) have no id, and
+            # behavior3js loads them. Derive one from the title, else the file name, else the
+            # position; make it unique against the ids derived so far and against every id and
+            # name in the file, so that no node named like it becomes a reference to it.
+            base, derived_from = (
+                (title.strip(), "its title") if title.strip()
+                else (Path(self.source).stem, "the file name")
+                if self.source and not self.source.startswith("<")
+                else (f"tree-{index + 1}", "its position in the file"))
+            # the ids derived so far live on this reader, created on first use
+            derived = self._derived_tree_ids
+            tree_id, copy = base, 1
+            while tree_id in derived or self.lines.of_id(tree_id) is not None:
+                copy += 1
+                tree_id = f"{base} ({copy})"
+            derived.add(tree_id)
+        elif not isinstance(tree_id, str):
+            self.problem(f"tree #{index + 1}: 'id' must be a string, not {tree_id!r}",
+                         key="id")
+            tree_id = f"tree-{index + 1}"
+        # With no id in the file, point at the tree's first node: the nearest known line.
+        line = self.lines.of_id(tree_id) if not derived_from else min(
+            (n for key in (nodes if isinstance(nodes, dict) else {})
+             if (n := self.lines.of_key(key)) is not None), default=None)
+        properties, found = _settings(raw)
         root = raw.get("root")
         tree = TreeSpec(tree_id, title, _text(raw.get("description")),
                         root if isinstance(root, str) and root else None,
-                        _object(raw.get("properties")), {}, self.lines.of_id(tree_id))
-        nodes = raw.get("nodes")
+                        properties, {}, line)
+        if derived_from:
+            self.problem(f"tree has no 'id' (an early behavior3editor export); using "
+                         f"{tree_id!r}, derived from {derived_from}. Other trees cannot "
+                         "reference it as a subtree", tree=tree, line=line, key="id",
+                         severity=Severity.WARNING)
+        for severity, field_name, message in found:
+            self.problem(message, tree=tree, line=line, key=field_name, severity=severity)
         if not isinstance(nodes, dict):
             self.problem("'nodes' must be an object mapping node ids to nodes", tree=tree,
                          line=tree.line, key="nodes")
@@ -262,11 +210,10 @@ class _Reader:
                              title=title, line=line, key="child")
             else:
                 children = [value]
-        properties = raw.get("properties", {})
-        if not isinstance(properties, dict):
-            self.problem("'properties' must be an object", tree=tree, node=key, title=title,
-                         line=line, key="properties")
-            properties = {}
+        properties, found = _settings(raw)
+        for severity, field_name, message in found:
+            self.problem(message, tree=tree, node=key, title=title, line=line, key=field_name,
+                         severity=severity)
         shape = "composite" if "children" in raw else "decorator" if "child" in raw else "leaf"
         return NodeSpec(key, name, title or name, _text(raw.get("description")), properties,
                         children, line, shape)
@@ -290,19 +237,31 @@ class _Reader:
         return result
 
 
-def parse_project(text: str, source: str = "<string>") -> ProjectSpec:
-    """Read an export from ``text``. Raises :class:`TreeLoadError` naming every problem."""
+def parse_project(text: str, source: str = "<string>", path: Path | None = None) -> ProjectSpec:
+    """Read an export from ``text``: behavior3editor 0.3.0, or a 1.x tree file or node
+    definitions (:mod:`cyborg.bt.editor_v1`, which finds the files it references from
+    ``path``). Raises :class:`TreeLoadError` naming every problem."""
+    text = text.removeprefix("\ufeff")
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise TreeLoadError([Problem(f"malformed JSON: {exc.msg}", source, exc.lineno,
                                      exc.colno)]) from None
-    reader = _Reader(text, source)
-    project = reader.read(data)
-    errors = [p for p in reader.problems if p.is_error]
-    if errors:
-        raise TreeLoadError(reader.problems)
-    project.problems = reader.problems
+    problems: list[Problem]
+    if is_v1(data):
+        reader_v1 = V1Reader(source, path)
+        project = reader_v1.read(data, text)
+        problems = reader_v1.problems
+    elif is_v1_definitions(data):
+        project = ProjectSpec(source, "nodes")
+        project.definitions, problems = parse_definitions(data, source, text)
+    else:
+        reader = _Reader(text, source)
+        project = reader.read(data)
+        problems = reader.problems
+    if any(p.is_error for p in problems):
+        raise TreeLoadError(problems)
+    project.problems = problems
     return project
 
 
@@ -314,7 +273,7 @@ def read_project(path: str | Path) -> ProjectSpec:
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise TreeLoadError([Problem(f"cannot read the file: {reason}", str(path))]) from None
-    return parse_project(text, str(path))
+    return parse_project(text, str(path), path)
 
 
 def _text(value: Any) -> str:
@@ -323,3 +282,43 @@ def _text(value: Any) -> str:
 
 def _object(value: Any) -> dict[str, Any]:
     return value if isinstance(value, dict) else {}
+
+
+def _settings(raw: dict[str, Any]) -> tuple[dict[str, Any], list[tuple[Severity, str, str]]]:
+    """A node's or tree's settings: its ``properties``, completed from ``parameters``.
+
+    ``parameters`` is the older name of ``properties`` (behavior3js still dumps both, and
+    behavior3py's test fixture has both). When ``properties`` is missing or empty, a non-empty
+    ``parameters`` object *is* the settings; when both have keys, ``properties`` wins and only
+    the keys it lacks are taken from ``parameters``. Returns the settings and what to report,
+    as ``(severity, field, message)``: a warning for each use of ``parameters`` (and for each of
+    its values that ``properties`` overrides), an error when either is not a JSON object.
+    """
+    found: list[tuple[Severity, str, str]] = []
+    properties = raw.get("properties", {})
+    if not isinstance(properties, dict):
+        found.append((Severity.ERROR, "properties", "'properties' must be an object"))
+        properties = {}
+    parameters = raw.get("parameters", {})
+    if not isinstance(parameters, dict):
+        found.append((Severity.ERROR, "parameters",
+                      "'parameters' (the older name of 'properties') must be an object"))
+        return properties, found
+    if not properties and parameters:
+        keys = ", ".join(repr(key) for key in parameters)
+        found.append((Severity.WARNING, "parameters",
+                      "settings are under 'parameters', the older name of 'properties'; "
+                      f"using them: {keys}"))
+        return dict(parameters), found
+    merged = dict(properties)
+    for key, value in parameters.items():
+        if key not in properties:
+            merged[key] = value
+            found.append((Severity.WARNING, "parameters",
+                          f"{key!r} is taken from 'parameters' (the older name of "
+                          "'properties'), as 'properties' does not set it"))
+        elif properties[key] != value:
+            found.append((Severity.WARNING, "parameters",
+                          f"{key!r} under 'parameters' ({value!r}) is ignored: 'properties' "
+                          f"sets it to {properties[key]!r}"))
+    return merged, found

@@ -84,6 +84,13 @@ class Node:
     node cannot work without (the robot's nodes need ``"robot"``). A tree tells which of its
     nodes lack theirs (:meth:`Tree.missing_resources <cyborg.bt.tree.Tree.missing_resources>`),
     and ``stub_missing`` stands stubs in for them."""
+    inputs: ClassVar[tuple[str, ...]] = ()
+    """The node's input ports, in order (``"target?"``: optional). A behavior3 v1 file binds
+    them to blackboard keys by position (its ``input`` array); :meth:`read` reads one."""
+    outputs: ClassVar[tuple[str, ...]] = ()
+    """The node's output ports, in order; the file's ``output`` array; :meth:`write`."""
+    ports: dict[str, str] = {}
+    """Port name (without ``?``) -> the blackboard key the file binds it to."""
 
     # Identity and wiring, bound by the builder after construction (see `bind`).
     uid: str = ""
@@ -143,6 +150,24 @@ class Node:
 
     def on_halt(self) -> None:
         """Called once when a RUNNING node is abandoned; cancel what it started."""
+
+    # ----------------------------------------------------------------- ports
+    def read(self, port: str, default: Any = None) -> Any:
+        """The global blackboard value the file binds input ``port`` to; ``default`` when the
+        port is unbound or the key is not set."""
+        key = self.ports.get(port)
+        return default if key is None else self.blackboard.get(key, default)
+
+    def write(self, port: str, value: Any) -> None:
+        """Set the global blackboard key output ``port`` is bound to (``None`` deletes it,
+        as behavior3 v1 does); nothing when the port is unbound."""
+        key = self.ports.get(port)
+        if key is None:
+            return
+        if value is None:
+            self.blackboard.globals.pop(key, None)
+        else:
+            self.blackboard[key] = value
 
     # ----------------------------------------------------------------- engine
     @property

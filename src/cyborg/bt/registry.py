@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from importlib.metadata import entry_points
 from typing import Any, TypeVar, overload
 
-from cyborg.bt import composites, decorators, leaves
+from cyborg.bt import blackboard_nodes, composites, decorators, leaves
 from cyborg.bt.node import Category, Node
 from cyborg.bt.properties import Signature, signature_of
 
@@ -165,6 +165,7 @@ STOCK_NODES: tuple[type[Node], ...] = (
     decorators.Timeout, decorators.ForceSuccess, decorators.ForceFailure, decorators.Delay,
     decorators.RunOnce,
     leaves.Failer, leaves.Succeeder, leaves.Runner, leaves.Error, leaves.Wait,
+    blackboard_nodes.Log, blackboard_nodes.IsNull, blackboard_nodes.NotNull,
 )
 """The nodes every registry starts with: behavior3editor's palette and a few more."""
 

@@ -46,8 +46,16 @@ class StubComposite(Sequence):
 
 def stub_class(spec: NodeSpec, definition: NodeDefinition | None,
                result: Status) -> type[Node]:
-    """The stub class for ``spec``: by declared category, else by how it was connected."""
+    """The stub class for ``spec``: by declared category, else by how it was connected.
+
+    How the block is connected wins where the two disagree (behavior3 v1 lets an action
+    have a child and a decorator have none): a leaf with children stands in as their parent,
+    a decorator without a child as a leaf."""
     category = definition.category if definition and definition.category else spec.shape
+    if spec.children and category in ("action", "condition"):
+        category = spec.shape
+    elif not spec.children and category == "decorator":
+        category = "action"
     if category == "composite":
         return StubComposite
     if category == "decorator":

@@ -1,0 +1,349 @@
+"""Reading behavior3editor 1.x tree files (the maintained editor's "behavior3 v1" format).
+
+One file holds one tree, its nodes nested::
+
+    {"version": "1.8.2", "name": "patrol", "desc": "...", "prefix": "", "export": true,
+     "group": [], "import": ["vars/robot.json"], "vars": [{"name": "target", "desc": ""}],
+     "root": {"id": "1", "name": "Sequence", "children": [
+        {"id": "2", "name": "FindTarget", "output": ["target"]},
+        {"id": "3", "name": "Sequence", "path": "trees/approach.json"},
+        {"id": "4", "name": "Wait", "args": {"time": 2}, "disabled": true}]}}
+
+How it becomes a :class:`~cyborg.bt.editor_format.ProjectSpec`:
+
+* Files are found relative to the **workdir**, the nearest folder at or above the tree file
+  that holds a ``*.b3-workspace`` file (as the editor does), else relative to the tree file's
+  own folder. The node definitions come from the workdir's ``node-config.b3-setting``.
+* Ids may be integers (before 1.8.2) or strings; they become strings. Node names go through
+  :mod:`cyborg.bt.editor_v1_names` (a v1 ``Sequence`` is cyborg's ``MemSequence``; seconds
+  become milliseconds). ``args`` are the node's properties, arg defaults from the definitions
+  filled in as the editor's build does; ``input``/``output`` bind ports (:mod:`cyborg.bt.ports`).
+* A node with ``path`` is a subtree reference: the file it names is read (once) as a tree of
+  its own, and each reference builds an independent instance of it. The children the
+  referencing file keeps are the editor's cached copy and are ignored.
+* ``disabled`` nodes are left out with everything below them, as the editor's build does.
+* ``vars`` (``declvar`` in 1.8.0-1.8.1) and the ``vars`` of the ``import`` files declare
+  blackboard variables; once any are declared, an input or output naming an undeclared one is
+  a warning. ``debug``, ``group``, ``prefix``, ``custom`` and ``$``-keys do not change how a
+  tree runs and are ignored.
+"""
+
+from __future__ import annotations
+
+import bisect
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+from cyborg.bt.editor_v1_names import EQUIVALENTS, NO_EQUIVALENT
+from cyborg.bt.problems import Problem, Severity
+from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
+
+SETTING_FILE = "node-config.b3-setting"
+_ID = re.compile(r'"id"\s*:\s*(?:"((?:[^"\\]|\\.)*)"|(-?\d+))')
+_CATEGORIES = ("action", "condition", "decorator", "composite")
+
+
+def is_v1(data: Any) -> bool:
+    """A behavior3 v1 tree: an object whose ``root`` is the root node itself."""
+    return isinstance(data, dict) and isinstance(data.get("root"), dict)
+
+
+def is_v1_definitions(data: Any) -> bool:
+    """A ``.b3-setting`` node list: an array of definitions with a ``type``."""
+    return isinstance(data, list) and any(isinstance(item, dict) and "type" in item
+                                          for item in data)
+
+
+def find_workdir(tree_file: Path) -> Path:
+    """The nearest folder at or above ``tree_file`` with a ``*.b3-workspace`` (or, lacking
+    one, a ``node-config.b3-setting``), else the tree file's own folder."""
+    start = tree_file.resolve().parent
+    for folder in (start, *start.parents):
+        if any(folder.glob("*.b3-workspace")) or (folder / SETTING_FILE).is_file():
+            return folder
+    return start
+
+
+def parse_definitions(raw: list[Any], source: str, text: str = "") -> tuple[
+        list[NodeDefinition], list[Problem]]:
+    """Node definitions from a ``.b3-setting`` array: category from ``type``, properties
+    from the args' defaults, and the declared input/output ports."""
+    lines = _LineIndex(text)
+    definitions, problems = [], []
+    for index, item in enumerate(raw):
+        name = item.get("name") if isinstance(item, dict) else None
+        if not isinstance(name, str) or not name:
+            problems.append(Problem(f"node definition #{index + 1} has no 'name'", source,
+                                    field="name"))
+            continue
+        assert isinstance(item, dict)
+        kind = str(item.get("type", "")).lower()
+        category = next((c for c in _CATEGORIES if kind.startswith(c)), "")
+        defaults = {arg["name"]: arg["default"] for arg in item.get("args") or []
+                    if isinstance(arg, dict) and isinstance(arg.get("name"), str)
+                    and "default" in arg}
+        definitions.append(NodeDefinition(
+            name, category, _text(item.get("desc")) or name, defaults, lines.of_name(name),
+            _strings(item.get("input")), _strings(item.get("output")), source))
+    return definitions, problems
+
+
+class _LineIndex:
+    """Lines of node ids and definition names in a file's text."""
+
+    def __init__(self, text: str) -> None:
+        self._starts = [0] + [m.end() for m in re.finditer("\n", text)]
+        self._ids: dict[str, int] = {}
+        for match in _ID.finditer(text):
+            value = match.group(1) if match.group(1) is not None else match.group(2)
+            self._ids.setdefault(value, self._line(match.start()))
+        self._names: dict[str, int] = {}
+        for match in re.finditer(r'"name"\s*:\s*"((?:[^"\\]|\\.)*)"', text):
+            self._names.setdefault(match.group(1), self._line(match.start()))
+
+    def _line(self, offset: int) -> int:
+        return bisect.bisect_right(self._starts, offset)
+
+    def of_id(self, node_id: str) -> int | None:
+        return self._ids.get(node_id)
+
+    def of_name(self, name: str) -> int | None:
+        return self._names.get(name)
+
+
+class V1Reader:
+    """Reads one v1 tree file and every file it references into a project."""
+
+    def __init__(self, source: str, path: Path | None) -> None:
+        self.source = source
+        self.path = path
+        self.workdir = find_workdir(path) if path is not None else None
+        self.problems: list[Problem] = []
+        self.trees: list[TreeSpec] = []
+        self._tree_ids: dict[Path, str] = {}
+        self._declared: set[str] = set()
+        self._defaults: dict[str, dict[str, Any]] = {}
+
+    def problem(self, message: str, source: str | None = None, *, line: int | None = None,
+                tree: TreeSpec | None = None, node: NodeSpec | None = None,
+                field: str | None = None, severity: Severity = Severity.ERROR) -> None:
+        self.problems.append(Problem(
+            message, source or self.source, line if node is None else node.line, None,
+            tree.display_name if tree else None, node.id if node else None,
+            node.label if node else None, field, severity))
+
+    # ------------------------------------------------------------------ files
+    def read(self, data: dict[str, Any], text: str) -> ProjectSpec:
+        project = ProjectSpec(self.source, "v1")
+        project.definitions = self.definitions()
+        self._defaults = {d.name: d.properties for d in project.definitions}
+        self._declared = self.declarations(data, self.source, set())
+        main = self.tree(data, text, self.source, self.path)
+        project.trees = self.trees
+        project.selected_tree = main.id
+        self.check_variables(project)
+        return project
+
+    def resolve(self, relative: str) -> Path | None:
+        """A file named in the tree: workdir-relative as the editor writes it, else relative
+        to the tree file's folder."""
+        if self.path is None:
+            return None
+        folders = [self.workdir, self.path.resolve().parent]
+        for folder in dict.fromkeys(f for f in folders if f is not None):
+            candidate = folder / relative
+            if candidate.is_file():
+                return candidate.resolve()
+        return None
+
+    def load(self, relative: str, field: str, tree: TreeSpec, node: NodeSpec | None = None,
+             ) -> tuple[Path, Any, str] | None:
+        """Read a referenced JSON file; a located problem when it cannot be."""
+        path = self.resolve(relative)
+        where = "the workdir or the tree's folder" if self.path else "a file (text given)"
+        if path is None:
+            self.problem(f"{field} {relative!r} was not found in {where}", tree.source,
+                         tree=tree, node=node, line=tree.line, field=field)
+            return None
+        try:
+            text = path.read_text(encoding="utf-8-sig")
+            return path, json.loads(text), text
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            self.problem(f"{field} {relative!r}: cannot read {path}: {exc}", tree.source,
+                         tree=tree, node=node, line=tree.line, field=field)
+            return None
+
+    def definitions(self) -> list[NodeDefinition]:
+        if self.workdir is None:
+            return []
+        setting = self.workdir / SETTING_FILE
+        if not setting.is_file():
+            found = sorted(self.workdir.glob("*.b3-setting"))
+            if len(found) != 1:
+                return []
+            setting = found[0]
+        try:
+            text = setting.read_text(encoding="utf-8-sig")
+            raw = json.loads(text)
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            self.problem(f"cannot read the node definitions: {exc}", str(setting),
+                         severity=Severity.WARNING)
+            return []
+        if not isinstance(raw, list):
+            raw = raw.get("nodes") if isinstance(raw, dict) else None
+        if not isinstance(raw, list):
+            self.problem("node definitions must be an array", str(setting),
+                         severity=Severity.WARNING)
+            return []
+        definitions, problems = parse_definitions(raw, str(setting), text)
+        self.problems.extend(problems)
+        return definitions
+
+    def declarations(self, data: dict[str, Any], source: str, seen: set[Path]) -> set[str]:
+        """Variable names declared by a tree and, recursively, by the files it imports."""
+        raw = data.get("vars", data.get("declvar")) or []
+        names = {item["name"] for item in raw
+                 if isinstance(item, dict) and isinstance(item.get("name"), str)}
+        holder = TreeSpec(source, _text(data.get("name")), "", None, {}, {}, 1, source)
+        for relative in _strings(data.get("import")):
+            loaded = self.load(relative, "import", holder)
+            if loaded is not None and loaded[0] not in seen and isinstance(loaded[1], dict):
+                seen.add(loaded[0])
+                names |= self.declarations(loaded[1], str(loaded[0]), seen)
+        return names
+
+    # ------------------------------------------------------------------ trees
+    def tree(self, data: dict[str, Any], text: str, source: str, path: Path | None) -> TreeSpec:
+        tree_id = self.tree_id(path)
+        stem = path.stem if path is not None else "tree"
+        title = _text(data.get("name")) or stem
+        tree = TreeSpec(tree_id, title, _text(data.get("desc")), None, {}, {}, 1,
+                        source if source != self.source else "")
+        if path is not None:
+            self._tree_ids[path.resolve()] = tree_id
+        self.trees.append(tree)
+        version = _text(data.get("version"))
+        if version and not re.match(r"1\.", version):
+            self.problem(f"written by behavior3editor {version}; read as a 1.x file", source,
+                         line=1, tree=tree, field="version", severity=Severity.WARNING)
+        root = self.node(data["root"], tree, _LineIndex(text), source, [0])
+        tree.root = root.id if root is not None else None
+        return tree
+
+    def tree_id(self, path: Path | None) -> str:
+        if path is None:
+            return "tree"
+        resolved = path.resolve()
+        if self.workdir is not None and resolved.is_relative_to(self.workdir):
+            return resolved.relative_to(self.workdir).with_suffix("").as_posix()
+        return resolved.with_suffix("").name
+
+    def node(self, raw: Any, tree: TreeSpec, lines: _LineIndex, source: str,
+             counter: list[int]) -> NodeSpec | None:
+        """Flatten ``raw`` and its enabled descendants into ``tree.nodes``."""
+        if not isinstance(raw, dict):
+            self.problem("a node must be a JSON object", source, tree=tree, field="children")
+            return None
+        counter[0] += 1
+        node_id = raw.get("id")
+        key = str(node_id) if isinstance(node_id, str | int) and node_id != "" else ""
+        line = lines.of_id(key) if key else None
+        v1_name = raw.get("name")
+        spec = NodeSpec(key or f"#{counter[0]}", v1_name if isinstance(v1_name, str) else "",
+                        _text(raw.get("desc")) or _text(v1_name), _text(raw.get("desc")), {},
+                        [], line)
+        if not key:
+            self.problem(f"node has no 'id'; called {spec.id!r} here", source, tree=tree,
+                         node=spec, field="id", severity=Severity.WARNING)
+        elif key in tree.nodes:
+            self.problem(f"node id {key!r} is used twice in this file", source, tree=tree,
+                         node=spec, field="id")
+            return None
+        if not spec.name:
+            self.problem("node has no 'name' (the node type)", source, tree=tree, node=spec,
+                         field="name")
+        args = raw.get("args", {})
+        if not isinstance(args, dict):
+            self.problem("'args' must be an object", source, tree=tree, node=spec, field="args")
+            args = {}
+        args = {**self._defaults.get(spec.name, {}), **args}
+        spec.inputs = self.keys(raw, "input", tree, spec, source)
+        spec.outputs = self.keys(raw, "output", tree, spec, source)
+        path = raw.get("path")
+        if isinstance(path, str) and path:
+            return self.reference(spec, path, tree, source)
+        equivalent = EQUIVALENTS.get(spec.name)
+        if equivalent is not None:
+            spec.name, spec.properties = equivalent.name, equivalent.convert(args)
+        else:
+            spec.properties = dict(args)
+            spec.foreign = NO_EQUIVALENT.get(spec.name, "")
+        children = raw.get("children", [])
+        if not isinstance(children, list):
+            self.problem("'children' must be an array of nodes", source, tree=tree, node=spec,
+                         field="children")
+            children = []
+        spec.shape = "composite" if len(children) > 1 else "decorator" if children else "leaf"
+        tree.nodes[spec.id] = spec
+        for child in children:
+            if isinstance(child, dict) and child.get("disabled") is True:
+                continue
+            built = self.node(child, tree, lines, source, counter)
+            if built is not None:
+                spec.children.append(built.id)
+        return spec
+
+    def reference(self, spec: NodeSpec, relative: str, tree: TreeSpec,
+                  source: str) -> NodeSpec | None:
+        """A node with ``path``: the subtree file becomes a tree of the project (read once);
+        the node refers to it by id."""
+        spec.title = ""  # the subtree's own name labels it
+        tree.nodes[spec.id] = spec
+        loaded = self.load(relative, "path", tree, spec)
+        if loaded is None:
+            spec.name = ""
+            return spec
+        path, data, text = loaded
+        known = self._tree_ids.get(path)
+        if known is None:
+            if not is_v1(data):
+                self.problem(f"path {relative!r}: {path} is not a behavior3 v1 tree file",
+                             source, tree=tree, node=spec, field="path")
+                spec.name = ""
+                return spec
+            known = self.tree(data, text, str(path), path).id
+        spec.name = known
+        return spec
+
+    def keys(self, raw: dict[str, Any], field: str, tree: TreeSpec, spec: NodeSpec,
+             source: str) -> list[str]:
+        value = raw.get(field, [])
+        if not isinstance(value, list) or not all(isinstance(k, str) for k in value):
+            self.problem(f"'{field}' must be an array of blackboard variable names", source,
+                         tree=tree, node=spec, field=field)
+            return []
+        return list(value)
+
+    def check_variables(self, project: ProjectSpec) -> None:
+        """Once variables are declared, every input and output must name one of them."""
+        if not self._declared:
+            return
+        for tree in project.trees:
+            for spec in tree.nodes.values():
+                for field, keys in (("input", spec.inputs), ("output", spec.outputs)):
+                    for key in keys:
+                        if key and key not in self._declared:
+                            self.problem(f"{field} {key!r} is not a declared variable (vars, "
+                                         "or the vars of an imported file)",
+                                         tree.source or self.source, tree=tree, node=spec,
+                                         field=field, severity=Severity.WARNING)
+
+
+def _text(value: Any) -> str:
+    return value if isinstance(value, str) else ""
+
+
+def _strings(value: Any) -> list[str]:
+    return [item for item in value if isinstance(item, str)] if isinstance(value, list) else []

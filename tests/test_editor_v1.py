@@ -1,0 +1,243 @@
+"""behavior3editor 1.x tree files: the editor's and its runtimes' own samples, and files written
+here for each rule (subtrees by path, ports, disabled nodes, vars and import, the name table)."""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cyborg.app.cli import main
+from cyborg.bt import (
+    Action,
+    Blackboard,
+    ManualClock,
+    Status,
+    TreeLoadError,
+    check_file,
+    default_registry,
+    load_tree,
+)
+from cyborg.bt.problems import Severity
+
+SAMPLES = Path(__file__).resolve().parent / "data" / "behavior3_v1"
+EDITOR = SAMPLES / "editor-sample"
+SAMPLE_TREES = sorted(SAMPLES.rglob("*.json"))
+
+
+class Greet(Action):
+    """A node with ports, as a user writes one for v1 trees."""
+
+    inputs = ("name", "greeting?")
+    outputs = ("said",)
+
+    def tick(self) -> Status:
+        self.write("said", f"{self.read('greeting', 'Hello')}, {self.read('name')}")
+        return Status.SUCCESS
+
+
+def _registry() -> Any:
+    registry = default_registry()
+    registry.add(Greet)
+    return registry
+
+
+def _write(folder: Path, name: str, root: dict[str, Any], **top: Any) -> Path:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps({"version": "1.8.2", "name": path.stem, "desc": "", **top,
+                                "root": root}, indent=2), encoding="utf-8")
+    return path
+
+
+def _node(node_id: int, name: str, *children: dict[str, Any], **fields: Any) -> dict[str, Any]:
+    node: dict[str, Any] = {"id": node_id, "name": name, **fields}
+    if children:
+        node["children"] = list(children)
+    return node
+
+
+def _errors(path: Path, **options: Any) -> list[Any]:
+    return [p for p in check_file(path, **options) if p.is_error]
+
+
+@pytest.mark.parametrize("path", SAMPLE_TREES, ids=lambda p: str(p.relative_to(SAMPLES)))
+def test_every_sample_tree_loads_with_stubs_for_the_game_nodes(path: Path) -> None:
+    """The editor's sample workdir, behavior3-ts's examples and behavior3lua's trees: only
+    their game-specific nodes (Attack, GetHp, ...) and v1 stock nodes cyborg lacks need
+    stubs; every subtree path resolves and every port binding fits."""
+    assert _errors(path, stub_missing=Status.SUCCESS) == []
+    tree = load_tree(path, stub_missing=Status.SUCCESS, clock=ManualClock())
+    assert tree.tick().status in Status
+
+
+def test_without_stubs_the_missing_nodes_are_named_with_file_line_and_id() -> None:
+    monster = EDITOR / "workdir" / "monster.json"
+    errors = _errors(monster)
+    by_node = {(Path(p.source).name, p.node_id): p for p in errors}
+    get_hp = by_node[("monster.json", "3")]
+    assert get_hp.line == 21 and get_hp.field == "name"
+    assert "declared in node-config.b3-setting" in get_hp.message
+    cmp_in_subtree = by_node[("subtree2.json", "2")]  # problems point into the subtree's file
+    assert "behavior3 v1's 'Cmp'" in cmp_in_subtree.message and cmp_in_subtree.line == 15
+
+
+def test_subtree_paths_resolve_against_the_workdir_and_each_reference_is_an_instance() -> None:
+    tree = load_tree(EDITOR / "workdir" / "monster.json", stub_missing=Status.SUCCESS)
+    structure = tree.structure.to_json()
+    attack = structure["root"]["children"][0]["children"][0]  # the tree's Sequence "攻击"
+    assert attack["label"] == "攻击"
+    labels = [child["label"] for child in attack["children"]]
+    assert labels == ["GetHp", "Cmp", "攻击", "subtree1"], "children in file order"
+    get_hp = attack["children"][0]
+    reference = get_hp["children"][0]
+    assert (reference["category"], reference["label"], reference["tree_id"]) == (
+        "tree", "subtree2", "workdir/subtree2")
+    assert tree.by_uid["8/2"].name == "Log", "ids inside a reference are prefixed by its id"
+
+
+def test_names_map_onto_cyborg_nodes_with_seconds_as_milliseconds(tmp_path: Path) -> None:
+    path = _write(tmp_path, "mapped.json", _node(1, "Sequence", _node(
+        2, "Selector", _node(3, "JustFailure"), _node(4, "Invert", _node(5, "JustFailure"))),
+        _node(6, "Wait", args={"time": 1.5}), _node(7, "AlwaysSuccess", _node(8, "JustFailure"))))
+    clock = ManualClock()
+    tree = load_tree(path, clock=clock)
+    assert [node.name for node in tree] == ["mapped", "MemSequence", "MemPriority", "Failer",
+                                            "Inverter", "Failer", "Wait", "ForceSuccess",
+                                            "Failer"]
+    assert [node.label for node in tree][1:4] == ["Sequence", "Selector", "JustFailure"]
+    assert tree.by_uid["6"].properties == {"milliseconds": 1500}
+    assert tree.tick().status is Status.RUNNING
+    clock.advance(1.4)
+    assert tree.tick().status is Status.RUNNING
+    clock.advance(0.2)
+    assert tree.tick().status is Status.SUCCESS
+
+
+def test_ports_bind_blackboard_keys_by_position(tmp_path: Path) -> None:
+    path = _write(tmp_path, "greet.json", _node(1, "Sequence",
+                  _node(2, "Greet", input=["visitor", ""], output=["last"]),
+                  _node(3, "NotNull", input=["last"]), _node(4, "IsNull", input=["nobody"]),
+                  _node(5, "Log", args={"message": "greeted"}, input=["last"])))
+    blackboard = Blackboard({"visitor": "Ada"})
+    tree = load_tree(path, registry=_registry(), blackboard=blackboard)
+    assert tree.by_uid["2"].ports == {"name": "visitor", "said": "last"}
+    assert tree.tick().status is Status.SUCCESS
+    assert blackboard["last"] == "Hello, Ada"
+
+
+def test_a_required_port_left_unbound_and_extra_keys_are_reported(tmp_path: Path) -> None:
+    path = _write(tmp_path, "unbound.json", _node(1, "Sequence",
+                  _node(2, "Greet", input=["", "hi"], output=["said", "more"])))
+    problems = check_file(path, registry=_registry())
+    errors = [p for p in problems if p.is_error]
+    assert [(p.node_id, p.field, p.line) for p in errors] == [("2", "input", 10)]
+    assert "input port 'name' is not bound" in errors[0].message
+    extra = [p for p in problems if p.severity is Severity.WARNING and p.field == "output"]
+    assert len(extra) == 1 and "output #2 ('more') is ignored" in extra[0].message
+
+
+def test_disabled_nodes_are_left_out_with_their_subtrees(tmp_path: Path) -> None:
+    path = _write(tmp_path, "disabled.json", _node(1, "Sequence",
+                  _node(2, "JustSuccess"),
+                  _node(3, "Sequence", _node(4, "JustFailure"), disabled=True),
+                  _node(5, "AlwaysFailure", _node(6, "JustFailure", disabled=True),
+                        _node(7, "JustSuccess"))))
+    tree = load_tree(path)
+    assert [node.node_id for node in tree][1:] == ["1", "2", "5", "7"]
+    assert tree.tick().status is Status.FAILURE
+
+
+def test_subtree_paths_fall_back_to_the_files_folder_and_cycles_are_named(
+        tmp_path: Path) -> None:
+    _write(tmp_path, "parts/leaf.json", _node(1, "JustSuccess"))
+    main_file = _write(tmp_path, "parts/main.json", _node(1, "Sequence",
+                       _node(2, "Sequence", path="leaf.json"),
+                       _node(3, "Sequence", path="leaf.json")))
+    tree = load_tree(main_file)  # no workspace file: relative to the tree's own folder
+    assert [node.uid for node in tree] == ["main", "1", "2", "2/1", "3", "3/1"]
+    _write(tmp_path, "a.json", _node(1, "Sequence", _node(2, "Sequence", path="b.json")))
+    b = _write(tmp_path, "b.json", _node(1, "Sequence", _node(2, "Sequence", path="a.json")))
+    errors = _errors(b)
+    assert any("cycle" in p.message and p.field == "name" for p in errors), errors
+
+
+def test_a_missing_subtree_or_import_names_file_node_and_field(tmp_path: Path) -> None:
+    path = _write(tmp_path, "broken.json", _node(1, "Sequence",
+                  _node(2, "Sequence", path="trees/gone.json")), **{"import": ["vars/no.json"]})
+    errors = _errors(path)
+    fields = {(p.field, p.node_id) for p in errors}
+    assert ("path", "2") in fields and ("import", None) in fields
+    message = next(p for p in errors if p.field == "path").message
+    assert "'trees/gone.json' was not found" in message
+    with pytest.raises(TreeLoadError):
+        load_tree(path)
+
+
+def test_declared_vars_and_imports_check_every_binding(tmp_path: Path) -> None:
+    _write(tmp_path, "vars/robot.json", _node(1, "JustSuccess"),
+           vars=[{"name": "visitor", "desc": ""}])
+    path = _write(tmp_path, "uses.json", _node(1, "Sequence",
+                  _node(2, "Greet", input=["visitor"], output=["typo_said"])),
+                  vars=[{"name": "said", "desc": ""}], **{"import": ["vars/robot.json"]})
+    warnings = [p for p in check_file(path, registry=_registry()) if not p.is_error]
+    assert [(p.node_id, p.field) for p in warnings] == [("2", "output")]
+    assert "'typo_said' is not a declared variable" in warnings[0].message
+
+
+def test_older_1x_files_with_integer_ids_and_declvar(tmp_path: Path) -> None:
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps({"name": "old", "desc": "", "declvar": [{"name": "x"}],
+                                "root": {"id": 1, "name": "IsNull", "input": ["y"]}}))
+    warnings = [p for p in check_file(path) if not p.is_error]
+    assert [(p.node_id, p.field) for p in warnings] == [("1", "input")]
+
+
+def test_a_v1_stock_node_cyborg_lacks_is_explained_not_mistaken_for_ours(
+        tmp_path: Path) -> None:
+    path = _write(tmp_path, "parallel.json", _node(1, "Parallel", _node(2, "JustSuccess")))
+    errors = _errors(path)
+    assert len(errors) == 1 and "behavior3 v1's 'Parallel' (ticks every child until all have" \
+        " finished, then succeeds) has no equivalent" in errors[0].message
+    assert _errors(path, stub_missing=Status.SUCCESS) == []
+
+
+def test_the_cli_takes_v1_files_and_node_definition_files(
+        capsys: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture) -> None:
+    subtree = str(EDITOR / "workdir" / "subtree1.json")
+    caplog.set_level(logging.INFO, "cyborg.bt.log")
+    assert main(["bt", "validate", subtree]) == 0
+    assert main(["bt", "run", subtree, "--fast", "--until-done"]) == 0
+    out = capsys.readouterr().out
+    assert "tick      1  RUNNING  subtree1 > 新建行为树 > Wait" in out
+    assert "hello" in caplog.messages
+    assert main(["bt", "dot", subtree]) == 0
+    assert '"2" [label="Log", shape=box' in capsys.readouterr().out  # ids are the file's own
+    assert main(["bt", "json", subtree]) == 0
+    assert json.loads(capsys.readouterr().out)["root"]["tree_id"] == "workdir/subtree1"
+    assert main(["bt", "validate", str(EDITOR / "node-config.b3-setting")]) == 0
+
+
+def test_the_workdirs_node_definitions_fill_arg_defaults_and_shape_stubs(
+        tmp_path: Path) -> None:
+    (tmp_path / "robot.b3-workspace").write_text('{"files": [], "settings": {}}')
+    (tmp_path / "node-config.b3-setting").write_text(json.dumps([
+        {"name": "Log", "type": "Action", "desc": "log",
+         "args": [{"name": "level", "type": "string?", "default": "warn"}]},
+        {"name": "Scan", "type": "Condition", "desc": "look around", "input": ["area"],
+         "output": ["found?"]}]))
+    path = _write(tmp_path, "trees/patrol.json", _node(1, "Sequence",
+                  _node(2, "Log", args={"message": "start"}),
+                  _node(3, "Scan", input=["", "x"], output=["seen"])))
+    problems = check_file(path, stub_missing=Status.RUNNING)
+    assert [(p.node_id, p.field, p.is_error) for p in problems if "stub" not in p.message] == [
+        ("3", "input", True), ("3", "input", False)], "ports checked against the definition"
+    path = _write(tmp_path, "trees/patrol.json", _node(1, "Sequence",
+                  _node(2, "Log", args={"message": "start"}), _node(3, "Scan", input=["x"])))
+    tree = load_tree(path, stub_missing=Status.FAILURE)
+    assert tree.by_uid["2"].properties == {"level": "warn", "message": "start"}
+    assert tree.by_uid["3"].category.value == "condition"
+    assert tree.tick().status is Status.FAILURE
