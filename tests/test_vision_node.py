@@ -134,6 +134,8 @@ def test_distance_is_nan_without_depth_and_frames_pair_by_exact_stamp(bus: Conte
     image_pub = camera.create_publisher("/cam/image", "sensor_msgs/msg/Image")
     depth_pub = camera.create_publisher("/cam/depth", "sensor_msgs/msg/Image")
     assert wait_for(lambda: detector_node.watched())
+    # depth is waited for only once its publisher is in the graph
+    assert wait_for(lambda: detector_node.publishers("/cam/depth") == ["/cam"])
     person = photo("astronaut")
     holes = np.full(person.shape[:2], np.nan, np.float32)
     holes[::2] = np.inf

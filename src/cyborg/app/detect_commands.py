@@ -122,7 +122,7 @@ def build_pipeline(args: argparse.Namespace) -> DetectionPipeline:
     classes = frozenset(name.strip() for name in args.classes.split(",") if name.strip())
     if not 0 <= args.confidence <= 1 or not 0 <= args.iou <= 1:
         raise CommandError("--confidence and --iou are between 0 and 1")
-    detector = Detector.open(find_model(args.model), backend=args.backend, family=args.family,
+    detector = Detector.open(args.model, backend=args.backend, family=args.family,
                              weights=args.weights, labels=args.labels, threads=args.threads,
                              input_size=args.input_size, confidence=args.confidence,
                              iou=args.iou, classes=classes)

@@ -11,7 +11,8 @@ kind            parameters (default)
                 ``backend`` (onnxruntime), ``threads`` (0: auto), ``input_size``, ``labels``,
                 ``weights`` (Darknet), ``confidence_threshold`` (0.5), ``iou_threshold`` (0.45),
                 ``classes`` (all), ``image_topic`` (/cyborg/camera/left/image_raw),
-                ``depth_topic`` (/cyborg/camera/depth/depth_registered; "" for none),
+                ``depth_topic`` (/cyborg/camera/depth/depth_registered; "" for none;
+                waited for only while it has a publisher, else distances are NaN),
                 ``right_topic`` (""), ``focal``/``baseline``/``doffs`` (stereo depth),
                 ``use_sim_time``
 ==============  ================================================================================
@@ -58,7 +59,7 @@ class RunningCamera:
     def describe(self) -> str:
         node = self.camera.node
         return (f"camera       {node.fq_name}: {self.source} at {self.camera.rate:g} Hz on "
-                f"{node.namespace}/{IMAGE_TOPIC} (+ right, depth)")
+                f"{node.namespace}/{IMAGE_TOPIC} (+ right, depth when the source has them)")
 
     def stop(self) -> None:
         self.camera.stop()

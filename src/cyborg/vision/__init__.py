@@ -12,8 +12,12 @@
 * the distance of each detection: the median of valid depth in its box
   (:mod:`~cyborg.vision.distance`), the annotated image (:mod:`~cyborg.vision.annotate`), and
   the bus messages (:mod:`~cyborg.vision.predictions`);
-* the nodes: :class:`DetectorNode` and :class:`CameraNode`; model files
-  (:mod:`~cyborg.vision.models`).
+* the nodes: :class:`DetectorNode` and :class:`CameraNode`; model files by name or path
+  (:func:`find_model`, :mod:`~cyborg.vision.models`), as ``cyborg detect --model`` finds
+  them::
+
+      from cyborg.vision import DetectionPipeline, Detector, open_source
+      pipeline = DetectionPipeline(Detector.open("yolox_nano"))
 
 This package uses the bus for its messages and nodes; only :mod:`cyborg.app` wires it up.
 """
@@ -25,9 +29,11 @@ from cyborg.vision.detector import Detection, Detector
 from cyborg.vision.detector_node import DetectorNode
 from cyborg.vision.distance import box_distance
 from cyborg.vision.frames import Frame, FrameSource, VisionError
+from cyborg.vision.models import find_model
 from cyborg.vision.pipeline import DetectionPipeline, Result
 from cyborg.vision.sources import SourceOptions, open_source
 
 __all__ = ["CameraNode", "CameraTopics", "Detection", "DetectionPipeline", "Detector",
            "DetectorNode", "Frame", "FrameSource", "Result", "SourceOptions", "StereoCalibration",
-           "StereoDepth", "VisionError", "box_distance", "depth_in_metres", "open_source"]
+           "StereoDepth", "VisionError", "box_distance", "depth_in_metres", "find_model",
+           "open_source"]

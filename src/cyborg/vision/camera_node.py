@@ -2,7 +2,10 @@
 
 Publishes, in the node's namespace, ``left/image_raw`` (``bgr8``), and when the source has them
 ``right/image_raw`` and ``depth/depth_registered`` (``32FC1`` metres), all three stamped alike
-with the time of publication so subscribers pair them by exact stamp. Files are played at
+with the time of publication so subscribers pair them by exact stamp. The right and depth topics
+are advertised only once the source gives its first right image or depth map: a video file
+has no depth, and a depth topic with a publisher that never publishes would keep a detector
+waiting for depth (:mod:`~cyborg.vision.camera_inputs`) instead of detecting. Files are played at
 ``rate`` frames per second (looping when asked); a camera at its own pace. On the robot a
 ZED driver publishes the same; in simulation this node stands in for it with recorded frames.
 """
@@ -17,6 +20,7 @@ from collections.abc import Callable
 import numpy as np
 
 from cyborg.bus import Node, Qos
+from cyborg.bus.topics import Publisher
 from cyborg.vision.frames import FrameSource, VisionError
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image
 
@@ -34,10 +38,11 @@ class CameraNode:
                  now_ns: Callable[[], int] = time.time_ns) -> None:
         self.node, self.open_source = node, open_source
         self.rate, self.loop, self.frame_id, self.now_ns = rate, loop, frame_id, now_ns
-        qos = Qos(depth=2)
-        self.image = node.create_publisher(IMAGE_TOPIC, "sensor_msgs/msg/Image", qos)
-        self.right = node.create_publisher(RIGHT_TOPIC, "sensor_msgs/msg/Image", qos)
-        self.depth = node.create_publisher(DEPTH_TOPIC, "sensor_msgs/msg/Image", qos)
+        self.image = node.create_publisher(IMAGE_TOPIC, "sensor_msgs/msg/Image", Qos(depth=2))
+        self.right: Publisher | None = None
+        """The right images' publisher, created with the first right image (None: none yet)."""
+        self.depth: Publisher | None = None
+        """The depth maps' publisher, created with the first depth map (None: none yet)."""
         self.published = 0
         self.error: VisionError | None = None
         self._stop = threading.Event()
@@ -69,13 +74,22 @@ class CameraNode:
 
     def _publish(self, left: np.ndarray, right: np.ndarray | None,
                  depth: np.ndarray | None) -> None:
+        # partners are advertised before the image: a detector that sees the image already
+        # sees their publishers, and waits for them
+        if right is not None and self.right is None:
+            self.right = self._advertise(RIGHT_TOPIC)
+        if depth is not None and self.depth is None:
+            self.depth = self._advertise(DEPTH_TOPIC)
         types, stamp = self.node.types, self.now_ns()
-        self.image.publish(bgr_to_image(types, left, stamp, self.frame_id))
-        if right is not None:
+        if right is not None and self.right is not None:
             self.right.publish(bgr_to_image(types, right, stamp, self.frame_id))
-        if depth is not None:
+        if depth is not None and self.depth is not None:
             self.depth.publish(depth_to_image(types, depth, stamp, self.frame_id))
+        self.image.publish(bgr_to_image(types, left, stamp, self.frame_id))
         self.published += 1
+
+    def _advertise(self, topic: str) -> Publisher:
+        return self.node.create_publisher(topic, "sensor_msgs/msg/Image", Qos(depth=2))
 
     def stop(self) -> None:
         self._stop.set()

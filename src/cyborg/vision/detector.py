@@ -1,6 +1,6 @@
 """The detector: an image in, labelled boxes out, with the time each stage took.
 
-    detector = Detector.open(Path("yolox_nano.onnx"))           # layout from the model
+    detector = Detector.open("yolox_nano")                      # a name, or a path
     detections = detector.detect(image)                         # BGR uint8, any size
     detector.confidence = 0.6                                   # changeable while running
 
@@ -26,6 +26,7 @@ from cyborg.vision.frames import VisionError, check_image
 from cyborg.vision.labels import COCO, label_of, read_labels
 from cyborg.vision.layouts import Candidates, Layout, decode, guess_layout, layout_named
 from cyborg.vision.letterbox import InputFormat, Letterbox, Preprocessor, to_image
+from cyborg.vision.models import find_model
 from cyborg.vision.suppression import greedy
 
 FORMATS = {Layout.YOLOX: InputFormat(rgb=False, scale=1.0, centred=False),
@@ -91,11 +92,19 @@ class Detector:
         self._decode(probe, 1.1)  # a wrong layout fails here, clearly
 
     @staticmethod
-    def open(model: Path, *, backend: str = "onnxruntime", family: str | None = None,
+    def open(model: str | Path, *, backend: str = "onnxruntime", family: str | None = None,
              weights: Path | None = None, labels: Path | None = None, threads: int = 0,
              input_size: int | None = None, confidence: float = 0.5, iou: float = 0.45,
              classes: frozenset[str] = frozenset()) -> Detector:
-        """A detector for a model file (``.onnx``, or a Darknet ``.cfg`` with ``weights``)."""
+        """A detector for a model (``.onnx``, or a Darknet ``.cfg`` with ``weights``).
+
+        ``model`` is found as ``cyborg detect --model`` finds it (:func:`~cyborg.vision.models.
+        find_model`): a name such as ``"yolox_nano"`` is looked for in ``$CYBORG_MODELS``,
+        the shared data's ``models/`` folder and the cache; a :class:`~pathlib.Path`, or a
+        string ending in ``.onnx``/``.cfg`` or holding a ``/``, is that file. The layout is
+        read from the model's output unless ``family`` names it.
+        """
+        model = find_model(model)
         names = read_labels(labels) if labels is not None else None
         runner: Backend
         if model.suffix == ".cfg":

@@ -3,8 +3,11 @@ image out.
 
 Subscribes to a colour image topic and, when given, a depth topic (``32FC1`` metres or
 ``16UC1`` millimetres) and/or a right-image topic for stereo depth; streams are paired by exact
-header stamp and unpaired messages are counted (:attr:`DetectorNode.dropped`). Publishes, in the
-node's namespace:
+header stamp and unpaired messages are counted (:attr:`DetectorNode.dropped`). Depth and right
+images are waited for only while their topic has a publisher in the bus graph: a camera without
+depth (a video file) is detected on the image alone, with distance NaN (unknown). Images that
+find no partner for 5 s are detected alone too, and the log says once which topic is silent
+(:mod:`~cyborg.vision.camera_inputs`). Publishes, in the node's namespace:
 
 ==================  ==================================  ========================================
 topic               type                                content
@@ -28,10 +31,11 @@ from collections.abc import Callable
 from typing import Any
 
 from cyborg.bus import Node, Qos
+from cyborg.bus.wire import EntityKind
+from cyborg.vision.camera_inputs import CameraInputs
 from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.frames import VisionError
 from cyborg.vision.image_messages import bgr_to_image, stamp_ns
-from cyborg.vision.pairing import ExactPairer
 from cyborg.vision.pipeline import DetectionPipeline, Result
 from cyborg.vision.predictions import detection_array_message, predictions_message
 
@@ -42,7 +46,10 @@ class DetectorNode:
     """Runs a :class:`DetectionPipeline` on a node, on frames from the bus."""
 
     def __init__(self, node: Node, pipeline: DetectionPipeline, topics: CameraTopics, *,
-                 now_ns: Callable[[], int] = time.time_ns) -> None:
+                 now_ns: Callable[[], int] = time.time_ns,
+                 clock: Callable[[], float] = time.monotonic, patience: float = 5.0) -> None:
+        """``now_ns`` stamps the predictions (wall or simulated time); ``clock`` (monotonic
+        seconds) times the ``patience`` granted to a depth publisher that yields no pair."""
         self.node, self.pipeline, self.topics = node, pipeline, topics
         self.now_ns = now_ns
         detector = pipeline.detector
@@ -66,16 +73,23 @@ class DetectorNode:
                                                 "vision_msgs/msg/Detection2DArray", Qos(depth=5))
         self.image = node.create_publisher("detection_image", "sensor_msgs/msg/Image",
                                            Qos(depth=1))
-        streams = topics.streams()
-        self.pairer = ExactPairer(streams, max_pending=10)
-        for stream in streams:
+        self.inputs = CameraInputs(topics, self.publishers, clock=clock, patience=patience,
+                                   name=node.fq_name)
+        for stream in topics.streams():
             topic = getattr(topics, stream)
             node.create_subscription(topic, "sensor_msgs/msg/Image",
                                      self._receiver(stream), Qos(depth=2))
 
     @property
     def dropped(self) -> int:
-        return self.pairer.dropped
+        """Messages that never became part of a frame (no partner with their stamp)."""
+        return self.inputs.dropped
+
+    def publishers(self, topic: str) -> list[str]:
+        """The nodes that publish ``topic`` now, from the bus graph."""
+        graph = self.node.context.graph
+        return sorted({entity.node_name
+                       for entity in graph.endpoints(topic, EntityKind.PUBLISHER)})
 
     def _check(self, changes: dict[str, Any]) -> None:
         labels = set(self.pipeline.detector.labels)
@@ -94,7 +108,7 @@ class DetectorNode:
 
     def _receiver(self, stream: str) -> Callable[[Any], None]:
         def receive(message: Any) -> None:
-            complete = self.pairer.add(stream, stamp_ns(message.header), message)
+            complete = self.inputs.add(stream, stamp_ns(message.header), message)
             if complete is not None:
                 self._on_frame(complete)
         return receive

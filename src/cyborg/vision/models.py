@@ -73,22 +73,34 @@ def cache_dir() -> Path:
     return Path(base) / "cyborg" / "models"
 
 
-def find_model(name_or_path: str) -> Path:
-    """The model file for a path or a model name; a clear error saying where it looked."""
-    path = Path(name_or_path).expanduser()
-    if path.suffix in (".onnx", ".cfg") or "/" in name_or_path:
+def find_model(name_or_path: str | os.PathLike[str]) -> Path:
+    """The model file for a path or a model name; a clear error saying where it looked.
+
+    The one resolver of the project: ``cyborg detect --model``, ``cyborg up --model``, the
+    detector launch kind and :meth:`Detector.open <cyborg.vision.detector.Detector.open>` all
+    go through it, so a model found by one is found by all. A :class:`~pathlib.Path`, or a
+    string ending in ``.onnx``/``.cfg`` or holding a ``/``, is a file (relative to the working
+    folder); any other string is a name looked for in :func:`model_dirs`::
+
+        find_model("yolox_nano")            # $CYBORG_MODELS, shared models/, the cache
+        find_model("exports/best.onnx")     # that file
+    """
+    text = os.fspath(name_or_path)
+    path = Path(text).expanduser()
+    if not isinstance(name_or_path, str) or path.suffix in (".onnx", ".cfg") or "/" in text:
         if not path.is_file():
             raise VisionError(f"model file {path}: not found")
         return path
+    name = text
     searched = model_dirs()
     for folder in searched:
-        for candidate in (folder / f"{name_or_path}.onnx", folder / name_or_path):
+        for candidate in (folder / f"{name}.onnx", folder / name):
             if candidate.is_file():
                 return candidate
-    hint = (f"; fetch it with `cyborg detect models fetch {name_or_path}`"
-            if name_or_path in CATALOGUE else
+    hint = (f"; fetch it with `cyborg detect models fetch {name}`"
+            if name in CATALOGUE else
             f"; known models: {', '.join(CATALOGUE)}, or give a path to an .onnx file")
-    raise VisionError(f"model {name_or_path!r} not found in "
+    raise VisionError(f"model {name!r} not found in "
                       f"{', '.join(str(folder) for folder in searched)}{hint}")
 
 
