@@ -117,3 +117,10 @@ def test_columbia_without_its_home_starts_free_near_the_centre(
     min_x, min_y, max_x, max_y = arnl_map.bounds()
     assert math.hypot(sim.pose.x - (min_x + max_x) / 2, sim.pose.y - (min_y + max_y) / 2) < 1.0
     assert "has no home or dock" in start_messages(caplog)[-1]
+
+
+def test_a_named_home_can_be_given_as_the_start(shared: Path) -> None:
+    triangle = read_map(shared / "maps" / "triangle.map")
+    sim = Simulator(triangle, start="Home")
+    assert sim.pose == Pose2D(5.09, 3.58, math.radians(54))
+    assert "RobotHome 'Home'" in sim.start_choice.reason

@@ -35,7 +35,8 @@ def add_parser(commands: Any) -> None:
     sim.add_argument("--speed", type=float, default=1.0, metavar="X",
                      help="simulated seconds per wall-clock second (0: as fast as possible)")
     sim.add_argument("--start", default=None, metavar="NAME",
-                     help="goal or dock to start at (default: the map's home, else its dock)")
+                     help="home, goal or dock to start at (default: the map's home, else "
+                          "its dock, else the free point nearest the map's centre)")
     sim.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
     sim.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                      help="join the router there instead of being one")

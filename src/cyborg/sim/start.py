@@ -48,14 +48,16 @@ def choose_start(arnl_map: ArnlMap, planner: Planner,
                  start: Pose2D | str | None = None) -> StartChoice:
     """Where to put the robot on ``arnl_map``; see the module docstring for the rules.
 
-    ``start`` is a pose, or the name of a goal or dock (KeyError listing the names if the map
-    has none of that name).
+    ``start`` is a pose, or the name of a home point, goal or dock (KeyError listing the
+    goals if the map has none of that name).
     """
     source = arnl_map.source
     if isinstance(start, Pose2D):
         return StartChoice(start, f"{source}: starting at the given pose {_where(start)}")
     if start is not None:
-        item = arnl_map.goal(start)
+        named_homes = [home for home in arnl_map.homes()
+                       if home.name == start and home.region is None]
+        item = named_homes[0] if named_homes else arnl_map.goal(start)
         pose = Pose2D(item.x, item.y, item.theta)
         return StartChoice(pose, f"{source}: starting at {item.kind} {item.name!r} "
                                  f"{_where(pose)}")
