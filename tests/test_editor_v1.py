@@ -241,3 +241,14 @@ def test_the_workdirs_node_definitions_fill_arg_defaults_and_shape_stubs(
     assert tree.by_uid["2"].properties == {"level": "warn", "message": "start"}
     assert tree.by_uid["3"].category.value == "condition"
     assert tree.tick().status is Status.FAILURE
+
+
+def test_tree_files_saved_with_a_byte_order_mark_load(tmp_path: Path, shared: Path) -> None:
+    exported = (shared / "trees" / "stock_nodes.tree.json").read_bytes()
+    with_bom = tmp_path / "bom.tree.json"
+    with_bom.write_bytes(b"\xef\xbb\xbf" + exported)
+    assert len(load_tree(with_bom)) == len(load_tree(shared / "trees" / "stock_nodes.tree.json"))
+    v1 = tmp_path / "bom_v1.json"
+    v1.write_bytes(b"\xef\xbb\xbf" + json.dumps({"name": "t", "root": _node(1, "JustSuccess")})
+                   .encode())
+    assert load_tree(v1).tick().status is Status.SUCCESS
