@@ -5,11 +5,13 @@ from __future__ import annotations
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import IO, Any
 
 import pytest
 
+from cyborg.bus import MessageTypes
 from tests.test_bus_multiprocess import free_port
 
 pytestmark = pytest.mark.heavy
@@ -21,25 +23,85 @@ def cyborg(*args: str, timeout: float = 20) -> subprocess.CompletedProcess[str]:
                           text=True, timeout=timeout)
 
 
-@pytest.fixture(scope="module")
-def endpoint() -> Iterator[str]:
+def first_line(stream: IO[str] | None, timeout: float) -> str:
+    """The next line of a child's output, or "" if none comes within ``timeout`` seconds."""
+    assert stream is not None
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.append(stream.readline()), daemon=True)
+    reader.start()
+    reader.join(timeout)
+    return lines[0] if lines else ""
+
+
+def rest(process: subprocess.Popen[str]) -> str:
+    """What a child that has ended wrote to stderr (for a failing assertion's message)."""
+    if process.poll() is None or process.stderr is None:
+        return "(still running)"
+    return process.stderr.read()
+
+
+def start_router() -> tuple[str, subprocess.Popen[str]]:
     address = f"tcp/127.0.0.1:{free_port()}"
     router = subprocess.Popen([sys.executable, "-m", "cyborg", "router", "--listen", address],
                               stdout=subprocess.PIPE, text=True)
-    assert router.stdout is not None
-    assert "listening on" in router.stdout.readline()
-    peers = [subprocess.Popen([sys.executable, str(PEER), role, address], text=True,
-                              stdin=subprocess.PIPE, stdout=subprocess.PIPE)
-             for role in ("params", "server", "talker")]
-    for peer in peers:
-        assert peer.stdout is not None and peer.stdout.readline().strip() == "ready"
+    assert "listening on" in first_line(router.stdout, 20)
+    return address, router
+
+
+def start_peer(role: str, address: str) -> subprocess.Popen[str]:
+    """A ``bus_peer.py`` process; it lives until its stdin closes (see :func:`stop`)."""
+    peer = subprocess.Popen([sys.executable, str(PEER), role, address], text=True,
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    assert first_line(peer.stdout, 20).strip() == "ready", f"peer {role} did not start"
+    return peer
+
+
+def stop(process: subprocess.Popen[str]) -> None:
+    if process.stdin is not None:
+        process.stdin.close()
+    else:
+        process.terminate()
+    try:
+        process.wait(10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        raise
+
+
+@pytest.fixture(scope="module")
+def endpoint() -> Iterator[str]:
+    address, router = start_router()
+    peers = [start_peer(role, address) for role in ("params", "server", "talker")]
     yield address
-    for peer in peers:
-        assert peer.stdin is not None
-        peer.stdin.close()
-        peer.wait(10)
-    router.terminate()
-    router.wait(10)
+    for process in [*peers, router]:
+        stop(process)
+
+
+@pytest.fixture
+def fresh_endpoint() -> Iterator[str]:
+    """A router of the test's own, for tests that need a topic or service to appear late."""
+    address, router = start_router()
+    yield address
+    stop(router)
+
+
+@pytest.fixture
+def peers() -> Iterator[Callable[[str, str], subprocess.Popen[str]]]:
+    """Start ``bus_peer.py`` roles during a test; they are stopped after it."""
+    started: list[subprocess.Popen[str]] = []
+
+    def start(role: str, address: str) -> subprocess.Popen[str]:
+        started.append(start_peer(role, address))
+        return started[-1]
+    yield start
+    for peer in started:
+        stop(peer)
+
+
+def background(*args: str) -> subprocess.Popen[str]:
+    """A ``cyborg`` command left running, its stdout and stderr piped."""
+    return subprocess.Popen([sys.executable, "-m", "cyborg", *args], text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
 def on(endpoint: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -109,8 +171,81 @@ def test_bad_input_is_named(endpoint: str) -> None:
     assert bad_yaml.returncode == 1 and "are not YAML" in bad_yaml.stderr
     bad_type = on(endpoint, "topic", "pub", "/x", "std_msgs/msg/Nope", "{}", "--once")
     assert bad_type.returncode == 1 and "unknown type 'std_msgs/msg/Nope'" in bad_type.stderr
-    unknown_topic = on(endpoint, "topic", "echo", "/nothing/here")
-    assert unknown_topic.returncode == 1 and "not in the graph" in unknown_topic.stderr
+    unknown_topic = on(endpoint, "topic", "echo", "/nothing/here", "--timeout", "1")
+    assert unknown_topic.returncode == 1
+    assert "waiting for a publisher of /nothing/here" in unknown_topic.stderr
+    assert "no publisher of /nothing/here appeared within 1 s" in unknown_topic.stderr
+    no_rate = on(endpoint, "topic", "hz", "/nothing/here", "--duration", "1")
+    assert no_rate.returncode == 1 and "appeared within 1 s" in no_rate.stderr
+    no_service = on(endpoint, "service", "call", "/nobody/add", "{a: 1}", "--timeout", "1")
+    assert no_service.returncode == 1
+    assert "waiting for service /nobody/add to become available" in no_service.stderr
+    assert "no server of /nobody/add appeared within 1 s" in no_service.stderr
+
+
+def test_echo_prints_the_latched_message_without_a_flag(endpoint: str, peers: Any) -> None:
+    peers("latched", endpoint)
+    for flags in ([], ["--latched"]):
+        echo = on(endpoint, "topic", "echo", "/robot/status", "--once", "--timeout", "10",
+                  *flags)
+        assert echo.returncode == 0, echo.stderr
+        assert echo.stdout == "data: latest\n---\n"
+
+
+def test_echo_waits_for_a_publisher_to_learn_the_type(endpoint: str) -> None:
+    echo = background("topic", "echo", "/late/battery", "--once", "--timeout", "20",
+                      "--connect", endpoint, "--wait", "0.5")
+    waiting = first_line(echo.stderr, 20)
+    assert "waiting for a publisher of /late/battery to learn its type" in waiting, rest(echo)
+    assert "cyborg topic echo /late/battery TYPE" in waiting
+    published = on(endpoint, "topic", "pub", "/late/battery", "sensor_msgs/msg/BatteryState",
+                   "{percentage: 0.5, power_supply_status: 2}", "--times", "30", "--rate", "10")
+    assert published.returncode == 0, published.stderr
+    out, err = echo.communicate(timeout=20)
+    assert echo.returncode == 0, err
+    fields = [line.split(":")[0] for line in out.splitlines() if not line.startswith(" ")]
+    battery = MessageTypes().store.fielddefs["sensor_msgs/msg/BatteryState"][1]
+    assert fields == [*(name for name, _ in battery), "---"]
+    assert "percentage: 0.5" in out and "power_supply_status: 2" in out
+    assert "POWER_SUPPLY" not in out  # the message's constants are not fields
+    assert "POWER_SUPPLY" not in published.stdout
+
+
+def test_a_late_latched_publisher_reaches_a_waiting_echo(fresh_endpoint: str,
+                                                          peers: Any) -> None:
+    echo = background("topic", "echo", "/robot/status", "--once", "--timeout", "20",
+                      "--connect", fresh_endpoint, "--wait", "0.5")
+    assert "waiting for a publisher" in first_line(echo.stderr, 20), rest(echo)
+    peers("latched", fresh_endpoint)
+    out, err = echo.communicate(timeout=20)
+    assert echo.returncode == 0, err
+    # "first" may arrive live (the peer publishes it as it starts), "latest" from history
+    assert out in ("data: first\n---\n", "data: latest\n---\n")
+
+
+def test_an_echo_given_the_type_hears_a_late_latched_publisher(fresh_endpoint: str,
+                                                                peers: Any) -> None:
+    echo = background("topic", "echo", "/robot/status", "std_msgs/msg/String", "--once",
+                      "--timeout", "20", "--connect", fresh_endpoint, "--wait", "0.5")
+    threading.Event().wait(3.0)  # it has subscribed by now, before any publisher
+    peers("latched", fresh_endpoint)
+    out, err = echo.communicate(timeout=20)
+    assert echo.returncode == 0, err
+    assert out in ("data: first\n---\n", "data: latest\n---\n")
+
+
+def test_service_call_waits_for_its_server(fresh_endpoint: str, peers: Any) -> None:
+    calls = [background("service", "call", "/robot/add", *typed, "{a: 2, b: 40}", "--timeout",
+                        "20", "--connect", fresh_endpoint, "--wait", "0.5")
+             for typed in ([], ["example_interfaces/srv/AddTwoInts"])]
+    for call in calls:
+        assert "waiting for service /robot/add to become available" in first_line(
+            call.stderr, 20), rest(call)
+    peers("server", fresh_endpoint)
+    for call in calls:
+        out, err = call.communicate(timeout=20)
+        assert call.returncode == 0, err
+        assert "sum: 42" in out
 
 
 def test_no_router_is_a_clear_error() -> None:

@@ -3,13 +3,15 @@
     cyborg router                          run a Zenoh router (the local meeting point)
     cyborg node list                       nodes alive now (ours and ROS 2 peers)
     cyborg topic list -t                   topics with their types
-    cyborg topic echo /robot/battery       print messages as YAML
+    cyborg topic echo /robot/battery       print messages as YAML (latched ones too)
     cyborg topic pub /chatter std_msgs/msg/String "{data: hi}" --once
     cyborg topic hz /camera/image
     cyborg service call /add example_interfaces/srv/AddTwoInts "{a: 2, b: 40}"
     cyborg param set /detector confidence_threshold 0.6
 
-Every command takes ``--connect ENDPOINT`` to reach another machine's router.
+Every command takes ``--connect ENDPOINT`` to reach another machine's router. Types and QoS
+come from the graph (:mod:`cyborg.app.bus_lookup`): ``echo`` and ``hz`` wait for a publisher of
+a topic not seen yet, ``service call`` for a server.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from typing import Any
 import yaml
 
 from cyborg.app.bt_commands import CommandError
+from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
 from cyborg.app.param_commands import add_param_parser
 from cyborg.bus import BusConfig, Context, MessageValueError, Node, Qos, new_message, to_plain
 from cyborg.bus.config import BusConfigError
@@ -52,11 +55,14 @@ def add_parser(commands: Any) -> None:
         "-t", "--show-types", action="store_true")
     echo = _command(topic, "echo", "print messages of a topic as YAML", topic_echo)
     echo.add_argument("topic")
-    echo.add_argument("type", nargs="?", help="message type (default: from the graph)")
+    echo.add_argument("type", nargs="?", help="message type (default: from the graph, waiting "
+                                              "for a publisher if need be)")
     echo.add_argument("--once", action="store_true", help="print one message and exit")
     echo.add_argument("--count", type=int, default=0, help="exit after this many messages")
     echo.add_argument("--timeout", type=float, default=0.0, help="give up after S seconds")
-    echo.add_argument("--latched", action="store_true", help="also get the latched message")
+    echo.add_argument("--latched", action="store_true",
+                      help="ask for latched messages even if no publisher says it keeps them "
+                           "(automatic when one does)")
     echo.add_argument("--full", action="store_true", help="print long arrays in full")
     pub = _command(topic, "pub", "publish a message given as YAML", topic_pub)
     pub.add_argument("topic")
@@ -68,7 +74,7 @@ def add_parser(commands: Any) -> None:
     pub.add_argument("--latched", action="store_true", help="latched (transient local)")
     hz = _command(topic, "hz", "print the rate of a topic", topic_hz)
     hz.add_argument("topic")
-    hz.add_argument("type", nargs="?")
+    hz.add_argument("type", nargs="?", help="message type (default: from the graph)")
     hz.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
 
     service = _group(commands, "service", "services on the bus")
@@ -79,7 +85,8 @@ def add_parser(commands: Any) -> None:
     call.add_argument("name")
     call.add_argument("type", nargs="?", help="service type (default: from the graph)")
     call.add_argument("values", nargs="?", default="{}")
-    call.add_argument("--timeout", type=float, default=5.0)
+    call.add_argument("--timeout", type=float, default=5.0,
+                      help="seconds to wait for a server, then for the reply (default 5)")
 
     add_param_parser(_group(commands, "param", "parameters of a node"), _command)
 
@@ -179,23 +186,6 @@ def _print_names(found: dict[str, set[str]], show_types: bool) -> None:
         print(f"{name} [{', '.join(sorted(type_names))}]" if show_types else name)
 
 
-def _absolute(name: str) -> str:
-    return name if name.startswith("/") else "/" + name
-
-
-def _type_from_graph(context: Context, name: str, found: dict[str, set[str]], what: str) -> str:
-    types = found.get(_absolute(name), set())
-    if len(types) != 1:
-        known = ", ".join(sorted(found)) or "none"
-        raise CommandError(f"{what} {name}: " + (
-            f"several types ({', '.join(sorted(types))}); give one" if types else
-            f"not in the graph; give its type (known {what}s: {known})"))
-    type_name = next(iter(types))
-    if type_name not in context.types:
-        raise CommandError(f"{what} {name}: type {type_name} is not registered here")
-    return type_name
-
-
 def _parse_values(text: str) -> dict[str, Any]:
     try:
         data = yaml.safe_load(text) if text.strip() else {}
@@ -228,10 +218,13 @@ def _shorten(data: Any, full: bool) -> Any:
 
 
 def topic_echo(args: argparse.Namespace) -> int:
+    """Print a topic's messages; the type and the durability to ask for come from the graph."""
     limit = 1 if args.once else args.count
     with open_context(args) as context:
-        type_name = args.type or _type_from_graph(context, args.topic, context.graph.topics(),
-                                                  "topic")
+        started = time.monotonic()
+        type_name = args.type or topic_type(context.graph, context.types, args.topic,
+                                            command="cyborg topic echo",
+                                            timeout=args.timeout or None)
         done = threading.Event()
         seen = [0]
 
@@ -247,8 +240,9 @@ def topic_echo(args: argparse.Namespace) -> int:
 
         node = Node("cyborg_topic_echo", context=context)
         node.create_subscription(args.topic, type_name, show,
-                                 Qos.latched() if args.latched else Qos(depth=100))
-        finished = done.wait(args.timeout or None)
+                                 echo_qos(context.graph, args.topic, latched=args.latched))
+        left = args.timeout - (time.monotonic() - started)
+        finished = done.wait(max(left, 0.0) if args.timeout else None)
         if args.timeout and not finished:
             raise CommandError(f"{args.topic}: {seen[0]} message(s) within {args.timeout:g} s")
     return 0
@@ -278,13 +272,14 @@ def topic_pub(args: argparse.Namespace) -> int:
 
 def topic_hz(args: argparse.Namespace) -> int:
     with open_context(args) as context:
-        type_name = args.type or _type_from_graph(context, args.topic, context.graph.topics(),
-                                                  "topic")
+        started = time.monotonic()
+        type_name = args.type or topic_type(context.graph, context.types, args.topic,
+                                            command="cyborg topic hz",
+                                            timeout=args.duration or None)
         arrivals: list[float] = []
         node = Node("cyborg_topic_hz", context=context)
         node.create_subscription(args.topic, type_name,
                                  lambda _m: arrivals.append(time.monotonic()), Qos(depth=1000))
-        started = time.monotonic()
         while not args.duration or time.monotonic() - started < args.duration:
             time.sleep(1.0)
             window = arrivals[-1000:]
@@ -303,11 +298,11 @@ def service_call(args: argparse.Namespace) -> int:
     if args.type and args.type.lstrip().startswith("{"):  # NAME VALUES, type from the graph
         args.type, args.values = None, args.type
     with open_context(args) as context:
-        type_name = args.type or _type_from_graph(context, args.name,
-                                                  context.graph.services(), "service")
-        if type_name not in context.types.services:
-            raise CommandError(f"unknown service type {type_name!r}")
-        request = _message(context, f"{type_name}_Request", args.values)
+        if args.type:  # a wrong type or wrong values are reported before any waiting
+            _request(context, args.type, args.values)
+        type_name = service_type(context.graph, context.types, args.name, args.type,
+                                 timeout=args.timeout)
+        request = _request(context, type_name, args.values)
         node = Node("cyborg_service_call", context=context)
         client = node.create_client(args.name, type_name)
         print(f"requester: making request: {to_plain(request)}\n")
@@ -318,3 +313,9 @@ def service_call(args: argparse.Namespace) -> int:
         print("response:")
         print(yaml.safe_dump(to_plain(response), sort_keys=False), end="")
     return 0
+
+
+def _request(context: Context, service: str, text: str) -> Any:
+    if service not in context.types.services:
+        raise CommandError(f"unknown service type {service!r}")
+    return _message(context, f"{service}_Request", text)

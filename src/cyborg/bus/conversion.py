@@ -5,10 +5,13 @@
 
 Fields left out get their zero value, as in ROS. A field the type does not have, or a value of
 the wrong kind, raises :class:`MessageValueError` naming the field path (``linear.x``).
+Constants of a type (``BatteryState.POWER_SUPPLY_STATUS_FULL``) are not fields: ``to_plain``
+leaves them out, as ``ros2 topic echo`` does.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -29,15 +32,28 @@ class MessageValueError(ValueError):
 
 
 def to_plain(message: Any) -> Any:
-    """A message as nested dicts and lists (numpy arrays become lists)."""
+    """A message as nested dicts and lists (numpy arrays become lists), fields only."""
     if isinstance(message, np.ndarray):
         return message.tolist()
     if isinstance(message, list):
         return [to_plain(item) for item in message]
-    if hasattr(message, "__dataclass_fields__"):
-        return {name: to_plain(getattr(message, name))
-                for name in message.__dataclass_fields__ if name != "__msgtype__"}
+    if dataclasses.is_dataclass(message) and not isinstance(message, type):
+        return {name: to_plain(getattr(message, name)) for name in message_fields(type(message))}
     return message
+
+
+def message_fields(message_class: type) -> list[str]:
+    """The names of a message class's fields, in order, without its constants.
+
+    rosbags writes each constant (and ``__msgtype__``) as ``NAME: ClassVar[int] = 1`` in a
+    module whose annotations stay strings, and :mod:`dataclasses` only recognises a string
+    ``ClassVar`` when ``typing`` is imported there under that name. So the constants come back
+    from :func:`dataclasses.fields` as ordinary fields with defaults. A real field of a message
+    is never a ``ClassVar``, which is how they are told apart here.
+    """
+    return [field.name for field in dataclasses.fields(message_class)
+            if not (isinstance(field.type, str)
+                    and field.type.startswith(("ClassVar", "typing.ClassVar")))]
 
 
 def new_message(types: MessageTypes, type_name: str, data: dict[str, Any] | None = None,
