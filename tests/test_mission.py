@@ -14,11 +14,16 @@ from pathlib import Path
 
 import pytest
 
-from cyborg.bt import SUCCESS
+from cyborg.app.cli import build_parser
+from cyborg.app.launch import Launch
+from cyborg.app.launchables import RunningSimulator, RunningTree
+from cyborg.app.up import CAMPUS_TREE, DATA, up_description, up_notes
+from cyborg.bt import SUCCESS, load_tree
 from cyborg.bt.snapshot import TickSnapshot
+from cyborg.bus import BusConfig, Context
 from cyborg.bus.actions import ActionServer, GoalStatus
 from cyborg.sim.simulator import Simulator
-from tests.system import running_system
+from tests.system import running_system, wait_until
 
 HOURS = 13.0
 PATROL = ["room1", "room2", "Outside", "room4"]
@@ -100,3 +105,61 @@ def test_patrol_and_recharge_over_a_full_battery_cycle(shared: Path) -> None:
     assert any(goal.status is GoalStatus.CANCELED for goal in goals)
     # no goal left behind: every goal ended except the one being driven now
     assert sum(not goal.status.terminal for goal in goals) <= 1
+
+
+# ---------------------------------------------------------------------------------- cyborg up
+RECHARGE_WITHIN = 120.0
+"""Wall-clock seconds in which `cyborg up`, on its defaults, shows the recharge (README)."""
+
+
+def _bundled_threshold() -> float:
+    tree = load_tree(Path(str(DATA.joinpath(CAMPUS_TREE))))
+    (guard,) = [node for node in tree if node.name == "CheckBattery"]
+    return float(guard.threshold)  # type: ignore[attr-defined]
+
+
+def test_cyborg_up_starts_just_above_the_recharge_threshold_and_says_so() -> None:
+    args = build_parser().parse_args(["up", "--no-detector"])
+    sim = next(spec for spec in up_description(args).nodes if spec.kind == "simulator")
+    threshold = _bundled_threshold()
+    assert threshold < sim.parameters["battery"] <= threshold + 5, "a recharge soon"
+    assert sim.parameters["speed"] > 1, "faster than real time"
+    notes = "\n".join(up_notes(args))
+    assert f"{sim.parameters['speed']:g}x real time (--speed)" in notes
+    assert f"battery at {sim.parameters['battery']:g} % (--battery)" in notes
+    assert f"below {threshold:g} %" in notes
+    assert all(len(f"  {line}") < 80 for line in notes.splitlines()), "as printed"
+    own = build_parser().parse_args(["up", "--speed", "1", "--battery", "100"])
+    assert "recharge" not in "\n".join(up_notes(own)), "no promise the user's choice breaks"
+
+
+@pytest.mark.heavy
+def test_cyborg_up_on_its_defaults_shows_a_recharge_within_two_minutes() -> None:
+    """What `cyborg up` starts, at its default pace and charge (the monitor and camera left
+    out): the patrol runs, the battery falls below the threshold, the robot docks and charges,
+    all within the wall-clock time the README promises."""
+    args = build_parser().parse_args(["up", "--no-monitor", "--no-detector"])
+    seen: list[str] = []
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(up_description(args), context)
+        started = time.monotonic()
+        launch.start()
+        try:
+            sim = next(item for item in launch.running
+                       if isinstance(item, RunningSimulator)).loop.simulator
+            runner = next(item for item in launch.running if isinstance(item, RunningTree))
+            labels = {node.uid: node.label for node in runner.runner.tree}
+            runner.runner.runner.add_listener(lambda snapshot: seen.extend(
+                labels[uid] for uid in snapshot.active[-1:]))
+            wait_until(lambda: "Charge to 90%" in seen,
+                       timeout=RECHARGE_WITHIN - (time.monotonic() - started),
+                       what="the recharge to start")
+            low = sim.battery.charge_percent
+            wait_until(lambda: sim.battery.charging and sim.battery.charge_percent > low + 0.1,
+                       timeout=max(RECHARGE_WITHIN - (time.monotonic() - started), 1.0),
+                       what="the battery to charge")
+        finally:
+            launch.stop()
+    assert low < _bundled_threshold()
+    patrol = seen[:seen.index("MoveTo Charger")]
+    assert {"MoveTo Lecture hall", "MoveTo Library"} <= set(patrol), "the patrol came first"

@@ -244,7 +244,10 @@ def models_command(args: argparse.Namespace) -> int:
         raise CommandError(f"unknown model {name!r}; known: {', '.join(CATALOGUE)}")
     model = CATALOGUE[name]
     progress = ProgressBar(sys.stderr, model.size, unit="bytes")
-    path = fetch(model, args.dir or cache_dir(), url=args.url,
-                 progress=lambda done, total: progress.update(done))
+    try:
+        path = fetch(model, args.dir or cache_dir(), url=args.url,
+                     progress=lambda done, total: progress.update(done))
+    finally:
+        progress.finish()
     print(f"{name}: {path} (sha256 {model.sha256[:12]}... verified)")
     return 0

@@ -21,13 +21,23 @@ A launch file is TOML (or YAML with the same keys)::
 
 ``cyborg launch FILE`` checks the whole file first (every problem names the file and the
 node), then starts the ``main`` process's nodes here and each other process as a child
-``cyborg launch FILE --process NAME`` that joins this one's bus. Ctrl-C (or SIGTERM) stops
-every node and every child cleanly. Relative paths are relative to the launch file.
+``cyborg launch FILE --process NAME`` that joins this one's bus. Relative paths are relative to
+the launch file.
+
+Ctrl-C (or SIGTERM) stops every node and every child cleanly, in this order (see
+:meth:`Launch.stop`): the tree runners first, so each halts its tree and a running MoveTo
+cancels its goal while the robot's nodes are still there to hear it; then the process's other
+nodes, last started first; then the child processes, last started first, each one gone before
+the next is asked. A terminal's Ctrl-C reaches every process of the job at once, so children
+ignore SIGINT and wait for their parent's SIGTERM; a child whose parent dies stops by itself.
+With ``-v`` each step is logged (``stopping tree runner /cyborg/bt/tree_runner``), by children
+too: they run with their parent's verbosity.
 """
 
 from __future__ import annotations
 
 import faulthandler
+import logging
 import os
 import signal
 import subprocess
@@ -41,8 +51,10 @@ from typing import Any
 
 import yaml
 
-from cyborg.app.launchables import LaunchError, NodeSpec, Running, starter_for
+from cyborg.app.launchables import LaunchError, NodeSpec, Running, RunningTree, starter_for
 from cyborg.bus import Context
+
+log = logging.getLogger("cyborg.app")
 
 NODE_KEYS = {"kind", "name", "namespace", "process", "parameters"}
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
@@ -147,8 +159,8 @@ class Launch:
             self.stop()
             raise
         for name in children or []:
-            command = [sys.executable, "-m", "cyborg", "launch", self.description.source,
-                       "--process", name, "--connect", connect]
+            command = [sys.executable, "-m", "cyborg", *_verbosity(), "launch",
+                       self.description.source, "--process", name, "--connect", connect]
             self.children.append((name, subprocess.Popen(command)))
 
     def describe(self) -> list[str]:
@@ -157,8 +169,9 @@ class Launch:
                   for name, child in self.children]
         return lines
 
-    def wait(self, duration: float | None = None) -> int:
-        """Wait for Ctrl-C / SIGTERM (or ``duration`` seconds, or a child dying)."""
+    def wait(self, duration: float | None = None, *, parent: int | None = None) -> int:
+        """Wait for Ctrl-C / SIGTERM (or ``duration`` seconds, or a child dying, or, for a
+        child, its ``parent`` process ending: a launch killed outright leaves no orphans)."""
         previous = signal.signal(signal.SIGTERM, _interrupt)
         started = time.monotonic()
         try:
@@ -168,6 +181,10 @@ class Launch:
                         print(f"cyborg launch: process {name} ended with code "
                               f"{child.returncode}", file=sys.stderr)
                         return 1
+                if parent is not None and os.getppid() != parent:
+                    print(f"cyborg launch: the launch that started this process (pid {parent}) "
+                          "has ended", file=sys.stderr)
+                    return 1
                 time.sleep(0.2)
         except KeyboardInterrupt:
             return 130
@@ -176,22 +193,39 @@ class Launch:
         return 0
 
     def stop(self) -> None:
-        """Stop children (SIGINT, then SIGKILL after 5 s) and this process's nodes;
-        :attr:`stopping` says which part is stopping now."""
-        self.stopping = "child processes"
-        for _name, child in self.children:
+        """Stop what this launch started, each part while the parts it needs are still there.
+
+        1. Tree runners, last started first. Each halts its tree: a running MoveTo cancels its
+           goal and the runner waits (up to 5 s) until the robot has confirmed, so the robot
+           stops and no "cancel failed" is reported, wherever the robot's nodes run.
+        2. This process's other nodes, last started first (the detector before its camera,
+           the simulator before the monitor that watched it).
+        3. Child processes, last started first: SIGTERM, then SIGKILL if one is still there
+           after 5 s; each is gone before the next is asked, and stops its own nodes the same
+           way.
+
+        :attr:`stopping` says which part is stopping now (for :func:`end_if_stuck`); with
+        ``-v`` each step is logged."""
+        trees = [item for item in self.running if isinstance(item, RunningTree)]
+        others = [item for item in self.running if not isinstance(item, RunningTree)]
+        for item in [*reversed(trees), *reversed(others)]:
+            self._step(" ".join(item.describe().split(":", 1)[0].split()))
+            item.stop()
+        self.running.clear()
+        for name, child in reversed(self.children):
+            self._step(f"process {name} (pid {child.pid})")
             if child.poll() is None:
-                child.send_signal(signal.SIGINT)
-        for _name, child in self.children:
+                child.send_signal(signal.SIGTERM)
             try:
                 child.wait(5.0)
             except subprocess.TimeoutExpired:
                 child.kill()
-        for item in reversed(self.running):
-            self.stopping = item.describe()
-            item.stop()
+                child.wait()
         self.stopping = "the bus and the interpreter's exit"
-        self.running.clear()
+
+    def _step(self, part: str) -> None:
+        self.stopping = part
+        log.info("stopping %s", part)
 
 
 STOP_DEADLINE = 20.0
@@ -213,3 +247,17 @@ def end_if_stuck(launch: Launch, deadline: float = STOP_DEADLINE) -> None:
 
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
+
+
+def as_child() -> None:
+    """Signals for a launch's child process: SIGTERM (its parent's stop) interrupts it; SIGINT
+    is ignored, since a terminal's Ctrl-C reaches the whole job and the parent stops its
+    children only once its own tree runners have halted."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _interrupt)
+
+
+def _verbosity() -> list[str]:
+    """``-v`` / ``-vv`` for a child process, after this process's log level."""
+    level = logging.getLogger().getEffectiveLevel()
+    return ["-vv"] if level <= logging.DEBUG else ["-v"] if level <= logging.INFO else []

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import importlib
 import math
+import time
 from pathlib import Path
 from typing import Any
 
@@ -36,11 +37,11 @@ from cyborg.app.vision_launchables import start_camera, start_detector
 from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
 
 __all__ = ["KINDS", "LaunchError", "NodeSpec", "Running", "RunningMonitor", "RunningSimulator",
-           "RunningTree", "Starter", "starter_for"]
+           "RunningTree", "SettlingRobot", "Starter", "starter_for"]
 from cyborg.bus import Context, Node, SimClock
 from cyborg.monitor import DEFAULT_PORT, Monitor, MonitorError
 from cyborg.nav.arnl_map import MapError, read_map
-from cyborg.nodes.bus_robot import BusRobot
+from cyborg.nodes.bus_robot import BusMove, BusRobot
 from cyborg.nodes.tree_runner import TreeRunnerNode
 from cyborg.sim.battery import Battery
 from cyborg.sim.node import SimulatorNode
@@ -102,9 +103,37 @@ def start_simulator(context: Context, spec: NodeSpec) -> RunningSimulator:
 
 
 # ---------------------------------------------------------------------------------- tree runner
+class SettlingRobot(BusRobot):
+    """The tree runner's robot, which remembers the moves it started.
+
+    Halting a MoveTo only *sends* the cancel (the tick must not block), so a runner that
+    destroyed its bus nodes right after halting would withdraw the cancel's client before the
+    robot answered, and the robot would drive on. :meth:`settle` waits until every move has
+    ended: stopping a tree runner calls it between the halt and the nodes' end."""
+
+    def __init__(self, node: Node, namespace: str) -> None:
+        super().__init__(node, namespace)
+        self._moves: list[BusMove] = []
+
+    def move_to(self, goal: str) -> BusMove:
+        move = super().move_to(goal)
+        self._moves = [*(earlier for earlier in self._moves if not earlier.done), move]
+        return move
+
+    def settle(self, timeout: float = 5.0) -> bool:
+        """Wait (wall time, at most ``timeout``) until every move has ended; True if all did."""
+        deadline = time.monotonic() + timeout
+        while any(not move.done for move in self._moves):
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.01)
+        return True
+
+
 class RunningTree:
-    def __init__(self, runner: TreeRunnerNode, robot_node: Node) -> None:
-        self.runner, self.robot_node = runner, robot_node
+    def __init__(self, runner: TreeRunnerNode, robot_node: Node,
+                 robot: SettlingRobot | None = None) -> None:
+        self.runner, self.robot_node, self.robot = runner, robot_node, robot
 
     def describe(self) -> str:
         tree, node = self.runner.tree, self.runner.node
@@ -116,7 +145,11 @@ class RunningTree:
                 f"{node.namespace}/enable")
 
     def stop(self) -> None:
+        """Halt the tree (a running MoveTo cancels its goal), wait until the robot has ended
+        the goals, then leave the bus."""
         self.runner.stop()
+        if self.robot is not None:
+            self.robot.settle()
         self.runner.destroy()
         self.robot_node.destroy()
 
@@ -145,7 +178,7 @@ def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
             raise spec.error(str(exc)) from exc
         clock: Clock = SimClock(node) if sim_time else MonotonicClock()
         robot_node = Node(f"{spec.name}_robot", spec.namespace, context=context)
-        robot = BusRobot(robot_node, str(robot_ns))
+        robot = SettlingRobot(robot_node, str(robot_ns))
         try:
             runner = TreeRunnerNode(node, spec.path(str(tree_file)), tree=choice or None,
                                     rate_hz=float(rate), clock=clock, robot=robot,
@@ -159,7 +192,7 @@ def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
         if robot_node is not None:
             robot_node.destroy()
         raise
-    return RunningTree(runner, robot_node)
+    return RunningTree(runner, robot_node, robot)
 
 
 # ---------------------------------------------------------------------------------- monitor

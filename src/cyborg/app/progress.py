@@ -1,43 +1,90 @@
 """A progress bar for long offline runs, drawn on stderr when it is a terminal.
 
-``[#########...........]  45/100 frames  61.2 FPS  0:01 left`` is redrawn in place at most ten
-times a second; into a pipe or file one line is written every ten seconds instead.
+``[##########..........]  45/100 frames  61.2 FPS  0:01 left  3 objects`` for a video,
+``[####................]  1.2/3.8 MB  850.3 kB/s  0:03 left`` for a download: the unit is what
+is counted, and sizes are written in B, kB, MB or GB (powers of 1000, as the download's
+``Content-Length`` is). The line is redrawn in place at most ten times a second and always
+fits the terminal (less its last column, so it never wraps): when it is narrow, the extra
+text goes first, then the time left, then the rate, then the bar; the count stays. Into a pipe
+or file one line is written every ten seconds instead.
 """
 
 from __future__ import annotations
 
 import shutil
 import time
-from typing import TextIO
+from typing import Literal, TextIO
+
+Unit = Literal["frames", "bytes"]
+
+BAR_WIDTH = (10, 40)
+"""Narrowest and widest bar, in columns; narrower than this, no bar is drawn."""
+
+
+def terminal_width() -> int:
+    """Columns a line may use: the terminal's (``$COLUMNS`` first, else 80) less the last one,
+    where a character would make some terminals wrap."""
+    return shutil.get_terminal_size((80, 24)).columns - 1
+
+
+def size(count: float, unit: str | None = None) -> str:
+    """``512 B``, ``2.0 kB``, ``3.8 MB``; with ``unit`` (``"MB"``), in that unit."""
+    units = {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9}
+    if unit is None:
+        unit = next((name for name, scale in reversed(units.items()) if count >= scale), "B")
+    value = count / units[unit]
+    return f"{value:.0f} {unit}" if unit == "B" else f"{value:.1f} {unit}"
+
+
+def duration(seconds: float) -> str:
+    """``0:07``, ``12:30``, ``1:02:03``."""
+    whole = int(seconds)
+    hours, minutes, secs = whole // 3600, whole // 60 % 60, whole % 60
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
 
 
 class ProgressBar:
-    def __init__(self, stream: TextIO, total: int | None, unit: str = "frames") -> None:
+    def __init__(self, stream: TextIO, total: int | None, unit: Unit = "frames") -> None:
         self.stream, self.total, self.unit = stream, total, unit
         self.live = stream.isatty()
         self.started = time.monotonic()
         self._drawn = 0.0
+        self._updated = False
         self.done = 0
 
-    def text(self, extra: str = "") -> str:
+    def _count(self) -> str:
+        if self.unit == "bytes":
+            if not self.total:
+                return size(self.done)
+            total, unit = size(self.total).split()
+            return f"{size(self.done, unit).split()[0]}/{total} {unit}"  # 1.2/3.8 MB
+        count = f"{self.done}/{self.total}" if self.total else f"{self.done}"
+        return f"{count} frames"
+
+    def _rate(self, rate: float) -> str:
+        return f"{size(rate)}/s" if self.unit == "bytes" else f"{rate:.1f} FPS"
+
+    def text(self, extra: str = "", width: int | None = None) -> str:
+        """The line as it is drawn now, at most ``width`` columns (default: the terminal's)."""
+        width = terminal_width() if width is None else width
         elapsed = max(time.monotonic() - self.started, 1e-9)
         rate = self.done / elapsed
-        count = f"{self.done}/{self.total}" if self.total else f"{self.done}"
-        parts = [f"{count} {self.unit}", f"{rate:.1f} FPS"]
+        parts = [self._count(), self._rate(rate)]
         if self.total and rate > 0:
-            left = max(self.total - self.done, 0) / rate
-            parts.append(f"{int(left // 60)}:{int(left % 60):02d} left")
+            parts.append(f"{duration(max(self.total - self.done, 0) / rate)} left")
         if extra:
             parts.append(extra)
-        line = "  ".join(parts)
-        if self.total:
-            width = max(10, min(40, shutil.get_terminal_size().columns - len(line) - 4))
-            filled = int(width * min(self.done / self.total, 1.0))
-            line = f"[{'#' * filled}{'.' * (width - filled)}]  {line}"
+        while len(parts) > 1 and len("  ".join(parts)) > width:
+            parts.pop()  # the least telling part goes first
+        line = "  ".join(parts)[:width]
+        bar = min(BAR_WIDTH[1], width - len(line) - 4)  # "[" bar "]  " line
+        if self.total and bar >= BAR_WIDTH[0]:
+            filled = int(bar * min(self.done / self.total, 1.0))
+            line = f"[{'#' * filled}{'.' * (bar - filled)}]  {line}"
         return line
 
     def update(self, done: int, extra: str = "") -> None:
-        self.done = done
+        self.done, self._updated = done, True
         now = time.monotonic()
         interval = 0.1 if self.live else 10.0
         if now - self._drawn < interval:
@@ -53,6 +100,9 @@ class ProgressBar:
         self.stream.flush()
 
     def finish(self, extra: str = "") -> None:
+        """Draw the last state and end the line; nothing if there was never an update."""
+        if not self._updated:
+            return
         self._write(extra)
         if self.live:
             self.stream.write("\n")

@@ -1,17 +1,49 @@
 """A one-line live view of a running tree: tick count, root status and active path.
 
-On a terminal the line is redrawn in place (at most 10 times a second). Into a pipe or file a
-new line is written only when the root status or the active path changes, so logs stay short.
+On a terminal the line is redrawn in place (at most 10 times a second) and always fits it
+(:func:`fit_status`): the tick and the root status stay, and a long active path is shortened
+from the middle, keeping the root and the nodes running now. Into a pipe or file a new line,
+in full, is written only when the root status or the active path changes, so logs stay short.
 """
 
 from __future__ import annotations
 
-import shutil
 import time
+from collections.abc import Sequence
 from typing import TextIO
 
+from cyborg.app.progress import terminal_width
 from cyborg.bt import Status, Tree
 from cyborg.bt.snapshot import TickSnapshot
+
+SEPARATOR, ELLIPSIS = " > ", "…"
+
+
+def fit_status(tick: int, status: Status, labels: Sequence[str], width: int) -> str:
+    """``tick     42  RUNNING  Root tree > … > Patrol > MoveTo room1`` in at most ``width``
+    columns. The tick number and the status are always there (with single spaces when the
+    line is very narrow); the active path (root first) takes what room is left."""
+    head = f"tick {tick:>6}  {status.name:<7}"
+    if len(head) + 2 > width:
+        head = f"tick {tick} {status.name}"
+    room = width - len(head) - 2
+    path = fit_path(labels, room) if labels else "-"
+    return f"{head}  {path}" if path and room > 0 else head[:width]
+
+
+def fit_path(labels: Sequence[str], room: int) -> str:
+    """The active path in at most ``room`` columns, the first of these that fits: all of it;
+    the root, ``…`` and the deepest nodes (the one running now last); ``…`` and the deepest
+    nodes; the deepest node cut short. Whole labels are dropped, never halves of them."""
+    full = SEPARATOR.join(labels)
+    if len(full) <= room:
+        return full
+    for head, first in (([labels[0]], 2), ([], 1)):
+        for start in range(first, len(labels)):
+            text = SEPARATOR.join([*head, ELLIPSIS, *labels[start:]])
+            if len(text) <= room:
+                return text
+    return labels[-1][:room - 1] + ELLIPSIS if room > 0 else ""
 
 
 class StatusLine:
@@ -24,10 +56,13 @@ class StatusLine:
         self._last_key: tuple[Status, tuple[str, ...]] | None = None
         self._last: TickSnapshot | None = None
 
-    def text(self, snapshot: TickSnapshot) -> str:
-        """``tick 42  RUNNING  Root tree > Priority > Patrol tree > MoveTo room1``."""
+    def text(self, snapshot: TickSnapshot, width: int | None = None) -> str:
+        """``tick     42  RUNNING  Root tree > Priority > Patrol tree > MoveTo room1``; with
+        ``width``, fitted into that many columns (:func:`fit_status`)."""
         labels = [self.tree.by_uid[uid].label for uid in snapshot.active]
-        path = " > ".join(labels) if labels else "-"
+        if width is not None:
+            return fit_status(snapshot.tick, snapshot.status, labels, width)
+        path = SEPARATOR.join(labels) if labels else "-"
         return f"tick {snapshot.tick:>6}  {snapshot.status.name:<7}  {path}"
 
     def update(self, snapshot: TickSnapshot) -> None:
@@ -44,11 +79,8 @@ class StatusLine:
             print(self.text(snapshot), file=self.stream, flush=True)
 
     def _draw(self, snapshot: TickSnapshot) -> None:
-        width = shutil.get_terminal_size().columns - 1
-        text = self.text(snapshot)
-        if len(text) > width:
-            text = "…" + text[-(width - 1):]
-        self.stream.write("\r" + text.ljust(width))
+        width = terminal_width()
+        self.stream.write("\r" + self.text(snapshot, width).ljust(width))
         self.stream.flush()
 
     def finish(self, *, interrupted: bool = False) -> None:

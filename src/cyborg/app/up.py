@@ -9,20 +9,28 @@ sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``-
 ``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. It prints what runs
 and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
 
+The defaults are chosen to *show* the mission, not to mimic a day of it: the battery drains
+about 9 % an hour and charging to 90 % takes two hours, so at real time from a full battery the
+first recharge would come after seven hours. ``cyborg up`` therefore simulates at 30x real time
+from a 33 % charge, just above the bundled tree's 30 % threshold: the robot patrols for about
+forty seconds, drives to the charger, charges for about four minutes and patrols again. Its
+first lines say so, and how to choose otherwise (``--speed 1 --battery 100``).
+
 ``cyborg launch FILE`` starts what a launch description lists (see :mod:`cyborg.app.launch`).
 """
 
 from __future__ import annotations
 
 import argparse
-import signal
+import os
 import sys
+from collections.abc import Sequence
 from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
 from cyborg.app.bt_commands import CommandError
-from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck, read_launch
+from cyborg.app.launch import Launch, LaunchDescription, as_child, end_if_stuck, read_launch
 from cyborg.app.launchables import LaunchError, NodeSpec, RunningTree
 from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
 from cyborg.app.status_line import StatusLine
@@ -31,6 +39,12 @@ from cyborg.app.up_vision import add_vision_options, vision_nodes
 DATA = files("cyborg.app").joinpath("data")
 CAMPUS_MAP = "campus.map"
 CAMPUS_TREE = "campus_patrol.b3.json"
+CAMPUS_THRESHOLD = 30.0
+"""The bundled tree's CheckBattery threshold, percent: below it the robot goes to recharge."""
+DEFAULT_SPEED = 30.0
+"""Simulated seconds per wall-clock second: a patrol round in ~6 s, a full charge in ~4 min."""
+DEFAULT_BATTERY = 33.0
+"""Start charge, percent: about 20 simulated minutes of patrol above the threshold."""
 
 
 def add_parser(commands: Any) -> None:
@@ -42,12 +56,15 @@ def add_parser(commands: Any) -> None:
                     help="ARNL .map file (default: the bundled campus)")
     up.add_argument("--tree", type=Path, default=None, metavar="FILE",
                     help="behavior3editor export to run (default: the bundled patrol)")
-    up.add_argument("--speed", type=float, default=1.0, metavar="X",
-                    help="simulated seconds per wall-clock second (0: as fast as possible)")
+    up.add_argument("--speed", type=float, default=DEFAULT_SPEED, metavar="X",
+                    help=f"simulated seconds per wall-clock second (default {DEFAULT_SPEED:g}, "
+                         "so a recharge shows within a minute; 1: real time; 0: as fast as "
+                         "possible)")
     up.add_argument("--start", default=None, metavar="NAME",
                     help="goal or dock to start at (default: the map's home, else its dock)")
-    up.add_argument("--battery", type=float, default=100.0, metavar="PERCENT",
-                    help="battery charge at the start (default 100)")
+    up.add_argument("--battery", type=float, default=DEFAULT_BATTERY, metavar="PERCENT",
+                    help=f"battery charge at the start (default {DEFAULT_BATTERY:g}, just "
+                         f"above the bundled tree's {CAMPUS_THRESHOLD:g} %% recharge threshold)")
     up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
     up.add_argument("--monitor-port", type=int, default=8080, metavar="PORT",
                     help="port of the web monitor (default 8080; 0: any free port)")
@@ -100,8 +117,23 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     return LaunchDescription(nodes, list(args.connect), args.listen or DEFAULT_ROUTER)
 
 
+def up_notes(args: argparse.Namespace) -> list[str]:
+    """The lines ``cyborg up`` prints first, under the bus: the pace and the charge it runs at,
+    and, on the bundled mission at the defaults, when the recharge comes and how to choose
+    otherwise (a recharge is seven hours away at real time on a full battery)."""
+    pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
+    lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
+    if (args.map, args.tree, args.speed, args.battery) == (None, None, DEFAULT_SPEED,
+                                                           DEFAULT_BATTERY):
+        lines += [f"             the patrol goes to recharge below {CAMPUS_THRESHOLD:g} % "
+                  "within a minute and",
+                  "             charges for about 4 minutes; --speed 1 --battery 100: real "
+                  "time"]
+    return lines
+
+
 def up_command(args: argparse.Namespace) -> int:
-    return run(up_description(args), args, title="cyborg up")
+    return run(up_description(args), args, title="cyborg up", notes=up_notes(args))
 
 
 def launch_command(args: argparse.Namespace) -> int:
@@ -115,43 +147,53 @@ def launch_command(args: argparse.Namespace) -> int:
         description.listen = args.listen
     if args.connect:
         description.connect = list(args.connect)
-    if args.process != "main":
-        # a launch's child is stopped by its parent's SIGINT, even when it was started where
-        # SIGINT is ignored (a shell's background job passes that on to what it starts)
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    return run(description, args, title=f"cyborg launch {args.file}", process=args.process)
+    if args.process == "main":
+        return run(description, args, title=f"cyborg launch {args.file}")
+    parent = os.getppid()
+    as_child()  # stopped by its parent's SIGTERM, after the parent's tree runners halted
+    return run(description, args, title=f"cyborg launch {args.file} --process {args.process}",
+               process=args.process, parent=parent)
 
 
 def run(description: LaunchDescription, args: argparse.Namespace, *, title: str,
-        process: str = "main") -> int:
+        process: str = "main", parent: int | None = None, notes: Sequence[str] = ()) -> int:
+    """Start ``process``'s nodes (and, for ``main``, the other processes as children), print
+    ``notes`` and what runs, follow the tree, and stop everything in order
+    (:meth:`Launch.stop`) on Ctrl-C, after ``--duration``, or when ``parent`` (a child's
+    launch) has gone."""
     context, where = bus_context(description.connect, description.listen)
     launch = Launch(description, context)
+    status_line: StatusLine | None = None
     code = 0
     try:
         children = [name for name in description.processes() if name != "main"] \
             if process == "main" else []
         connect = description.connect[0] if description.connect else description.listen
         launch.start(process, children=children, connect=connect)
-        print(f"{title}: bus {where}; Ctrl-C stops everything", flush=True)
-        for line in launch.describe():
+        stops = "Ctrl-C stops everything" if parent is None else "stops with its launch"
+        print(f"{title}: bus {where}; {stops}", flush=True)
+        for line in [*notes, *launch.describe()]:
             print(f"  {line}", flush=True)
-        _follow_tree(launch)
-        code = launch.wait(args.duration)
+        status_line = _follow_tree(launch)
+        code = launch.wait(args.duration, parent=parent)
     except LaunchError as exc:
         raise CommandError(str(exc)) from exc
     finally:
         end_if_stuck(launch)
         launch.stop()
         context.close()
+        if status_line is not None:  # ends a live line: what follows starts on its own
+            status_line.finish(interrupted=code == 130 or sys.exc_info()[0] is KeyboardInterrupt)
     if code == 130:
         print(f"{title}: stopped", file=sys.stderr)
     return code
 
 
-def _follow_tree(launch: Launch) -> None:
+def _follow_tree(launch: Launch) -> StatusLine | None:
     """Print a live status line for the first tree runner of this process."""
     for item in launch.running:
         if isinstance(item, RunningTree):
             line = StatusLine(item.runner.tree, sys.stdout)
             item.runner.runner.add_listener(line.update)
-            return
+            return line
+    return None
