@@ -92,6 +92,19 @@ def test_yaml_launch_is_the_same_as_toml(tmp_path: Path) -> None:
     assert description.processes() == ["main", "brain"]
 
 
+def test_a_byte_order_mark_is_read_past_and_other_encodings_are_named(tmp_path: Path) -> None:
+    text = "[[node]]\nkind = \"tree_runner\"\nname = \"runner\"\n"
+    for suffix, body in ((".toml", text),
+                         (".yaml", "node:\n  - kind: tree_runner\n    name: runner\n")):
+        path = tmp_path / f"bom{suffix}"
+        path.write_bytes(b"\xef\xbb\xbf" + body.encode())
+        assert [spec.name for spec in read_launch(path).nodes] == ["runner"]
+    latin = tmp_path / "latin.toml"
+    latin.write_bytes(text.encode() + b"# Kj\xf8kken\n")
+    with pytest.raises(LaunchError, match=r"latin.toml:4: not UTF-8 text \(byte 47"):
+        read_launch(latin)
+
+
 def test_nodes_that_cannot_start_stop_what_started(tmp_path: Path, shared: Path) -> None:
     broken_tree = tmp_path / "broken.b3.json"
     broken_tree.write_text('{"trees": [}')

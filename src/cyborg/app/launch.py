@@ -76,9 +76,13 @@ class LaunchDescription:
 def read_launch(path: Path) -> LaunchDescription:
     """Parse and check a launch file; :class:`LaunchError` names the file, node and field."""
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as Notepad writes
     except OSError as exc:
         raise LaunchError(f"{path}: cannot read the launch file: {exc.strerror}") from exc
+    except UnicodeDecodeError as exc:
+        line = path.read_bytes()[:exc.start].count(b"\n") + 1
+        raise LaunchError(f"{path}:{line}: not UTF-8 text (byte {exc.start}: "
+                          f"{exc.object[exc.start:exc.start + 1]!r})") from exc
     try:
         if path.suffix.lower() in (".yaml", ".yml"):
             data = yaml.safe_load(text) or {}
