@@ -1,4 +1,5 @@
-"""What the bus commands learn from the graph (types, durability) and how they print messages.
+"""What the bus commands learn from the graph (types, durability), how they print messages and
+how ``topic hz`` measures a rate.
 
 In-process and quick: a :class:`Graph` fed tokens by hand stands for the bus, a timer thread for
 a publisher that starts late. The same behaviour across processes is in ``test_bus_cli.py``.
@@ -13,6 +14,7 @@ import pytest
 
 from cyborg.app.bt_commands import CommandError
 from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
+from cyborg.app.rate_window import Rate, RateWindow, hz_line
 from cyborg.bus import Durability, MessageTypes, Qos, new_message, to_plain
 from cyborg.bus.graph import Graph
 from cyborg.bus.wire import EntityKind, endpoint_token
@@ -128,3 +130,72 @@ def test_a_service_call_waits_for_a_server(capsys: pytest.CaptureFixture[str],
                         timeout=0.1) == "std_srvs/srv/Trigger"  # a given type is kept
     with pytest.raises(CommandError, match=r"no server of /other appeared within 0\.2 s"):
         service_type(graph, TYPES, "/other", "std_srvs/srv/Trigger", timeout=0.2)
+
+
+# ---------------------------------------------------------------------- topic hz
+class FakeClock:
+    """Seconds that pass only when a test says so."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def publish(window: RateWindow, clock: FakeClock, hz: float, seconds: int) -> list[Rate | None]:
+    """``seconds`` report periods of 1 s in which a publisher sends at ``hz`` (0: it is silent),
+    with the report ``topic hz`` makes at the end of each."""
+    start = clock.now
+    sends = [start + k / hz for k in range(1, round(hz * seconds) + 1)] if hz else []
+    reports: list[Rate | None] = []
+    for second in range(1, seconds + 1):
+        while sends and sends[0] <= start + second + 1e-9:
+            clock.now = sends.pop(0)
+            window.arrived()
+        clock.now = start + second
+        reports.append(window.report())
+    return reports
+
+
+def rates(reports: list[Rate | None]) -> list[float | None]:
+    return [None if report is None else round(report.rate, 6) for report in reports]
+
+
+def test_hz_measures_a_publisher_that_stops_and_resumes_afresh() -> None:
+    clock = FakeClock()
+    window = RateWindow(clock)
+    assert rates(publish(window, clock, 10, 3)) == [10.0, 10.0, 10.0]
+    silence = publish(window, clock, 0, 3)
+    assert silence == [None, None, None]  # not the old 10 Hz, again and again
+    assert [hz_line(report) for report in silence] == ["no new messages"] * 3
+    resumed = publish(window, clock, 2, 3)
+    assert rates(resumed) == [2.0, 2.0, 2.0]  # not a mix of the 10 Hz and the gap
+    assert resumed[0] is not None and resumed[0].count == 2 and resumed[0].max_gap == 0.5
+
+
+def test_hz_does_not_mix_a_lone_message_long_ago_into_a_new_rate() -> None:
+    clock = FakeClock()
+    window = RateWindow(clock)
+    assert publish(window, clock, 1, 1) == [None]  # one message: no rate yet
+    assert publish(window, clock, 0, 30) == [None] * 30
+    assert rates(publish(window, clock, 4, 2)) == [4.0, 4.0]
+
+
+def test_hz_still_measures_a_topic_slower_than_the_report_period() -> None:
+    clock = FakeClock()
+    window = RateWindow(clock)
+    assert rates(publish(window, clock, 0.5, 8)) == [None, None, None, 0.5, None, 0.5, None, 0.5]
+
+
+def test_hz_window_keeps_the_latest_arrivals() -> None:
+    clock = FakeClock()
+    window = RateWindow(clock, size=5)
+    publish(window, clock, 10, 2)
+    last = publish(window, clock, 5, 1)[-1]
+    assert last is not None and last.count == 5 and last.rate == pytest.approx(5.0)
+
+
+def test_hz_prints_a_rate_the_ros2_way() -> None:
+    line = hz_line(Rate(rate=10.0, min_gap=0.09, max_gap=0.11, count=11))
+    assert line == "average rate: 10.000\n\tmin: 0.090s max: 0.110s window: 11"

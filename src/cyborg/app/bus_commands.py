@@ -17,7 +17,6 @@ a topic not seen yet, ``service call`` for a server.
 from __future__ import annotations
 
 import argparse
-import itertools
 import sys
 import threading
 import time
@@ -29,6 +28,7 @@ import yaml
 from cyborg.app.bt_commands import CommandError
 from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
 from cyborg.app.param_commands import add_param_parser
+from cyborg.app.rate_window import RateWindow, hz_line
 from cyborg.bus import BusConfig, Context, MessageValueError, Node, Qos, new_message, to_plain
 from cyborg.bus.config import BusConfigError
 from cyborg.bus.wire import EntityKind
@@ -276,20 +276,13 @@ def topic_hz(args: argparse.Namespace) -> int:
         type_name = args.type or topic_type(context.graph, context.types, args.topic,
                                             command="cyborg topic hz",
                                             timeout=args.duration or None)
-        arrivals: list[float] = []
+        window = RateWindow(time.monotonic)
         node = Node("cyborg_topic_hz", context=context)
-        node.create_subscription(args.topic, type_name,
-                                 lambda _m: arrivals.append(time.monotonic()), Qos(depth=1000))
+        node.create_subscription(args.topic, type_name, lambda _m: window.arrived(),
+                                 Qos(depth=1000))
         while not args.duration or time.monotonic() - started < args.duration:
             time.sleep(1.0)
-            window = arrivals[-1000:]
-            if len(window) < 2:
-                print("no new messages", flush=True)
-                continue
-            gaps = [b - a for a, b in itertools.pairwise(window)]
-            mean = sum(gaps) / len(gaps)
-            print(f"average rate: {1.0 / mean:.3f}\n\tmin: {min(gaps):.3f}s max: "
-                  f"{max(gaps):.3f}s window: {len(window)}", flush=True)
+            print(hz_line(window.report()), flush=True)
     return 0
 
 
