@@ -114,14 +114,21 @@ def test_a_video_camera_advertises_no_depth_and_the_detector_finds_the_person_wi
 
 
 # ------------------------------------------------------------------ the detector's log
-def test_without_a_depth_publisher_the_detector_runs_image_only_and_says_so_after_5_s(
-        bus: Context, detector: Detector, caplog: pytest.LogCaptureFixture) -> None:
-    caplog.set_level(logging.INFO, logger=WARNING)
+def _detector_on_clock(bus: Context, detector: Detector) -> tuple[FakeClock, DetectorNode,
+                                                                  list[Any]]:
+    """A detector node on /cam/image + /cam/depth whose clock the test moves, and the
+    predictions it publishes."""
     clock = FakeClock()
     node = Node("detector", "/d", context=bus)
     detector_node = DetectorNode(node, DetectionPipeline(detector),
                                  CameraTopics("/cam/image", "/cam/depth"), clock=clock)
-    predictions = listen(bus, "/d/predictions")
+    return clock, detector_node, listen(bus, "/d/predictions")
+
+
+def test_without_a_depth_publisher_the_detector_runs_image_only_and_says_so_after_5_s(
+        bus: Context, detector: Detector, caplog: pytest.LogCaptureFixture) -> None:
+    caplog.set_level(logging.INFO, logger=WARNING)
+    clock, detector_node, predictions = _detector_on_clock(bus, detector)
     image = Node("cam", context=bus).create_publisher("/cam/image", "sensor_msgs/msg/Image")
     person = photo("astronaut")
 
@@ -148,11 +155,7 @@ def test_without_a_depth_publisher_the_detector_runs_image_only_and_says_so_afte
 def test_a_silent_depth_publisher_is_waited_for_5_s_then_named_and_detection_goes_on(
         bus: Context, detector: Detector, caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.INFO, logger=WARNING)
-    clock = FakeClock()
-    node = Node("detector", "/d", context=bus)
-    detector_node = DetectorNode(node, DetectionPipeline(detector),
-                                 CameraTopics("/cam/image", "/cam/depth"), clock=clock)
-    predictions = listen(bus, "/d/predictions")
+    clock, detector_node, predictions = _detector_on_clock(bus, detector)
     camera = Node("cam", context=bus)
     image = camera.create_publisher("/cam/image", "sensor_msgs/msg/Image")
     depth = camera.create_publisher("/cam/depth", "sensor_msgs/msg/Image")
