@@ -9,6 +9,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cyborg.app.cli import main
 from cyborg.bt import (
@@ -20,6 +22,7 @@ from cyborg.bt import (
     check_file,
     default_registry,
     load_tree,
+    loads_tree,
 )
 from cyborg.bt.problems import Severity
 
@@ -252,3 +255,42 @@ def test_tree_files_saved_with_a_byte_order_mark_load(tmp_path: Path, shared: Pa
     v1.write_bytes(b"\xef\xbb\xbf" + json.dumps({"name": "t", "root": _node(1, "JustSuccess")})
                    .encode())
     assert load_tree(v1).tick().status is Status.SUCCESS
+
+
+_json_values = st.recursive(
+    st.none() | st.booleans() | st.integers(-3, 3) | st.floats(allow_nan=True)
+    | st.sampled_from(["", "1", "Sequence", "Wait", "Log", "x", "sub.json"]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(
+        st.sampled_from(["id", "name", "args", "input", "output", "children", "path",
+                         "disabled", "desc", "time"]), inner, max_size=4),
+    max_leaves=12)
+
+
+@settings(max_examples=150, deadline=None)
+@given(root=st.dictionaries(st.sampled_from(["id", "name", "args", "input", "output",
+                                             "children", "path", "disabled"]),
+                            _json_values, max_size=6),
+       top=st.dictionaries(st.sampled_from(["vars", "declvar", "import", "version", "name"]),
+                           _json_values, max_size=3))
+def test_any_v1_shaped_input_loads_or_names_its_problems(root: dict[str, Any],
+                                                         top: dict[str, Any]) -> None:
+    text = json.dumps({**top, "root": root})
+    try:
+        tree = loads_tree(text, stub_missing=Status.SUCCESS)
+    except TreeLoadError as exc:
+        assert exc.problems and all(p.source == "<string>" for p in exc.problems)
+    else:
+        assert len(tree) >= 1
+
+
+def test_a_tree_nested_too_deeply_is_a_located_error(tmp_path: Path) -> None:
+    for levels in (300, 5000):  # deeper than cyborg builds; deeper than JSON reads
+        text = "".join(f'{{"id": {depth}, "name": "Invert", "children": ['
+                       for depth in range(levels))
+        text += '{"id": "leaf", "name": "JustSuccess"}' + "]}" * levels
+        path = tmp_path / f"deep{levels}.json"
+        path.write_text(f'{{"name": "deep", "root": {text}}}')
+        with pytest.raises(TreeLoadError) as caught:
+            load_tree(path)
+        assert "nested more deeply than" in str(caught.value), levels
+        assert str(path) in str(caught.value)

@@ -247,6 +247,9 @@ def parse_project(text: str, source: str = "<string>", path: Path | None = None)
     except json.JSONDecodeError as exc:
         raise TreeLoadError([Problem(f"malformed JSON: {exc.msg}", source, exc.lineno,
                                      exc.colno)]) from None
+    except RecursionError:
+        raise TreeLoadError([Problem("malformed JSON: nested more deeply than the JSON reader "
+                                     "allows", source, 1)]) from None
     problems: list[Problem]
     if is_v1(data):
         reader_v1 = V1Reader(source, path)

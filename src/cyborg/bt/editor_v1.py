@@ -41,6 +41,8 @@ from cyborg.bt.problems import Problem, Severity
 from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 
 SETTING_FILE = "node-config.b3-setting"
+MAX_DEPTH = 200
+"""Levels of nesting a tree may have (deeper is refused with a located error, not a crash)."""
 _ID = re.compile(r'"id"\s*:\s*(?:"((?:[^"\\]|\\.)*)"|(-?\d+))')
 _CATEGORIES = ("action", "condition", "decorator", "composite")
 
@@ -241,10 +243,14 @@ class V1Reader:
         return resolved.with_suffix("").name
 
     def node(self, raw: Any, tree: TreeSpec, lines: _LineIndex, source: str,
-             counter: list[int]) -> NodeSpec | None:
+             counter: list[int], depth: int = 0) -> NodeSpec | None:
         """Flatten ``raw`` and its enabled descendants into ``tree.nodes``."""
         if not isinstance(raw, dict):
             self.problem("a node must be a JSON object", source, tree=tree, field="children")
+            return None
+        if depth >= MAX_DEPTH:
+            self.problem(f"the tree is nested more deeply than {MAX_DEPTH} levels", source,
+                         tree=tree, line=lines.of_id(str(raw.get("id"))), field="children")
             return None
         counter[0] += 1
         node_id = raw.get("id")
@@ -290,7 +296,7 @@ class V1Reader:
         for child in children:
             if isinstance(child, dict) and child.get("disabled") is True:
                 continue
-            built = self.node(child, tree, lines, source, counter)
+            built = self.node(child, tree, lines, source, counter, depth + 1)
             if built is not None:
                 spec.children.append(built.id)
         return spec
