@@ -266,6 +266,10 @@ def test_inputs_wait_only_for_the_partners_that_have_a_publisher_now() -> None:
     assert inputs.add("image", 4, "i4") == {"image": "i4"}
     assert inputs.dropped == 0
     assert inputs.add("depth", 5, "late") is None and inputs.dropped == 1
+    early = CameraInputs(CameraTopics("/cam/image", "/cam/depth"), lambda topic: [],
+                         clock=clock)  # a camera's first depth map, before the graph shows it
+    assert early.add("depth", 1, "d1") is None
+    assert early.add("image", 1, "i1") == {"image": "i1", "depth": "d1"}
     alone = CameraInputs(CameraTopics("/cam/image"), lambda topic: [], clock=clock)
     assert alone.add("image", 1, "i1") == {"image": "i1"}
     clock.now += 60

@@ -75,6 +75,11 @@ class CameraInputs:
         self.received: Counter[str] = Counter()
         """Messages of each optional stream since the last pair."""
         self.complained = False
+        self.heard: set[str] = set()
+        """Optional streams whose messages came before the graph showed their publisher (a
+        camera that starts publishing at once): paired until the graph catches up."""
+        self.shown: set[str] = set()
+        """Optional streams the graph has shown a publisher of; from then on it decides."""
         self._warned = False
         self._dropped = 0
 
@@ -90,6 +95,8 @@ class CameraInputs:
 
     def add(self, stream: str, stamp: int, message: Any) -> dict[str, Any] | None:
         """One message in; the messages of a frame when this one completes (or is) a frame."""
+        if stream in self.optional and stream not in self.shown:
+            self.heard.add(stream)  # a message proves a publisher the graph may not show yet
         self._follow_graph()
         if stream != "image":
             if stream not in self.streams:  # its publisher is not in the graph (yet)
@@ -120,9 +127,14 @@ class CameraInputs:
 
     # ------------------------------------------------------------------ states
     def _follow_graph(self) -> None:
-        """Pair exactly the optional streams that have a publisher now."""
+        """Pair exactly the optional streams that have a publisher now (or, before the graph
+        shows one, whose messages come)."""
+        published = {stream for stream in self.optional
+                     if self.publishers(getattr(self.topics, stream))}
+        self.shown |= published
+        self.heard -= published
         wanted = ("image", *(stream for stream in self.optional
-                             if self.publishers(getattr(self.topics, stream))))
+                             if stream in published or stream in self.heard))
         if wanted == self.streams:
             return
         log.info("%s: pairing %s by stamp (publishers of %s: %s)", self.name,
