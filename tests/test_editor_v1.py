@@ -17,6 +17,7 @@ from cyborg.bt import (
     Action,
     Blackboard,
     ManualClock,
+    NodeRegistry,
     Status,
     TreeLoadError,
     check_file,
@@ -77,15 +78,25 @@ def test_every_sample_tree_loads_with_stubs_for_the_game_nodes(path: Path) -> No
     assert tree.tick().status in Status
 
 
+def _registry_without(name: str) -> NodeRegistry:
+    registry = NodeRegistry()
+    for node_type in default_registry().types():
+        if node_type.name != name:
+            registry.add(node_type.cls, node_type.name, origin=node_type.origin)
+    return registry
+
+
 def test_without_stubs_the_missing_nodes_are_named_with_file_line_and_id() -> None:
     monster = EDITOR / "workdir" / "monster.json"
-    errors = _errors(monster)
+    errors = _errors(monster, registry=_registry_without("Cmp"))
     by_node = {(Path(p.source).name, p.node_id): p for p in errors}
     get_hp = by_node[("monster.json", "3")]
     assert get_hp.line == 21 and get_hp.field == "name"
     assert "declared in node-config.b3-setting" in get_hp.message
     cmp_in_subtree = by_node[("subtree2.json", "2")]  # problems point into the subtree's file
-    assert "behavior3 v1's 'Cmp'" in cmp_in_subtree.message and cmp_in_subtree.line == 15
+    assert "unknown node name 'Cmp'" in cmp_in_subtree.message and cmp_in_subtree.line == 15
+    assert ("subtree2.json", "2") not in {(Path(p.source).name, p.node_id)
+                                         for p in _errors(monster)}, "cyborg has Cmp now"
 
 
 def test_subtree_paths_resolve_against_the_workdir_and_each_reference_is_an_instance() -> None:
@@ -201,11 +212,28 @@ def test_older_1x_files_with_integer_ids_and_declvar(tmp_path: Path) -> None:
 
 def test_a_v1_stock_node_cyborg_lacks_is_explained_not_mistaken_for_ours(
         tmp_path: Path) -> None:
-    path = _write(tmp_path, "parallel.json", _node(1, "Parallel", _node(2, "JustSuccess")))
+    path = _write(tmp_path, "delay.json", _node(1, "Delay", _node(2, "JustSuccess"),
+                                                args={"delay": 1}))
     errors = _errors(path)
-    assert len(errors) == 1 and "behavior3 v1's 'Parallel' (ticks every child until all have" \
-        " finished, then succeeds) has no equivalent" in errors[0].message
+    assert len(errors) == 1 and "behavior3 v1's 'Delay' (schedules its child for later and " \
+        "succeeds at once) has no equivalent" in errors[0].message, "not cyborg's Delay"
     assert _errors(path, stub_missing=Status.SUCCESS) == []
+
+
+def test_v1_parallel_and_behavior3lua_names_map_onto_cyborgs_v1_nodes(tmp_path: Path) -> None:
+    path = _write(tmp_path, "mapped_v1.json", _node(1, "Parallel",
+                  _node(2, "RepeatUntilFailure", _node(3, "JustSuccess"), args={"maxLoop": 2}),
+                  _node(4, "RetryUntilSuccess", _node(5, "JustFailure"), input=["tries"]),
+                  _node(6, "Check", args={"value": "tries == 2"})))
+    blackboard = Blackboard({"tries": 2})
+    clock = ManualClock()
+    tree = load_tree(path, blackboard=blackboard, clock=clock)
+    assert [node.name for node in tree][1:] == ["ParallelAll", "RetryUntilFailure",
+                                                "Succeeder", "RetryUntilSuccess", "Failer",
+                                                "Check"]
+    assert tree.by_uid["2"].properties == {"count": 2}
+    assert tree.by_uid["4"].ports == {"count": "tries"}
+    assert [tree.tick().status for _ in range(3)] == [Status.RUNNING] * 2 + [Status.SUCCESS]
 
 
 def test_the_cli_takes_v1_files_and_node_definition_files(
@@ -294,3 +322,11 @@ def test_a_tree_nested_too_deeply_is_a_located_error(tmp_path: Path) -> None:
             load_tree(path)
         assert "nested more deeply than" in str(caught.value), levels
         assert str(path) in str(caught.value)
+
+
+def test_a_file_from_a_newer_editor_is_read_with_a_warning() -> None:
+    monster = SAMPLES / "behavior3-ts-example" / "monster.json"  # "version": "2.0.0"
+    (warning,) = [p for p in check_file(monster, stub_missing=Status.SUCCESS)
+                  if p.field == "version"]
+    assert warning.severity is Severity.WARNING and warning.line == 1
+    assert "written by behavior3editor 2.0.0; read as a 1.x file" in warning.message

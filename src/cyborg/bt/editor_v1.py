@@ -205,8 +205,8 @@ class V1Reader:
 
     def declarations(self, data: dict[str, Any], source: str, seen: set[Path]) -> set[str]:
         """Variable names declared by a tree and, recursively, by the files it imports."""
-        raw = data.get("vars", data.get("declvar")) or []
-        names = {item["name"] for item in raw
+        raw = data.get("vars", data.get("declvar"))
+        names = {item["name"] for item in (raw if isinstance(raw, list) else [])
                  if isinstance(item, dict) and isinstance(item.get("name"), str)}
         holder = TreeSpec(source, _text(data.get("name")), "", None, {}, {}, 1, source)
         for relative in _strings(data.get("import")):

@@ -5,8 +5,8 @@ differently from behavior3editor 0.3.0, and run trees as a stack machine: a RUNN
 resumed on the next tick without re-ticking its ancestors' earlier children. So a v1
 ``Sequence`` resumes at its running child, which is cyborg's ``MemSequence``. Times are
 seconds in v1 and milliseconds in cyborg's (and behavior3's) nodes. :data:`EQUIVALENTS` maps a
-v1 name onto cyborg's node and converts its ``args``; :data:`NO_EQUIVALENT` says what the v1
-stock nodes without a cyborg counterpart do, so an error can tell the user (register a node
+v1 name onto cyborg's node and converts its ``args``; :data:`NO_EQUIVALENT` says what the few
+v1 stock nodes without a cyborg counterpart do, so an error can tell the user (register a node
 class of that name, or run with ``--stub-missing``). docs/behavior3-v1.md has the table.
 """
 
@@ -62,6 +62,7 @@ class Equivalent:
 EQUIVALENTS: dict[str, Equivalent] = {
     "Sequence": Equivalent("MemSequence", "v1 resumes the running child"),
     "Selector": Equivalent("MemPriority", "v1 resumes the running child"),
+    "Parallel": Equivalent("ParallelAll", "v1 waits for every child, then succeeds"),
     "Invert": Equivalent("Inverter"),
     "Inverter": Equivalent("Inverter"),
     "AlwaysSuccess": Equivalent("ForceSuccess"),
@@ -71,47 +72,26 @@ EQUIVALENTS: dict[str, Equivalent] = {
     "JustFailure": Equivalent("Failer"),
     "Wait": Equivalent("Wait", "time in seconds -> milliseconds", _seconds("time")),
     "Timeout": Equivalent("Timeout", "time in seconds -> milliseconds", _seconds("time")),
-    "RetryUntilSuccess": Equivalent("Retry", "count -> maxAttempts (none: forever)",
-                                    _renamed("count", "maxAttempts", absent=-1)),
-    "RepeatUntilSuccess": Equivalent("RepeatUntilSuccess", "behavior3lua's maxLoop"),
+    "RepeatUntilSuccess": Equivalent("RetryUntilSuccess", "behavior3lua's name; maxLoop -> count",
+                                     _renamed("maxLoop", "count")),
+    "RepeatUntilFailure": Equivalent("RetryUntilFailure", "behavior3lua's name; maxLoop -> count",
+                                     _renamed("maxLoop", "count")),
 }
-"""v1 name -> cyborg node. Names not here are looked up as they are."""
+"""v1 name -> cyborg node. Names not here are looked up as they are: most v1 stock nodes
+(IfElse, Race, Switch, Case, Watchdog, Once, Repeat, RetryUntilSuccess, Check, Let, ...) are
+cyborg stock nodes of the same name (:mod:`cyborg.bt.v1_controls`, :mod:`cyborg.bt.v1_data`,
+:mod:`cyborg.bt.v1_math`)."""
 
 NO_EQUIVALENT: dict[str, str] = {
-    "Parallel": "ticks every child until all have finished, then succeeds",
-    "Race": "ticks every child until one succeeds",
-    "IfElse": "ticks child 2 or 3 by the result of child 1",
-    "Switch": "runs the first Case whose condition succeeds",
-    "Case": "a condition and a branch, inside Switch",
-    "Watchdog": "re-checks a guard every tick while a branch runs",
     "Delay": "schedules its child for later and succeeds at once",
     "Listen": "ticks its child when an event fires",
-    "Once": "succeeds the first time its child completes, then fails",
-    "Repeat": "ticks its child count times, stopping at a failure",
-    "RetryUntilFailure": "succeeds when its child fails, fails after count tries",
-    "RepeatUntilFailure": "repeats its child until it fails, up to maxLoop times (behavior3lua)",
-    "Assert": "raises when its child fails",
-    "ForEach": "ticks its child for each element of an array",
-    "Filter": "keeps the array elements its child succeeds on",
-    "Loop": "ticks its children a number of times",
-    "Check": "evaluates an expression over blackboard variables",
-    "Cmp": "compares a blackboard value with numbers (behavior3lua)",
-    "Calculate": "evaluates an expression into a variable",
     "WaitForEvent": "runs until an event fires",
-    "WaitForCount": "runs for a number of ticks (behavior3lua)",
-    "Includes": "tests whether an array holds an element",
-    "Push": "appends to an array",
-    "Concat": "joins two arrays",
-    "Index": "reads an array element",
-    "GetField": "reads an object field",
-    "SetField": "writes an object field",
-    "RandomIndex": "picks a random array element",
-    "Random": "writes a random number (behavior3lua)",
-    "Math": "applies a math function",
-    "Clear": "deletes a variable",
+    "Loop": "ticks its children a number of times (the editor's sample only)",
 }
-"""v1 stock nodes with no cyborg counterpart: what each does, for error messages."""
+"""v1 stock nodes with no cyborg counterpart: what each does, for error messages. Delay,
+Listen and WaitForEvent need behavior3-ts's event dispatch and deferred callbacks, which a
+tree ticked from its root has no place for; Loop has no runtime to take its meaning from."""
 
-REPLACED_IN_CYBORG = frozenset({"Parallel", "Delay", "RepeatUntilFailure"})
+REPLACED_IN_CYBORG = frozenset({"Delay"})
 """v1 names that cyborg's own stock nodes use with another meaning: in a v1 file a stock
 class of that name is not used for them (a class registered by the user is)."""

@@ -31,7 +31,15 @@ from dataclasses import dataclass
 from importlib.metadata import entry_points
 from typing import Any, TypeVar, overload
 
-from cyborg.bt import blackboard_nodes, composites, decorators, leaves
+from cyborg.bt import (
+    blackboard_nodes,
+    composites,
+    decorators,
+    leaves,
+    v1_controls,
+    v1_data,
+    v1_math,
+)
 from cyborg.bt.node import Category, Node
 from cyborg.bt.properties import Signature, signature_of
 
@@ -166,8 +174,18 @@ STOCK_NODES: tuple[type[Node], ...] = (
     decorators.RunOnce,
     leaves.Failer, leaves.Succeeder, leaves.Runner, leaves.Error, leaves.Wait,
     blackboard_nodes.Log, blackboard_nodes.IsNull, blackboard_nodes.NotNull,
+    # behavior3 v1 (behavior3-ts, behavior3lua) stock nodes; see docs/behavior3-v1.md
+    v1_controls.IfElse, v1_controls.ParallelAll, v1_controls.Race, v1_controls.Switch,
+    v1_controls.Case, v1_controls.Watchdog, v1_controls.Once, v1_controls.AlwaysRunning,
+    v1_controls.Assert, v1_controls.Repeat, v1_controls.RetryUntilSuccess,
+    v1_controls.RetryUntilFailure, v1_controls.ForEach, v1_controls.Filter,
+    v1_controls.WaitForCount,
+    v1_data.Check, v1_data.Calculate, v1_data.Let, v1_data.Now, v1_data.Clear, v1_data.Includes,
+    v1_data.Push, v1_data.Concat, v1_data.Index, v1_data.GetField, v1_data.SetField,
+    v1_data.RandomIndex, v1_math.Math, v1_math.Cmp, v1_math.Random,
 )
-"""The nodes every registry starts with: behavior3editor's palette and a few more."""
+"""The nodes every registry starts with: behavior3editor's palette, behavior3 v1's stock
+nodes and a few more."""
 
 for _cls in STOCK_NODES:
     _REGISTERED.add(_cls, origin="stock")
