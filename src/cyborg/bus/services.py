@@ -4,8 +4,19 @@ The server declares a complete queryable on the service key (its type hash is th
 hash); a client sends a ``get`` with the CDR request and the 33-byte attachment, and the server
 replies on the same key with the request's sequence number and the client's GID echoed.
 
-Unlike ROS 2, a handler's exception reaches the caller: the server answers with a Zenoh error
-reply naming the exception, and :meth:`ServiceClient.call` raises :class:`ServiceError` with it.
+Unlike ROS 2, a failure reaches the caller as one line, never as a traceback, and the server
+logs where it happened:
+
+* a request that does not fit the service's request type (a wrong field type on the client, a
+  payload that does not decode on the server) never reaches the handler: the client raises
+  :class:`RequestError` before sending, the server answers ``bad request: ...``;
+* a handler refuses a request by raising :class:`RequestError` naming the field (``goal.x: nan
+  is not a finite number``); checks in :attr:`ServiceServer.checks` run before the handler;
+  the caller gets ``bad request: goal.x: ...``, the server logs one warning line;
+* any other exception in a handler gives the caller ``ExceptionType: first line of its
+  message``; the server logs the traceback the first time per exception type, then one line;
+* a response that does not fit the response type is an error reply naming the field, at once,
+  not a timeout.
 
     def add(request):
         return AddTwoInts_Response(sum=request.a + request.b)
@@ -24,7 +35,9 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import zenoh
+from rosbags.interfaces import Nodetype
 
 from cyborg.bus.wire import (
     Attachment,
@@ -37,6 +50,7 @@ from cyborg.bus.wire import (
 )
 
 if TYPE_CHECKING:
+    from cyborg.bus.message_types import MessageTypes
     from cyborg.bus.node import Node
 
 log = logging.getLogger("cyborg.bus")
@@ -50,6 +64,94 @@ class ServiceError(RuntimeError):
 
 class ServiceTimeoutError(ServiceError):
     """No reply came within the timeout."""
+
+
+class RequestError(ServiceError):
+    """A request the service cannot take: ``field`` (``goal.x``, empty if unknown) and why.
+
+    Raise it in a handler (or a check) to refuse a request without a traceback; the caller gets
+    ``bad request: FIELD: REASON``. :meth:`ServiceClient.call` raises it for a request that does
+    not fit the request type and for a server's refusal, with the service's name.
+    """
+
+    def __init__(self, field: str, reason: str, service: str = "") -> None:
+        self.field, self.reason, self.service = field, _one_line(reason), service
+        self.detail = f"{field}: {self.reason}" if field else self.reason
+        super().__init__(f"service {service}: bad request: {self.detail}" if service
+                         else f"bad request: {self.detail}")
+
+
+_BAD_REQUEST = "bad request: "
+_MAX_ERROR = 300  # characters of an error text that travel
+
+
+def _one_line(text: str, limit: int = _MAX_ERROR) -> str:
+    """The first line of ``text``, control characters escaped, at most ``limit`` characters:
+    what may travel between a server and a caller's terminal (never a traceback)."""
+    first = text.strip().split("\n", 1)[0].strip()
+    first = "".join(char if char.isprintable() else f"\\x{ord(char):02x}"
+                    if ord(char) < 256 else f"\\u{ord(char):04x}" for char in first)
+    return first if len(first) <= limit else first[: limit - 1] + "…"
+
+
+def field_problem(types: MessageTypes, type_name: str, message: Any,
+                  path: str = "") -> str | None:
+    """Where ``message`` does not fit ``type_name``, as ``"goal.x: expected a number, got
+    '1'"``; None where it fits. Names the first field that is wrong, however deep."""
+    if not isinstance(message, types.message_class(type_name)):
+        return f"{path or 'the message'}: expected a {type_name}, got {_shown(message)}"
+    for name, (kind, detail) in types.store.fielddefs[type_name][1]:
+        where = f"{path}.{name}" if path else name
+        problem = _value_problem(types, kind, detail, getattr(message, name, None), where)
+        if problem:
+            return problem
+    return None
+
+
+def _value_problem(types: MessageTypes, kind: Any, detail: Any, value: Any,
+                   where: str) -> str | None:
+    if kind == Nodetype.NAME:
+        return field_problem(types, detail, value, where)
+    if kind == Nodetype.BASE:
+        return _base_problem(detail[0], value, where)
+    (element_kind, element), bound = detail
+    if not isinstance(value, list | tuple | np.ndarray):
+        return f"{where}: expected a list, got {_shown(value)}"
+    if kind == Nodetype.ARRAY and len(value) != bound:
+        return f"{where}: expected {bound} items, got {len(value)}"
+    if kind == Nodetype.SEQUENCE and bound and len(value) > bound:
+        return f"{where}: at most {bound} items, got {len(value)}"
+    if isinstance(value, np.ndarray) and value.dtype != object:
+        return None  # numbers: the serialiser converts the array as a whole
+    for index, item in enumerate(value):
+        problem = _value_problem(types, element_kind, element, item, f"{where}[{index}]")
+        if problem:
+            return problem
+    return None
+
+
+def _base_problem(type_name: str, value: Any, where: str) -> str | None:
+    if type_name in ("string", "wstring"):
+        if not isinstance(value, str):
+            return f"{where}: expected text, got {_shown(value)}"
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError as exc:
+            return f"{where}: not valid text (a lone surrogate at character {exc.start})"
+        return None
+    if type_name == "bool":
+        ok = isinstance(value, bool | np.bool_)
+        return None if ok else f"{where}: expected true or false, got {_shown(value)}"
+    if type_name in ("float32", "float64"):
+        ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
+        return None if ok else f"{where}: expected a number, got {_shown(value)}"
+    ok = isinstance(value, int | np.integer) and not isinstance(value, bool)
+    return None if ok else f"{where}: expected an integer ({type_name}), got {_shown(value)}"
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return _one_line(text if len(text) <= 40 else text[:39] + "…")
 
 
 class _ServiceEndpoint:
@@ -94,22 +196,43 @@ class Responder:
         return self._attachment.gid
 
     def reply(self, response: Any) -> None:
+        """Send ``response``; one that does not fit the response type becomes an error reply
+        naming the field (and an error in the server's log), sent at once."""
         server = self._server
+        response_type = f"{server.service_type}_Response"
         if not isinstance(response, server.response_class):
-            self.fail(TypeError(f"the handler returned {type(response).__name__}, "
-                                f"not {server.service_type}_Response"))
+            log.error("service %s: the handler returned %s, not %s", server.name,
+                      type(response).__name__, response_type)
+            self._send_error(f"bad response from the handler: it returned "
+                             f"{type(response).__name__}, not {response_type}")
+            return
+        try:
+            payload = server.context.types.serialize(response, response_type)
+        except Exception as exc:
+            problem = field_problem(server.context.types, response_type, response) \
+                or f"{type(exc).__name__}: {exc}"
+            log.error("service %s: the handler's response does not fit %s: %s", server.name,
+                      response_type, _one_line(problem))
+            self._send_error(f"bad response from the handler: {problem}")
             return
         if not self._done.acquire(blocking=False):
             return
-        payload = server.context.types.serialize(response, f"{server.service_type}_Response")
         reply = Attachment(self._attachment.sequence, time.time_ns(), self._attachment.gid)
         self._query.reply(self._query.key_expr, payload.obj, attachment=reply.encode())
         self._query.drop()
 
     def fail(self, error: BaseException) -> None:
+        """Answer with an error: ``bad request: ...`` for a :class:`RequestError`, else the
+        exception's type and the first line of its message."""
+        if isinstance(error, RequestError):
+            self._send_error(_BAD_REQUEST + error.detail)
+        else:
+            self._send_error(f"{type(error).__name__}: {error}")
+
+    def _send_error(self, text: str) -> None:
         if not self._done.acquire(blocking=False):
             return
-        self._query.reply_err(f"{type(error).__name__}: {error}".encode())
+        self._query.reply_err(_one_line(text).encode())
         self._query.drop()
 
 
@@ -118,6 +241,9 @@ class ServiceServer(_ServiceEndpoint):
 
     With ``deferred=True`` the handler is ``handler(request, responder)`` and answers through
     ``responder.reply(response)`` whenever it is ready (an action's get_result does this).
+
+    ``checks`` are called with each decoded request before the handler; one that raises
+    :class:`RequestError` refuses the request (``server.checks.append(require_finite)``).
     """
 
     def __init__(self, node: Node, name: str, service_type: str,
@@ -125,18 +251,21 @@ class ServiceServer(_ServiceEndpoint):
         super().__init__(node, name, service_type, EntityKind.SERVICE_SERVER)
         self.handler, self.deferred = handler, deferred
         self.handled = 0
+        self.checks: list[Callable[[Any], object]] = []
+        self._traced: set[type] = set()  # exception types whose traceback was logged
         self._queryable = self.context.session.declare_queryable(
             self.key, self._on_query, complete=True)
 
     def _on_query(self, query: zenoh.Query) -> None:
+        payload = query.payload.to_bytes() if query.payload is not None else b""
         try:
             attachment = Attachment.decode(query.attachment.to_bytes()) if query.attachment \
                 else Attachment(0, 0, bytes(16))
-            payload = query.payload.to_bytes() if query.payload is not None else b""
             request = self.context.types.deserialize(payload, f"{self.service_type}_Request")
-        except Exception as exc:
-            self.context.drop(f"{self.name}: cannot decode request", str(exc))
-            query.reply_err(f"cannot decode {self.service_type} request: {exc}".encode())
+        except Exception as exc:  # the request's type is checked here, before the handler
+            self.context.drop(f"{self.name}: cannot decode request", _one_line(str(exc)))
+            query.reply_err(_one_line(f"{_BAD_REQUEST}not a {self.service_type} request "
+                                      f"({len(payload)} bytes): {exc}").encode())
             query.drop()
             return
         self.node.callbacks.submit(self._handle, Responder(self, query, attachment), request)
@@ -144,13 +273,22 @@ class ServiceServer(_ServiceEndpoint):
     def _handle(self, responder: Responder, request: Any) -> None:
         self.handled += 1
         try:
+            for check in self.checks:
+                check(request)
             if self.deferred:
                 self.handler(request, responder)
             else:
                 responder.reply(self.handler(request))
+        except RequestError as exc:
+            log.warning("service %s: bad request from client %s: %s", self.name,
+                        responder.caller_gid.hex()[:12], exc.detail)
+            responder.fail(exc)
         except Exception as exc:
-            log.error("service %s: handler raised %s: %s", self.name, type(exc).__name__, exc,
-                      exc_info=True)
+            first = type(exc) not in self._traced
+            self._traced.add(type(exc))
+            log.error("service %s: the handler raised %s: %s%s", self.name, type(exc).__name__,
+                      _one_line(str(exc)), "" if first else " (traceback logged before)",
+                      exc_info=first)
             responder.fail(exc)
 
     def destroy(self) -> None:
@@ -173,11 +311,22 @@ class ServiceClient(_ServiceEndpoint):
         return self.context.graph.wait_for(lambda graph: self.service_is_ready(), timeout)
 
     def call(self, request: Any, timeout: float = 5.0) -> Any:
-        """Send ``request`` and return the response; raise :class:`ServiceError` on failure."""
+        """Send ``request`` and return the response; raise :class:`ServiceError` on failure:
+        :class:`RequestError` for a request that does not fit the request type (nothing is
+        sent) or that the server refused, :class:`ServiceTimeoutError` without a reply."""
         if not isinstance(request, self.request_class):
             raise TypeError(f"call {self.name}: expected {self.service_type}_Request, "
                             f"got {type(request).__name__}")
-        payload = self.context.types.serialize(request, f"{self.service_type}_Request")
+        request_type = f"{self.service_type}_Request"
+        try:
+            payload = self.context.types.serialize(request, request_type)
+        except Exception as exc:
+            problem = field_problem(self.context.types, request_type, request)
+            if problem is None:
+                raise RequestError("", f"cannot send it ({type(exc).__name__}: {exc})",
+                                   self.name) from exc
+            field, _colon, reason = problem.partition(": ")
+            raise RequestError(field, reason, self.name) from exc
         attachment = Attachment(next(self._sequence), time.time_ns(), self.gid)
         replies = self.context.session.get(
             self.key, payload=payload.obj, attachment=attachment.encode(),
@@ -191,11 +340,13 @@ class ServiceClient(_ServiceEndpoint):
                                                           f"{self.service_type}_Response")
                 except Exception as exc:
                     raise ServiceError(f"service {self.name}: cannot decode the response: "
-                                       f"{exc}") from exc
+                                       f"{_one_line(str(exc))}") from exc
             if reply.err is not None:
-                text = reply.err.payload.to_string()
+                text = _one_line(reply.err.payload.to_bytes().decode("utf-8", "replace"))
                 if text == "Timeout":
                     break
+                if text.startswith(_BAD_REQUEST):
+                    raise RequestError("", text.removeprefix(_BAD_REQUEST), self.name)
                 raise ServiceError(f"service {self.name} failed: {text}")
         if time.monotonic() - started >= timeout * 0.9:
             raise ServiceTimeoutError(f"service {self.name}: no reply within {timeout:g} s")

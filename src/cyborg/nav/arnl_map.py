@@ -15,6 +15,12 @@ A map file is text, one record per line::
 Files store millimetres and degrees; :func:`read_map` converts to metres and radians, so nothing
 beyond this module ever sees a millimetre. Errors are :class:`MapError` naming file and line.
 
+A map may come from anyone (the ``load_map_file`` service takes a path from any client), so
+reading it is bounded: fields are split in linear time by ARIA's quoting rules, every
+coordinate and heading must be finite and within 10 km (:mod:`cyborg.nav.map_syntax`), and the
+file's size, the grid it needs and its number of objects are capped (:mod:`cyborg.nav.map_limits`,
+with the environment variables that raise each cap).
+
 The format is ASCII, but names and descriptions are free text, and the tools that write maps
 disagree on how to store "ø": ARIA copies bytes, Windows editors write the ANSI code page
 (Windows-1252, a superset of Latin-1), newer editors UTF-8, some with a byte-order mark.
@@ -28,23 +34,26 @@ from __future__ import annotations
 
 import codecs
 import math
-import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from cyborg.nav.map_objects import MapObject
+from cyborg.nav.map_limits import MapLimits, check_grid, map_limits, read_capped
+from cyborg.nav.map_objects import MapObject, declared_categories
+from cyborg.nav.map_syntax import (
+    MAX_COORDINATE_MM,
+    MapError,
+    check_header,
+    coordinate,
+    out_of_bounds,
+    split_fields,
+)
+
+__all__ = ["MAP_INTROS", "ArnlMap", "MapError", "MapType", "decode_map_bytes", "parse_map",
+           "read_map", "split_fields"]
 
 MAP_INTROS = ("2D-Map", "2D-Map-Ex", "2D-Map-Ex2", "2D-Map-Ex3", "2D-Map-Ex4")
-
-
-class MapError(ValueError):
-    """A map file that cannot be read; the message names the file and the line."""
-
-    def __init__(self, source: str, line: int, message: str) -> None:
-        super().__init__(f"{source}:{line}: {message}" if line else f"{source}: {message}")
-        self.source, self.line, self.reason = source, line, message
 
 
 @dataclass(frozen=True)
@@ -128,19 +137,17 @@ class ArnlMap:
 
 
 # ---------------------------------------------------------------------- reading
-def read_map(path: str | Path) -> ArnlMap:
-    """Read an ARNL map file; :class:`MapError` (file and line) if it is not one."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise MapError(str(path), 0, f"cannot read the map: {exc.strerror or exc}") from exc
+def read_map(path: str | Path, limits: MapLimits | None = None) -> ArnlMap:
+    """Read an ARNL map file; :class:`MapError` (file and line) if it is not one, or if it
+    exceeds a cap of ``limits`` (default: :func:`~cyborg.nav.map_limits.map_limits`)."""
+    limits = limits or map_limits()
+    raw = read_capped(path, limits.max_bytes)
     try:
         text = decode_map_bytes(raw)
     except UnicodeDecodeError as exc:
         raise MapError(str(path), 0, f"starts with a UTF-16 byte-order mark but is not UTF-16 "
                                      f"({exc.reason} at byte {exc.start})") from exc
-    return parse_map(text, str(path))
+    return parse_map(text, str(path), limits)
 
 
 def decode_map_bytes(raw: bytes) -> str:
@@ -175,12 +182,15 @@ def _decode_line(line: bytes) -> str:
     return line.decode("latin-1")  # never fails: every byte is a character
 
 
-def parse_map(text: str, source: str = "<map>") -> ArnlMap:
+def parse_map(text: str, source: str = "<map>", limits: MapLimits | None = None) -> ArnlMap:
     """Parse the text of a map file; ``source`` names it in error messages.
 
     Lines end at LF, CR LF or CR, and nowhere else: ``str.splitlines`` would also break at
     characters such as U+0085 or U+2028 inside a name, and shift every later line number.
+    The map is checked against ``limits`` (objects while reading; the grid it needs at 5 cm
+    at the end), so a map that loads can be planned on and simulated.
     """
+    limits = limits or map_limits()
     text = text.removeprefix("\ufeff")
     rows = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     first = next((index for index, row in enumerate(rows) if row.strip()), None)
@@ -193,6 +203,7 @@ def parse_map(text: str, source: str = "<map>") -> ArnlMap:
     section: str | None = None  # e.g. "LINES", "DATA", "Laser2_LINES"
     section_rows: list[str] = []
     section_lines: list[int] = []
+    counts = {"Cairn": 0, "MapInfo": 0, "header": 0}
     for index in range(first + 1, len(rows)):
         row = rows[index].strip()
         if not row:
@@ -208,20 +219,36 @@ def parse_map(text: str, source: str = "<map>") -> ArnlMap:
         if section is not None:
             _store_section(result, section, section_rows, section_lines, source)
             section, section_rows, section_lines = None, [], []
-        _header_line(result, row, index + 1, source)
+        _header_line(result, row, index + 1, source, limits, counts)
     _store_section(result, section, section_rows, section_lines, source)
-    result.objects = [item.classified(result.types) for item in result.objects]
+    declared = declared_categories(result.types)
+    result.objects = [item.classified(declared) for item in result.objects]
+    for item in result.objects:
+        if (item.is_forbidden_line or item.is_forbidden_area) and item.region is None:
+            raise MapError(source, item.line or 0, f"Cairn {item.kind} {item.name!r}: a "
+                           "forbidden zone needs its region (from x, from y, to x, to y after "
+                           "the name)")
+    check_grid(result, limits=limits)
     return result
 
 
-def _header_line(result: ArnlMap, row: str, line: int, source: str) -> None:
+def _header_line(result: ArnlMap, row: str, line: int, source: str, limits: MapLimits,
+                 counts: dict[str, int]) -> None:
+    """One ``Key: values`` line; ``counts`` (Cairn, MapInfo, other header lines so far) are
+    held to the cap on objects."""
     key, colon, rest = row.partition(":")
     if not colon or not key or " " in key:
         raise MapError(source, line, f"expected 'Key: values', LINES or DATA, found {row[:60]!r}")
+    kind = key if key in ("Cairn", "MapInfo") else "header"
+    counts[kind] += 1
+    if counts[kind] > limits.max_objects:
+        raise MapError(source, line, f"more than {limits.max_objects:,} "
+                                     f"{'other header' if kind == 'header' else kind} lines, the "
+                                     "cap for a map; set CYBORG_MAP_MAX_OBJECTS to raise it")
     try:
-        tokens = shlex.split(rest, posix=True)
+        tokens = split_fields(rest)
     except ValueError as exc:
-        raise MapError(source, line, f"{key}: {exc} (an unbalanced quote?)") from exc
+        raise MapError(source, line, f"{key}: {exc}") from None
     if key == "Cairn":
         result.objects.append(_cairn(tokens, line, source))
     elif key == "MapInfo":
@@ -230,26 +257,30 @@ def _header_line(result: ArnlMap, row: str, line: int, source: str) -> None:
         settings = dict(token.partition("=")[::2] for token in tokens[1:])
         result.types.append(MapType(tokens[0], settings, line))
     else:
+        check_header(key, tokens, source, line)
         result.header.setdefault(key, []).extend(tokens)
+
+
+_REGION = ("from_x", "from_y", "to_x", "to_y")
 
 
 def _cairn(tokens: list[str], line: int, source: str) -> MapObject:
     """``Type x y th "desc" icon "name" [fromX fromY toX toY]`` (mm, degrees)."""
     if len(tokens) < 7:
+        hint = ("; a field holds a quote: a quoted field ends only at a quote before a space "
+                "or the line's end" if any('"' in token for token in tokens) else "")
         raise MapError(source, line, f"Cairn needs at least 7 fields (type x y heading "
-                                     f"\"description\" icon \"name\"), found {len(tokens)}")
+                                     f"\"description\" icon \"name\"), found {len(tokens)}{hint}")
     kind, name = tokens[0], tokens[6]
     what = f"Cairn {kind} {name!r}" if name else f"Cairn {kind}"
-    try:
-        x, y, heading = (float(value) for value in tokens[1:4])
-        region = None
-        if len(tokens) >= 11:
-            fx, fy, tx, ty = (float(value) / 1000 for value in tokens[7:11])
-            region = (fx, fy, tx, ty)
-    except ValueError as exc:
-        raise MapError(source, line, f"{what}: a coordinate is not a number ({exc})") from exc
-    if not all(math.isfinite(value) for value in (x, y, heading)):
-        raise MapError(source, line, f"{what}: coordinates must be finite")
+    x, y = (coordinate(tokens[index], what, field, source, line)
+            for index, field in ((1, "x"), (2, "y")))
+    heading = coordinate(tokens[3], what, "heading", source, line, unit="degrees")
+    region = None
+    if len(tokens) >= 11:
+        fx, fy, tx, ty = (coordinate(token, what, field, source, line) / 1000
+                          for token, field in zip(tokens[7:11], _REGION, strict=True))
+        region = (fx, fy, tx, ty)
     return MapObject(kind=kind, x=x / 1000, y=y / 1000, theta=math.radians(heading),
                      description=tokens[4], icon=tokens[5], name=name, region=region,
                      line=line)
@@ -271,26 +302,46 @@ def _store_section(result: ArnlMap, section: str | None, rows: list[str], lines:
         result.sensor_points[section.removesuffix("_DATA")] = array
 
 
+_FIELDS = {2: ("x", "y"), 4: ("x1", "y1", "x2", "y2")}
+_ROWS_AT_ONCE = 65_536  # rows converted together: few temporary objects, whatever the file
+
+
 def _numbers(rows: list[str], width: int, lines: list[int], source: str,
              section: str) -> np.ndarray:
-    """Rows of ``width`` numbers as an array; a bad row is named by its line."""
-    if not rows:
-        return np.zeros((0, width))
-    split = [row.split() for row in rows]
-    for tokens, line, row in zip(split, lines, rows, strict=True):
-        if len(tokens) != width:
-            raise MapError(source, line, f"{section}: expected {width} numbers, found {row[:60]!r}")
-    try:
-        values = np.array([token for tokens in split for token in tokens], dtype=np.float64)
-    except ValueError:
-        values = None
-    if values is not None and np.isfinite(values).all():
-        return values.reshape(-1, width)
-    for tokens, line, row in zip(split, lines, rows, strict=True):  # find the culprit
+    """Rows of ``width`` coordinates (mm) as an array; a bad row is named by its line, and a
+    number that is not finite or lies beyond the bound by its line and field too.
+
+    Rows are converted a block at a time, joined and split once per block: millions of
+    per-row lists kept alive at once would cost seconds of garbage collection and gigabytes.
+    """
+    for index, row in enumerate(rows):  # each list is freed at once
+        if len(row.split()) != width:
+            raise MapError(source, lines[index], f"{section}: expected {width} numbers, found "
+                                                 f"{row[:60]!r}")
+    blocks = [np.zeros((0, width))]
+    for start in range(0, len(rows), _ROWS_AT_ONCE):
+        block = rows[start:start + _ROWS_AT_ONCE]
+        tokens = " ".join(block).split()
         try:
-            ok = all(math.isfinite(float(token)) for token in tokens)
-        except ValueError:
-            ok = False
-        if not ok:
-            raise MapError(source, line, f"{section}: expected {width} numbers, found {row[:60]!r}")
-    raise AssertionError("unreachable: every row parsed")
+            values = np.fromiter(map(float, tokens), dtype=np.float64, count=len(tokens))
+        except ValueError:  # name the culprit's line
+            for index, token in enumerate(tokens):
+                _number(token, width, section, source, lines[start + index // width],
+                        block[index // width])
+            raise
+        outside = ~(np.abs(values) <= MAX_COORDINATE_MM)  # NaN compares false
+        if outside.any():
+            index = int(np.argmax(outside))
+            row_index, column = divmod(index, width)
+            raise MapError(source, lines[start + row_index], out_of_bounds(
+                section, _FIELDS[width][column], tokens[index]))
+        blocks.append(values.reshape(-1, width))
+    return np.concatenate(blocks)
+
+
+def _number(token: str, width: int, section: str, source: str, line: int, row: str) -> None:
+    try:
+        float(token)
+    except ValueError:
+        raise MapError(source, line, f"{section}: expected {width} numbers, found "
+                                     f"{row[:60]!r}") from None

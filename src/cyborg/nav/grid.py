@@ -23,6 +23,7 @@ import numpy as np
 from scipy import ndimage
 
 from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.map_limits import CHUNK, check_grid, grid_shape, segment_samples
 from cyborg.nav.map_objects import MapObject
 
 
@@ -47,13 +48,17 @@ class MapGrid:
     @classmethod
     def from_map(cls, arnl_map: ArnlMap, resolution: float = 0.1, *,
                  sim_obstacles: bool = False, margin: float = 1.0) -> MapGrid:
-        """Rasterise ``arnl_map``; ``sim_obstacles`` adds the simulator's boxes to the walls."""
-        if resolution <= 0:
+        """Rasterise ``arnl_map``; ``sim_obstacles`` adds the simulator's boxes to the walls.
+
+        MapError (a ValueError naming the map) before anything is allocated if the grid would
+        exceed the cell cap or drawing it the drawing cap (:mod:`cyborg.nav.map_limits`).
+        """
+        if not resolution > 0 or not math.isfinite(resolution):
             raise ValueError(f"grid resolution must be positive, not {resolution}")
-        min_x, min_y, max_x, max_y = arnl_map.bounds()
-        origin_x, origin_y = min_x - margin, min_y - margin
-        columns = math.ceil((max_x - origin_x + margin) / resolution) + 1
-        rows = math.ceil((max_y - origin_y + margin) / resolution) + 1
+        check_grid(arnl_map, resolution, margin)
+        bounds = arnl_map.bounds()
+        origin_x, origin_y = bounds[0] - margin, bounds[1] - margin
+        rows, columns = grid_shape(bounds, resolution, margin)
         grid = cls(origin_x, origin_y, resolution, np.zeros((rows, columns), bool),
                    np.zeros((rows, columns), bool))
         grid.mark_points(grid.walls, arnl_map.points)
@@ -102,12 +107,21 @@ class MapGrid:
             layer[rows, columns] = True
 
     def mark_segments(self, layer: np.ndarray, segments: np.ndarray) -> None:
-        """Mark every cell an (N, 4) array of segments passes through (sampled finely)."""
+        """Mark every cell an (N, 4) array of segments passes through (sampled finely, a
+        chunk of segments at a time so the samples never need more than a few MB)."""
         if len(segments) == 0:
             return
+        counts = segment_samples(segments, self.resolution)
+        ends = np.cumsum(counts)
+        begin = 0
+        while begin < len(segments):
+            done = int(ends[begin - 1]) if begin else 0
+            end = max(begin + 1, int(np.searchsorted(ends, done + CHUNK, side="right")))
+            self._mark_samples(layer, segments[begin:end], counts[begin:end])
+            begin = end
+
+    def _mark_samples(self, layer: np.ndarray, segments: np.ndarray, counts: np.ndarray) -> None:
         starts, ends = segments[:, :2], segments[:, 2:]
-        lengths = np.hypot(*(ends - starts).T)
-        counts = np.maximum(2, np.ceil(lengths / (self.resolution / 3)).astype(np.int64) + 1)
         owner = np.repeat(np.arange(len(segments)), counts)
         first = np.concatenate([[0], np.cumsum(counts)[:-1]])
         t = (np.arange(counts.sum()) - np.repeat(first, counts)) / np.repeat(counts - 1, counts)
@@ -115,22 +129,25 @@ class MapGrid:
         self.mark_points(layer, samples)
 
     def fill_area(self, layer: np.ndarray, area: MapObject) -> None:
-        """Mark the cells whose centres lie inside an area object (rotation included)."""
+        """Mark the cells whose centres lie inside an area object (rotation included), a band
+        of rows at a time."""
         corners = area.corners()
         if corners is None or len(corners) != 4:
             return
         low_r, low_c = self.cells_of(corners.min(axis=0, keepdims=True))
         high_r, high_c = self.cells_of(corners.max(axis=0, keepdims=True))
-        r, c = np.mgrid[low_r[0]:high_r[0] + 1, low_c[0]:high_c[0] + 1]
-        x = self.origin_x + (c + 0.5) * self.resolution
-        y = self.origin_y + (r + 0.5) * self.resolution
         assert area.region is not None
         fx, fy, tx, ty = area.region
         cos, sin = math.cos(-area.theta), math.sin(-area.theta)
-        ux, uy = x * cos - y * sin, x * sin + y * cos
-        inside = ((ux >= min(fx, tx)) & (ux <= max(fx, tx))
-                  & (uy >= min(fy, ty)) & (uy <= max(fy, ty)))
-        layer[r[inside], c[inside]] = True
+        band = max(1, CHUNK // int(high_c[0] - low_c[0] + 1))
+        for top in range(int(low_r[0]), int(high_r[0]) + 1, band):
+            r, c = np.mgrid[top:min(top + band, int(high_r[0]) + 1), low_c[0]:high_c[0] + 1]
+            x = self.origin_x + (c + 0.5) * self.resolution
+            y = self.origin_y + (r + 0.5) * self.resolution
+            ux, uy = x * cos - y * sin, x * sin + y * cos
+            inside = ((ux >= min(fx, tx)) & (ux <= max(fx, tx))
+                      & (uy >= min(fy, ty)) & (uy <= max(fy, ty)))
+            layer[r[inside], c[inside]] = True
         self.mark_segments(layer, np.array([[*corners[i], *corners[(i + 1) % 4]]
                                             for i in range(4)]))  # thin areas stay closed
 

@@ -21,6 +21,7 @@ simulator obstacles.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -75,9 +76,10 @@ class MapObject:
     def is_sim_obstacle(self) -> bool:
         return self.category == SIM_OBSTACLE
 
-    def classified(self, types: list[MapType]) -> MapObject:
-        """This object with its category, given the map's ``MapInfo`` declarations."""
-        return replace(self, category=_category(self.kind, self.region is not None, types))
+    def classified(self, declared: Mapping[str, str]) -> MapObject:
+        """This object with its category, given the map's ``MapInfo`` declarations as
+        :func:`declared_categories` maps them (built once per map, not once per object)."""
+        return replace(self, category=_category(self.kind, self.region is not None, declared))
 
     # ------------------------------------------------------------------ geometry
     def corners(self) -> np.ndarray | None:
@@ -106,7 +108,13 @@ class MapObject:
         return min(fx, tx) <= ux <= max(fx, tx) and min(fy, ty) <= uy <= max(fy, ty)
 
 
-def _category(kind: str, has_region: bool, types: list[MapType]) -> str:
+def declared_categories(types: Iterable[MapType]) -> dict[str, str]:
+    """Declared type name → category (``GoalType``, ``DockType`` ...); a later declaration of
+    the same name wins."""
+    return {declaration.name: declaration.category for declaration in types}
+
+
+def _category(kind: str, has_region: bool, declared: Mapping[str, str]) -> str:
     if kind == "Goal":
         return GOAL
     if kind == "GoalWithHeading":
@@ -121,7 +129,6 @@ def _category(kind: str, has_region: bool, types: list[MapType]) -> str:
         return FORBIDDEN_AREA
     if kind.startswith("Sim.") and has_region:
         return SIM_OBSTACLE
-    declared = {declaration.name: declaration.category for declaration in types}
     category = declared.get(kind)
     if category == "DockType":
         return DOCK

@@ -83,11 +83,18 @@ class Planner:
 
     # ------------------------------------------------------------------ checks
     def check(self, pose: Pose2D, role: str = "goal") -> tuple[str, str] | None:
-        """``(code, reason)`` if the robot cannot stand at ``pose``, else None."""
+        """``(code, reason)`` if the robot cannot stand at ``pose``, else None.
+
+        A pose that is not finite (NaN or infinite, from a service request or the command
+        line) is off the map: it has no cell, and a heading of NaN could never be reached.
+        """
         grid = self.grid
-        row, column = grid.cell(pose.x, pose.y)
         occupied = START_OCCUPIED if role == "start" else GOAL_OCCUPIED
         where = f"{role} ({pose.x:.2f}, {pose.y:.2f})"
+        if not all(math.isfinite(value) for value in (pose.x, pose.y, pose.theta)):
+            return ((OUTSIDE_MAP if role == "start" else GOAL_OCCUPIED),
+                    f"{where} heading {pose.theta:.2f} is not a finite pose")
+        row, column = grid.cell(pose.x, pose.y)
         if not grid.inside(row, column):
             return (OUTSIDE_MAP if role == "start" else GOAL_OCCUPIED), f"{where} is off the map"
         if grid.forbidden[row, column]:

@@ -16,21 +16,54 @@ service                          type                            answers
 
 The map can be switched while running: :class:`NavigationMap` holds the current map and its
 planner and tells listeners (the simulator) when it changes. A map that fails to load leaves the
-old one in place and the reply says why (file and line).
+old one in place and the reply says why (file and line). Loading runs on its own thread, one
+map at a time, so the node's other services (the simulator's ``stop``) keep answering; only
+``.map`` files are read, so the reply never quotes some other file to a caller.
+
+Requests are checked before the handlers run: a pose with a NaN or infinite number is refused
+with ``bad request: goal.x: nan is not a finite number`` (see :func:`require_finite`).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import logging
 import math
 import threading
 from collections.abc import Callable
 from pathlib import Path as FilePath
 from typing import Any
 
+import numpy as np
+
 from cyborg.bus import Node, new_message
+from cyborg.bus.services import RequestError, Responder
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose, Pose2D
 from cyborg.nav.planner import Planner, PlanResult
+
+log = logging.getLogger("cyborg.nav")
+
+
+def require_finite(message: Any, path: str = "") -> None:
+    """RequestError naming the first number in ``message`` (a request, at any depth) that is
+    NaN or infinite, e.g. ``goal.position.x``: no pose, distance or heading can be one."""
+    if isinstance(message, float | np.floating):
+        if not math.isfinite(message):
+            raise RequestError(path, f"{message!r} is not a finite number")
+    elif isinstance(message, np.ndarray) and message.dtype.kind == "f":
+        bad = np.flatnonzero(~np.isfinite(message))
+        if len(bad):
+            raise RequestError(f"{path}[{bad[0]}]", f"{message.flat[bad[0]]!r} is not a finite "
+                                                    "number")
+    elif isinstance(message, list | tuple):
+        for index, item in enumerate(message):
+            require_finite(item, f"{path}[{index}]")
+    elif dataclasses.is_dataclass(message) and not isinstance(message, type):
+        for item in dataclasses.fields(message):
+            value = getattr(message, item.name)
+            if not isinstance(value, str | bool | int):
+                require_finite(value, f"{path}.{item.name}" if path else item.name)
 
 
 class NavigationMap:
@@ -43,13 +76,16 @@ class NavigationMap:
         self.listeners: list[Callable[[ArnlMap, Planner], None]] = []
 
     def load(self, path: str | FilePath) -> ArnlMap:
-        """Read and switch to another map; MapError leaves the current one in place."""
+        """Read and switch to another map; MapError leaves the current one in place.
+
+        Listeners (the simulator) switch first: if one refuses the map, by raising, the
+        services keep the map the simulator still drives on."""
         arnl_map = read_map(path)
         planner = Planner(arnl_map)
-        with self._lock:
-            self.map, self.planner = arnl_map, planner
         for listener in list(self.listeners):
             listener(arnl_map, planner)
+        with self._lock:
+            self.map, self.planner = arnl_map, planner
         return arnl_map
 
     def plan(self, start: Pose2D, goal: Pose2D, use_heading: bool = False) -> PlanResult:
@@ -69,14 +105,16 @@ class NavigationServices:
         self._classes = {name: types.message_class(f"cyborg_msgs/srv/{name}_Response")
                          for name in ("AvailableGoals", "DistanceToGoal", "ClosestGoal",
                                       "MakePlan", "LoadMapFile")}
-        node.create_service("nav/get_available_goals", "cyborg_msgs/srv/AvailableGoals",
-                            self.available_goals)
-        node.create_service("nav/get_distance_to_goal", "cyborg_msgs/srv/DistanceToGoal",
-                            self.distance_to_goal)
-        node.create_service("nav/get_closest_goal", "cyborg_msgs/srv/ClosestGoal",
-                            self.closest_goal)
-        node.create_service("make_plan", "cyborg_msgs/srv/MakePlan", self.make_plan)
-        node.create_service("load_map_file", "cyborg_msgs/srv/LoadMapFile", self.load_map_file)
+        self._loading = threading.Lock()  # one map at a time
+        for name, service, handler in (
+                ("nav/get_available_goals", "AvailableGoals", self.available_goals),
+                ("nav/get_distance_to_goal", "DistanceToGoal", self.distance_to_goal),
+                ("nav/get_closest_goal", "ClosestGoal", self.closest_goal),
+                ("make_plan", "MakePlan", self.make_plan)):
+            node.create_service(name, f"cyborg_msgs/srv/{service}", handler).checks.append(
+                require_finite)
+        node.create_service("load_map_file", "cyborg_msgs/srv/LoadMapFile", self.load_map_file,
+                            deferred=True)
 
     def _robot(self) -> Pose2D:
         pose = self.pose()
@@ -119,10 +157,33 @@ class NavigationServices:
         return response(found=True, message="", path=result.path.to_message(self.node.types),
                         length=result.length)
 
-    def load_map_file(self, request: Any) -> Any:
+    def load_map_file(self, request: Any, responder: Responder) -> None:
+        """Load on a thread of its own and answer from there (deferred), one map at a time."""
+        reply = self._classes["LoadMapFile"]
+        path = request.path
+        if not path.lower().endswith(".map"):
+            responder.reply(reply(success=False, message=f"load_map_file: {path[:80]!r} is not "
+                                                          "an ARNL map (a .map file)"))
+            return
+        if not self._loading.acquire(blocking=False):
+            responder.reply(reply(success=False, message="another map is loading; try again "
+                                                          "when it is done"))
+            return
+        threading.Thread(target=self._load, args=(path, responder), daemon=True,
+                         name="cyborg-load-map").start()
+
+    def _load(self, path: str, responder: Responder) -> None:
+        reply = self._classes["LoadMapFile"]
         try:
-            arnl_map = self.maps.load(request.path)
+            arnl_map = self.maps.load(path)
         except MapError as exc:
-            return self._classes["LoadMapFile"](success=False, message=str(exc))
-        return self._classes["LoadMapFile"](
-            success=True, message=f"loaded {arnl_map.source}: {len(arnl_map.goals())} goals")
+            log.warning("load_map_file: %s", exc)
+            responder.reply(reply(success=False, message=str(exc)))
+        except Exception as exc:  # a listener (the simulator) failed: say so, keep serving
+            log.error("load_map_file %r: %s: %s", path, type(exc).__name__, exc, exc_info=True)
+            responder.fail(exc)
+        else:
+            responder.reply(reply(success=True, message=f"loaded {arnl_map.source}: "
+                                                        f"{len(arnl_map.goals())} goals"))
+        finally:
+            self._loading.release()

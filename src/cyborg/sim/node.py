@@ -88,9 +88,10 @@ class SimulatorNode:
 
     # ------------------------------------------------------------------ publishing
     def _stamp(self) -> Any:
-        seconds = self.sim.time
-        return self.types.message_class("builtin_interfaces/msg/Time")(
-            sec=int(seconds), nanosec=round((seconds % 1.0) * 1e9) % 1_000_000_000)
+        # Whole nanoseconds first: int() and round() of the parts apart turned 2.9999999999999996
+        # into 2 s + 0 ns, one second back, which /clock followers take for a jump.
+        sec, nanosec = divmod(round(self.sim.time * 1e9), 1_000_000_000)
+        return self.types.message_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec)
 
     def _header(self, frame: str) -> Any:
         return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
@@ -154,8 +155,11 @@ class SimulatorNode:
             intensities=np.zeros(0, np.float32))
 
     def _map_changed(self, arnl_map: ArnlMap, planner: Planner) -> None:
+        """A new map (``load_map_file``, on the loading thread): the grids are built before
+        the simulation's lock is taken, so ``stop`` and the simulation wait only for the swap."""
+        prepared = self.sim.prepare_map(arnl_map, planner=planner)
         with self.loop.lock:
-            self.sim.load_map(arnl_map, planner=planner)
+            self.sim.install_map(prepared)
 
     # ------------------------------------------------------------------ services
     def _trigger(self, success: bool, message: str) -> Any:

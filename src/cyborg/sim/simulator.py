@@ -47,6 +47,18 @@ class SimSettings:
     seed: int = 0
 
 
+@dataclass(frozen=True)
+class PreparedMap:
+    """A map with what the simulator builds from it, ready to :meth:`Simulator.install_map`."""
+
+    map: ArnlMap
+    world: MapGrid
+    planner: Planner
+    base: RobotBase
+    laser: Laser
+    start_choice: StartChoice
+
+
 class Simulator:
     """One robot in one map; see the module docstring."""
 
@@ -73,19 +85,33 @@ class Simulator:
         the map's home, or its dock, or a free point near the middle of the map
         (:mod:`cyborg.sim.start`). The choice is in ``start_choice`` and in the log: a warning
         when the map names no start, so ``cyborg sim`` shows it."""
+        self.install_map(self.prepare_map(arnl_map, start, planner))
+
+    def prepare_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
+                    planner: Planner | None = None) -> PreparedMap:
+        """Build everything a map needs (grids, clearance, laser, start) without touching the
+        running simulation: the slow half of :meth:`load_map`, which a caller can run without
+        holding the simulation's lock, then :meth:`install_map` under it."""
         settings = self.settings
         world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
         planner = planner or Planner(arnl_map)
         choice = choose_start(arnl_map, planner, start)  # an unknown name changes nothing
-        self.map, self.world, self.planner = arnl_map, world, planner
-        self.base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
-                              world.resolution)
-        self.laser = Laser(world.walls, (world.origin_x, world.origin_y), world.resolution,
-                           settings.laser, seed=settings.seed)
+        base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
+                         world.resolution)
+        laser = Laser(world.walls, (world.origin_x, world.origin_y), world.resolution,
+                      settings.laser, seed=settings.seed)
+        return PreparedMap(arnl_map, world, planner, base, laser, choice)
+
+    def install_map(self, prepared: PreparedMap) -> None:
+        """Switch to a map :meth:`prepare_map` built: quick, so it can hold the lock."""
+        settings = self.settings
+        self.map, self.world, self.planner = prepared.map, prepared.world, prepared.planner
+        self.base, self.laser = prepared.base, prepared.laser
         self.angles = settings.laser.angles()
-        self.navigator = Navigator(planner, settings.navigator)
+        self.navigator = Navigator(prepared.planner, settings.navigator)
         self.docking = Docking(settings.dock)
         self.battery.charging = False
+        choice = prepared.start_choice
         self.start_choice: StartChoice = choice
         log.log(logging.WARNING if choice.invented else logging.INFO, "%s", choice.reason)
         self.base.place(choice.pose)
