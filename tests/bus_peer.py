@@ -2,21 +2,103 @@
 
 It joins the router at ENDPOINT, sets up what ROLE says, prints ``ready`` and then lives until
 its stdin closes (the test ends) or 60 s pass, so a failing test never leaves it behind.
+
+Imported, it also gives the hostile-input tests a second session in the same process
+(:func:`linked_contexts`) and the raw tools of an attacker on the network: samples with any
+payload and attachment (:func:`raw_put`), service calls with any request (:func:`raw_call`)
+and doorbell datagrams (:func:`ring`). Everything stays on loopback.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
 import random
+import socket
 import sys
 import threading
 import time
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
 import zenoh
 
 from cyborg.bus import BusConfig, Context, Node, Qos, ServerGoal, new_message
-from cyborg.bus.wire import Attachment
+from cyborg.bus.doorbell import doorbell_address, encode
+from cyborg.bus.wire import Attachment, EntityKind, data_key, fully_qualified
+
+
+# ---------------------------------------------------------------------- in-process attacker
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def wait_for(predicate: Callable[[], object], timeout: float = 5.0) -> bool:
+    """Poll ``predicate`` until it is true or ``timeout`` wall seconds pass."""
+    deadline = time.monotonic() + timeout
+    while not predicate() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return bool(predicate())
+
+
+@contextlib.contextmanager
+def linked_contexts() -> Iterator[tuple[Context, Context]]:
+    """(victim, attacker): two sessions linked peer to peer over loopback, no router."""
+    address = f"tcp/127.0.0.1:{free_port()}"
+    victim = Context(BusConfig(connect=(), listen=(address,)))
+    attacker = Context(BusConfig(connect=(address,), listen=()))
+    try:
+        assert wait_for(lambda: attacker.session.info.peers_zid(), 10), "no loopback link"
+        yield victim, attacker
+    finally:
+        attacker.close()
+        victim.close()
+
+
+def until_subscribed(attacker: Context, topic: str, timeout: float = 5.0) -> None:
+    """Wait until the attacker's graph shows a subscription on ``topic``: data then reaches it."""
+    assert wait_for(lambda: attacker.graph.count(topic, EntityKind.SUBSCRIPTION) > 0, timeout), \
+        f"no subscription on {topic} in the graph"
+    time.sleep(0.05)  # the subscriber's declaration travels beside its token
+
+
+def forged(sequence: int, gid: bytes | None = None) -> bytes:
+    """An rmw_zenoh attachment with any sequence number and GID (random by default)."""
+    return Attachment(sequence, time.time_ns(), gid if gid is not None else os.urandom(16)) \
+        .encode()
+
+
+def raw_put(context: Context, topic: str, type_name: str, payload: bytes,
+            attachment: bytes | None) -> None:
+    """A sample on ``topic``'s data key, with whatever payload and attachment (blocking when
+    the link is congested rather than dropping, so a flood arrives whole)."""
+    key = data_key(context.domain, fully_qualified("/", topic), type_name,
+                   context.types.hash(type_name))
+    context.session.put(key, payload, attachment=attachment,
+                        congestion_control=zenoh.CongestionControl.BLOCK)
+
+
+def raw_call(context: Context, service: str, service_type: str, payload: bytes,
+             attachment: bytes | None, timeout: float = 2.0) -> list[Any]:
+    """A service request with any bytes; the replies (ok or err), as Zenoh gives them."""
+    key = data_key(context.domain, fully_qualified("/", service), service_type,
+                   context.types.hash(service_type))
+    return list(context.session.get(key, payload=payload, attachment=attachment,
+                                    timeout=timeout))
+
+
+def ring(victim: Context, entity_id: int, attachment: bytes, reference: bytes) -> None:
+    """A doorbell datagram to the victim's session, as any local process can send one."""
+    with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as sender:
+        sender.sendto(encode(entity_id, attachment, reference),
+                      doorbell_address(victim.domain, victim.zid))
+
+
+# ---------------------------------------------------------------------- roles
 
 
 def talker(node: Node) -> None:

@@ -50,13 +50,21 @@ class FakeRobot:
     can_dock: bool = True
     no_path_to: set[str] = field(default_factory=set)
     distances: dict[str, float] = field(default_factory=dict)
+    reachable: bool = True
+    """False: the robot's services and action server are gone (the simulator was killed)."""
+    send_attempts: int = 0
+    """Calls of move_to, sent or not."""
 
     def goals(self, refresh: bool = False) -> dict[str, Goal]:
+        if refresh and not self.reachable:
+            raise RobotError("service /cyborg/nav/get_available_goals is not available")
         return dict(self.goals_)
 
     def move_to(self, goal: str) -> FakeMove:
-        if goal == "offline":
-            raise RobotError("move_to_goal is not available")
+        self.send_attempts += 1
+        if goal == "offline" or not self.reachable:
+            raise RobotError(f"cannot send the robot to {goal!r}: action /cyborg/move_to_goal: "
+                             "service /cyborg/move_to_goal/_action/send_goal is not available")
         move = FakeMove(goal)
         if goal in self.no_path_to:
             move.finish(MoveOutcome.NO_PATH, "NO_VALID_PATH: cut off")

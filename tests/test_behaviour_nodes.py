@@ -3,11 +3,23 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
+from typing import Any
 
 import pytest
 
-from cyborg.bt import ERROR, FAILURE, RUNNING, SUCCESS, ManualClock, Status, Tree, loads_tree
+from cyborg.bt import (
+    ERROR,
+    FAILURE,
+    RUNNING,
+    SUCCESS,
+    ManualClock,
+    Status,
+    Tree,
+    TreeLoadError,
+    loads_tree,
+)
 from cyborg.nav.geometry import Pose2D
 from cyborg.nodes.robot import DockState, MoveOutcome
 from tests.builders import N, registry, tree_json
@@ -130,6 +142,97 @@ def test_nodes_without_a_robot_report_what_is_missing(caplog: pytest.LogCaptureF
     assert "MoveTo needs a robot to act on" in caplog.text
 
 
+def attempts_over(tree: Tree, clock: ManualClock, robot: FakeRobot, seconds: float,
+                  step: float = 0.25) -> list[float]:
+    """Tick every ``step`` s (exact in binary) for ``seconds``; the times at which the node
+    tried to send the robot."""
+    times: list[float] = []
+    for _ in range(round(seconds / step)):
+        before = robot.send_attempts
+        tree.tick()
+        if robot.send_attempts > before:
+            times.append(clock.now())
+        clock.advance(step)
+    return times
+
+
+def test_move_to_backs_off_while_the_action_server_is_gone(
+        caplog: pytest.LogCaptureFixture) -> None:
+    """The simulator was killed: move_to fails at once. The patrol must not retry every tick
+    and log a warning each time (727 warnings in 75 s)."""
+    caplog.set_level(logging.INFO, "cyborg.nodes")
+    robot, clock = FakeRobot(reachable=False), ManualClock()
+    tree = robot_tree(N("Repeater", N("MemSequence", N("MoveTo", location="home"),
+                                      N("Wait", milliseconds=2000),
+                                      N("MoveTo", location="kitchen")), maxLoop=-1),
+                      robot, clock)
+    attempts = attempts_over(tree, clock, robot, 75.0)
+    assert attempts == [0.0, 2.0, 6.0, 14.0, 30.0, 60.0], "2 s doubling, up to 30 s"
+    warnings = [record for record in caplog.records if record.levelno >= logging.WARNING]
+    assert 1 <= len(warnings) <= 3, [record.getMessage() for record in warnings]
+    assert len(caplog.records) <= 10
+    assert "tried 3 times" in warnings[0].getMessage()
+    assert "not available" in warnings[0].getMessage()
+    # the simulator is back: the next try (at most the cap later) gets through
+    robot.reachable = True
+    assert attempts_over(tree, clock, robot, 20.0) == [90.0]
+    assert robot.moves and not robot.moves[0].done
+    assert tree.tick().status is RUNNING
+
+
+def test_move_to_waits_running_between_tries_then_fails_and_keeps_its_back_off() -> None:
+    robot, clock = FakeRobot(reachable=False), ManualClock()
+    tree = robot_tree(N("MoveTo", location="home", retries=1, retryDelay=1,
+                        retryDelayMax=8), robot, clock)
+    assert run(tree, clock, 1.0, 0.25) == [RUNNING] * 4 and robot.send_attempts == 1
+    assert "trying again in 1 s" in reason(tree)
+    assert tree.tick().status is FAILURE and robot.send_attempts == 2, "1 try + 1 retry"
+    assert "tried 2 times" in reason(tree) and "not available" in reason(tree)
+    # the next activation does not hammer the server: it waits out the back-off first (2 s)
+    clock.advance(0.25)
+    assert run(tree, clock, 1.75, 0.25) == [RUNNING] * 7 and robot.send_attempts == 2
+    assert "waiting" in reason(tree)
+    robot.reachable = True
+    assert tree.tick().status is RUNNING and robot.send_attempts == 3 and robot.moves
+
+
+def test_the_back_off_doubles_up_to_its_cap_and_starts_again_after_a_send() -> None:
+    robot, clock = FakeRobot(reachable=False), ManualClock()
+    tree = robot_tree(N("MoveTo", location="home", retries=100, retryDelay=1,
+                        retryDelayMax=4), robot, clock)
+    assert attempts_over(tree, clock, robot, 19.5) == [0.0, 1.0, 3.0, 7.0, 11.0, 15.0, 19.0]
+    robot.reachable = True
+    assert attempts_over(tree, clock, robot, 4.0) == [23.0]
+    robot.reachable = False
+    robot.moves[0].finish(MoveOutcome.FAILED, "FAILED_MOVE: stuck")  # retried at once...
+    assert attempts_over(tree, clock, robot, 3.5) == [23.5, 24.5, 26.5], "...back off from 1 s"
+
+
+def test_an_unreachable_map_service_backs_off_too() -> None:
+    robot, clock = FakeRobot(reachable=False), ManualClock()
+    tree = robot_tree(N("MoveTo", location="attic"), robot, clock)  # not cached: asks again
+    assert tree.tick().status is RUNNING
+    assert "get_available_goals is not available" in reason(tree)
+
+
+@pytest.mark.parametrize("props", [{"retryDelay": 0}, {"retryDelay": -1},
+                                   {"retryDelayMax": 0.5}, {"retryDelay": "soon"}])
+def test_bad_back_off_properties_are_load_errors(props: dict[str, Any]) -> None:
+    with pytest.raises(TreeLoadError, match="retryDelay"):
+        robot_tree(N("MoveTo", location="home", **props), FakeRobot())
+
+
+def test_a_missing_goal_in_a_loop_is_logged_once_per_interval(
+        caplog: pytest.LogCaptureFixture) -> None:
+    robot, clock = FakeRobot(), ManualClock()
+    tree = robot_tree(N("Repeater", N("MoveTo", location="attic"), maxLoop=-1), robot, clock)
+    run(tree, clock, 20.0)  # fails every tick: nothing to back off from, the goal is not there
+    warnings = [record.getMessage() for record in caplog.records
+                if record.levelno >= logging.WARNING]
+    assert 1 <= len(warnings) <= 4, warnings
+    assert "no goal named 'attic'" in warnings[0]
+
+
 # ---------------------------------------------------------------------------------- battery
 def test_check_battery_is_a_latching_guard() -> None:
     robot, clock = FakeRobot(), ManualClock()
@@ -163,6 +266,19 @@ def test_charge_fails_when_docking_is_refused_or_fails() -> None:
     full = robot_tree(N("Charge", target=90), FakeRobot(), clock)
     full.blackboard.resources["robot"].set_battery(91.0)
     assert full.tick().status is SUCCESS
+
+
+def test_a_refused_dock_in_a_loop_is_logged_once_per_interval(
+        caplog: pytest.LogCaptureFixture) -> None:
+    robot, clock = FakeRobot(can_dock=False), ManualClock()
+    robot.set_battery(20.0)
+    tree = robot_tree(N("Priority", N("CheckBattery", N("Charge", target=95), threshold=25),
+                        N("Runner")), robot, clock)
+    run(tree, clock, 20.0)
+    assert robot.dock_requests == 200, "the guard asks every tick"
+    warnings = [record.getMessage() for record in caplog.records
+                if record.levelno >= logging.WARNING]
+    assert 1 <= len(warnings) <= 2 and "the map has no Dock" in warnings[0], warnings
 
 
 def test_charge_times_out_when_docking_never_starts() -> None:

@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import sys
 import threading
+import time
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +18,7 @@ from cyborg.bus import Node, Qos, new_message
 from cyborg.sim.docking import DockState
 from tests.small_maps import room_map, write
 from tests.system import running_system, wait_until, write_tree
+from tests.test_runner_services import refused_or_timed_out, release_fifo
 
 FAILER_MODULE = """
 from cyborg.bt import Action, Status, register
@@ -22,6 +27,23 @@ from cyborg.bt import Action, Status, register
 class Explode(Action):
     def tick(self) -> Status:
         raise RuntimeError("boom: a faulty sensor driver")
+"""
+
+
+HANGING_MODULE = """
+import threading
+
+from cyborg.bt import Action, Status, register
+
+GATE = threading.Event()
+
+@register
+class HangsWhileBuilt(Action):
+    def __init__(self) -> None:
+        GATE.wait(30.0)  # a model that takes forever to load
+
+    def tick(self) -> Status:
+        return Status.RUNNING
 """
 
 
@@ -147,6 +169,48 @@ def test_reload_rejects_a_bad_file_and_keeps_running(patrol: Path, amroffice: Pa
             what="the robot heading to room2")
         again = system.call("/cyborg/bt/reload", "cyborg_msgs/srv/ReloadTree", path="")
         assert again.success and str(small) in again.message
+
+
+def test_enable_stops_the_robot_at_once_while_a_reload_hangs(
+        patrol: Path, amroffice: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A reload that never ends must not hold the stop button: enable(false) is answered within
+    a second and the robot stops; the reload is answered with a timeout error and the patrol
+    tree stays loaded. The load hangs in a node's constructor (a FIFO used to do it; the loader
+    now refuses one at once, so it is tried too)."""
+    (tmp_path / "hanging_nodes.py").write_text(HANGING_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    hangs = write_tree(tmp_path, {"name": "HangsWhileBuilt"}, "hangs.b3.json")
+    fifo = tmp_path / "never.b3.json"
+    os.mkfifo(fifo)
+    with running_system(amroffice, patrol, speed=10, start="Dock",
+                        registry_modules=["hanging_nodes"]) as system:
+        gate = sys.modules["hanging_nodes"].GATE
+        system.runner.node.parameters.set({"reload_timeout": 2.0})
+        wait_until(lambda: system.sim.base.speed > 0.2, what="the robot driving")
+        reload = system.client.create_client("/cyborg/bt/reload", "cyborg_msgs/srv/ReloadTree")
+
+        def reload_async(path: Path) -> Future[Any]:
+            return reload.call_async(new_message(system.client.types,
+                                                 "cyborg_msgs/srv/ReloadTree_Request",
+                                                 {"path": str(path)}), timeout=10)
+        try:
+            answer = reload_async(fifo).result(8)
+            assert not answer.success and refused_or_timed_out(answer.message, "2 s"), \
+                answer.message
+            pending = reload_async(hangs)
+            threading.Event().wait(0.3)  # the reload has started and hangs
+            started = time.monotonic()
+            reply = system.call("/cyborg/bt/enable", "std_srvs/srv/SetBool", data=False)
+            took = time.monotonic() - started
+            assert reply.success and took < 1.0, f"enable answered after {took:.2f} s"
+            wait_until(lambda: abs(system.sim.base.speed) < 0.01, timeout=5,
+                       what="the robot to stop")
+            answer = pending.result(8)
+            assert not answer.success and "did not finish within 2 s" in answer.message
+            assert system.runner.path == patrol
+        finally:
+            gate.set()
+            release_fifo(fifo)
 
 
 def test_unreachable_goal_makes_move_to_fail_not_hang(tmp_path: Path) -> None:

@@ -137,7 +137,7 @@ class TreeRunner:
         returns something other than RUNNING. RUNNING nodes are halted on the way out."""
         period = 1.0 / self.rate_hz
         clock = self.clock
-        anchor = clock.now()  # ticks are due at anchor + slot * period (no drift from sums)
+        anchor = now = clock.now()  # ticks are due at anchor + slot * period (no drift)
         slot = 0
         done = 0
         try:
@@ -157,9 +157,9 @@ class TreeRunner:
                     break
                 slot += 1
                 due = anchor + slot * period
-                now = clock.now()
-                if due < now:  # overran: restart the schedule rather than burst
-                    anchor, slot, due = now, 0, now
+                before, now = now, clock.now()
+                if due < now or now < before:  # overran, or the clock went back (a restarted
+                    anchor, slot, due = now, 0, now  # simulation): restart the schedule
                 clock.sleep_until(due, self._wake)
         finally:
             with self._tick_lock:

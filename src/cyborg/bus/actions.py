@@ -41,6 +41,10 @@ log = logging.getLogger("cyborg.bus")
 STATUS_QOS = Qos.latched(depth=1)
 KEEP_FINISHED = 100
 """Finished goals whose results can still be fetched."""
+MAX_GOALS = 100
+"""Goals a server runs at once (each has a thread); more are rejected until some finish."""
+MAX_RESULT_WAITERS = 16
+"""get_result requests one running goal holds open; more are answered with an error at once."""
 
 
 class GoalStatus(IntEnum):
@@ -109,18 +113,23 @@ class ActionServer:
     """Accepts goals, runs ``execute(goal) -> result`` for each, answers result requests.
 
     ``accept(request) -> bool`` may reject goals; ``cancel(goal) -> bool`` may refuse a cancel.
+
+    Goal ids come from clients, so the tables keyed by them are bounded: a goal id the server
+    already knows is rejected (as rcl_action does), at most ``max_goals`` goals run at once,
+    and at most ``MAX_RESULT_WAITERS`` result requests wait for one goal.
     """
 
     def __init__(self, node: Node, name: str, action_type: str,
                  execute: Callable[[ServerGoal], Any], *,
                  accept: Callable[[Any], bool] | None = None,
-                 cancel: Callable[[ServerGoal], bool] | None = None) -> None:
+                 cancel: Callable[[ServerGoal], bool] | None = None,
+                 max_goals: int = MAX_GOALS) -> None:
         types = node.types
         if action_type not in types.actions:
             raise KeyError(f"{name}: unknown action type {action_type!r}")
         self.node, self.types, self.action_type = node, types, action_type
         self.execute, self.accept, self.allow_cancel = execute, accept, cancel
-        self.name = name
+        self.name, self.max_goals = name, max_goals
         self._goals: dict[bytes, ServerGoal] = {}
         self._results: dict[bytes, tuple[GoalStatus, Any]] = {}
         self._waiting: dict[bytes, list[Responder]] = {}
@@ -142,7 +151,12 @@ class ActionServer:
 
     def _on_goal(self, request: Any) -> Any:
         goal_id = bytes(request.goal_id.uuid)
-        accepted = self.accept(request.goal) if self.accept is not None else True
+        refusal = self._refusal(goal_id)
+        if refusal:
+            log.warning("action %s: goal %s rejected: %s", self.name, goal_id.hex(), refusal)
+            accepted = False
+        else:
+            accepted = self.accept(request.goal) if self.accept is not None else True
         response = self.types.message_class(f"{self.action_type}_SendGoal_Response")(
             accepted=bool(accepted), stamp=_stamp(self.types))
         if accepted:
@@ -154,6 +168,16 @@ class ActionServer:
             threading.Thread(target=self._run, args=(goal,), daemon=True,
                              name=f"cyborg-goal{self.name}").start()
         return response
+
+    def _refusal(self, goal_id: bytes) -> str:
+        """Why a goal cannot be taken whatever it asks for; empty if it can."""
+        with self._lock:
+            if goal_id in self._goals or goal_id in self._results:
+                return "its id is already known (a replayed or duplicated request)"
+            running = sum(1 for goal in self._goals.values() if not goal.status.terminal)
+        if running >= self.max_goals:
+            return f"{running} goals are running, the most this server takes ({self.max_goals})"
+        return ""
 
     def _run(self, goal: ServerGoal) -> None:
         self._set_status(goal, GoalStatus.EXECUTING)
@@ -194,8 +218,17 @@ class ActionServer:
         with self._lock:
             finished = self._results.get(goal_id)
             if finished is None and goal_id in self._goals:
-                self._waiting.setdefault(goal_id, []).append(responder)
-                return
+                waiting = self._waiting.setdefault(goal_id, [])
+                if len(waiting) < MAX_RESULT_WAITERS:
+                    waiting.append(responder)
+                    return
+                crowded = True
+            else:
+                crowded = False
+        if crowded:
+            responder.fail(ActionError(f"{MAX_RESULT_WAITERS} requests are already waiting for "
+                                       f"the result of goal {goal_id.hex()}"))
+            return
         if finished is None:  # unknown goal: ROS answers UNKNOWN with an empty result
             result_type = f"{self.action_type}_Result"
             responder.reply(self._result_response(GoalStatus.UNKNOWN,

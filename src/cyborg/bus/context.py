@@ -16,8 +16,10 @@ import atexit
 import hashlib
 import itertools
 import logging
+import os
 import socket
 import threading
+import time
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -28,15 +30,19 @@ import zenoh
 
 from cyborg.bus.config import BusConfig
 from cyborg.bus.doorbell import Doorbell, supported
-from cyborg.bus.graph import Graph
+from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.message_types import MessageTypes
 from cyborg.bus.readonly import ReadonlyCopier
-from cyborg.bus.wire import LIVELINESS_PREFIX, domain_id
+from cyborg.bus.wire import LIVELINESS_PREFIX, EntityKind, domain_id, gid
 
 log = logging.getLogger("cyborg.bus")
 
 SHM_PREFIX = "@cyborg_shm"
 """Liveliness tokens and keys of subscriptions that take large messages through shared memory."""
+
+DROP_REPORT_INTERVAL = 60.0
+"""Wall seconds between two warnings about dropped input of the same kind (the first is said
+at once; later ones are counted and summed up at most this often)."""
 
 
 _OPEN: WeakSet[Context] = WeakSet()
@@ -53,9 +59,12 @@ getattr(threading, "_register_atexit", atexit.register)(_close_open_contexts)
 
 
 def host_id() -> str:
-    """Identifies this machine (and boot), so shared memory is only offered to local peers."""
+    """Identifies this machine (and boot) and user, so shared memory is only offered to local
+    peers of the same user: slot files are private to their owner (mode 0600), and a reader
+    refuses other users' files."""
     boot = Path("/proc/sys/kernel/random/boot_id")
-    text = socket.gethostname() + (boot.read_text().strip() if boot.exists() else "")
+    text = socket.gethostname() + (boot.read_text().strip() if boot.exists() else "") + \
+        f"/uid{os.geteuid()}"
     return hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
 
 
@@ -72,6 +81,7 @@ class Context:
         self.session = zenoh.open(self.config.to_zenoh())
         self.zid = str(self.session.zid())
         self.graph = Graph(self.domain)
+        self.graph.on_departure(self._on_departure)
         self.dropped: Counter[str] = Counter()
         """Input dropped, by reason: ``'/topic: cannot decode'``, ``'/topic: slot reused'``."""
         self._ids = itertools.count(0)
@@ -80,7 +90,7 @@ class Context:
         self._latched: dict[str, list[Any]] = {}
         self._shm_readers: dict[str, set[tuple[str, int]]] = {}
         self._nodes: list[Any] = []
-        self._warned: set[str] = set()
+        self._reported: dict[str, tuple[float, int]] = {}  # reason -> (when said, count then)
         self._closed = False
         self.calls = ThreadPoolExecutor(max_workers=8, thread_name_prefix="cyborg-call")
         self.doorbell = self._open_doorbell()
@@ -114,20 +124,28 @@ class Context:
         else:
             self.graph.remove(key)
 
+    def _on_departure(self, entity: GraphEntity) -> None:
+        """An endpoint left the graph: a publisher's sequence numbers are no longer needed."""
+        if entity.kind is EntityKind.PUBLISHER:
+            publisher = gid(entity.key)
+            for subscription in self.local_subscriptions(entity.topic):
+                subscription.forget_publisher(publisher)
+
     def _on_shm_token(self, sample: zenoh.Sample) -> None:
         # @cyborg_shm/<domain>/<host>/<zid>/<eid>/<mangled topic>
         chunks = str(sample.key_expr).split("/")
-        if len(chunks) != 6:
-            return
-        if not chunks[4].isdigit():
+        if len(chunks) != 6 or not chunks[4].isdigit() or len(chunks[4]) > 10:
             return
         topic, reader = chunks[5].replace("%", "/"), (chunks[3], int(chunks[4]))
         with self._lock:
-            readers = self._shm_readers.setdefault(topic, set())
             if sample.kind == zenoh.SampleKind.PUT:
-                readers.add(reader)
-            else:
+                self._shm_readers.setdefault(topic, set()).add(reader)
+                return
+            readers = self._shm_readers.get(topic)
+            if readers is not None:
                 readers.discard(reader)
+                if not readers:  # keyed by names others choose: keep no empty entries
+                    del self._shm_readers[topic]
 
     def shm_readers(self, topic: str) -> tuple[tuple[str, int], ...]:
         """(session id, entity id) of the subscriptions of other sessions on this machine that
@@ -177,14 +195,26 @@ class Context:
 
     # ------------------------------------------------------------------ dropped input
     def drop(self, reason: str, detail: str = "") -> None:
-        """Count one dropped input; the first of each kind is logged as a warning."""
+        """Count one dropped input, and say so: the first of each kind at once, then at most
+        once every ``DROP_REPORT_INTERVAL`` seconds with the number dropped since.
+
+        ``reason`` names where (the topic or service) and what; ``detail`` says why.
+        """
+        now = time.monotonic()
         with self._lock:
             self.dropped[reason] += 1
-            first = reason not in self._warned
-            self._warned.add(reason)
-        if first:
+            count = self.dropped[reason]
+            said = self._reported.get(reason)
+            if said is not None and now - said[0] < DROP_REPORT_INTERVAL:
+                return
+            self._reported[reason] = (now, count)
+        suffix = f": {detail}" if detail else ""
+        if said is None:
             log.warning("dropped input (%s)%s; further drops of this kind are counted",
-                        reason, f": {detail}" if detail else "")
+                        reason, suffix)
+        else:
+            log.warning("dropped input (%s) %d more times in %.0f s; the last%s", reason,
+                        count - said[1], now - said[0], suffix or " without detail")
 
     # ------------------------------------------------------------------ lifetime
     def register_node(self, node: Any) -> None:

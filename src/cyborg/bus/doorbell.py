@@ -19,12 +19,18 @@ A datagram holds the subscriber's entity id, the rmw_zenoh attachment and the sl
 Whatever cannot be rung (no such socket: an older process, another network namespace, a full
 queue) makes the publisher send the reference through Zenoh as before; subscriptions drop the
 second copy by its sequence number. Malformed datagrams are counted as dropped input.
+
+An abstract socket has no file permissions: any local user who learns the name can send to
+it. The doorbell therefore asks the kernel for each sender's credentials (``SO_PASSCRED``) and
+drops datagrams from other users; slot files are the user's own (mode 0600) anyway, and a
+reference that names anything else is refused by :func:`cyborg.bus.shm.open_slot`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import logging
+import os
 import socket
 import struct
 import sys
@@ -34,6 +40,7 @@ from collections.abc import Callable, Iterable
 log = logging.getLogger("cyborg.bus")
 
 _HEAD = struct.Struct("<IH")  # entity id, attachment length
+_CREDENTIALS = struct.Struct("iII")  # struct ucred: pid, uid, gid
 _MAX_DATAGRAM = 4096
 _STOP = b""
 
@@ -67,6 +74,15 @@ def decode(datagram: bytes) -> tuple[int, bytes, bytes]:
     return entity_id, datagram[_HEAD.size:end], datagram[end:]
 
 
+def sender_uid(ancillary: list[tuple[int, int, bytes]]) -> int | None:
+    """The sending process's user id from ``SCM_CREDENTIALS`` ancillary data (None if absent)."""
+    for level, kind, data in ancillary:
+        if level == socket.SOL_SOCKET and kind == socket.SCM_CREDENTIALS \
+                and len(data) >= _CREDENTIALS.size:
+            return int(_CREDENTIALS.unpack_from(data)[1])
+    return None
+
+
 class Doorbell:
     """One session's doorbell: rings others' (:meth:`ring`), answers its own on a thread."""
 
@@ -80,7 +96,9 @@ class Doorbell:
         self._handlers: dict[int, Handler] = {}
         self._lock = threading.Lock()
         self._closed = False
+        self._uid = os.getuid()
         self._inbox = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        self._inbox.setsockopt(socket.SOL_SOCKET, socket.SO_PASSCRED, 1)  # who sent each one
         self._inbox.bind(self.address)
         self._outbox = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
         self._outbox.setblocking(False)  # a full queue makes the publisher use Zenoh instead
@@ -98,13 +116,18 @@ class Doorbell:
             self._handlers.pop(entity_id, None)
 
     def _answer(self) -> None:
+        space = socket.CMSG_SPACE(_CREDENTIALS.size)
         while True:
             try:
-                datagram = self._inbox.recv(_MAX_DATAGRAM)
+                datagram, ancillary, _flags, _address = self._inbox.recvmsg(_MAX_DATAGRAM, space)
             except OSError:  # closed under a handler that outlived close()'s wait
                 return
             if self._closed:
                 return
+            uid = sender_uid(ancillary)
+            if uid is not None and uid != self._uid:
+                self._drop("doorbell: datagram from another user", f"uid {uid}")
+                continue
             try:
                 entity_id, attachment, reference = decode(datagram)
             except ValueError as exc:

@@ -7,6 +7,11 @@ process is handed over directly on the publisher's thread when the receiving nod
 
 An exception in a callback is logged with its traceback — once per callback, then counted — and
 the node keeps running.
+
+A node may give some of its callbacks a thread of their own (ROS 2's callback groups, each with
+its executor): :meth:`CallbackThread.route` sends what one entity submits to another
+:class:`CallbackThread`, so a slow callback on the node's thread never delays them — the tree
+runner's stop button is served this way (:meth:`cyborg.bus.Node.create_service`).
 """
 
 from __future__ import annotations
@@ -31,11 +36,26 @@ class CallbackThread:
         self._reported: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._busy = threading.Lock()  # held while one of this node's callbacks runs
+        self._routes: dict[int, tuple[object, CallbackThread]] = {}  # id(owner) -> its thread
         self._thread = threading.Thread(target=self._run, name=f"cyborg-node{name}",
                                          daemon=True)
         self._thread.start()
 
+    def route(self, owner: object, thread: CallbackThread) -> None:
+        """Run the callbacks ``owner`` submits here (its bound methods, as a service server
+        submits its handler) on ``thread`` instead, in their order, one at a time."""
+        self._routes[id(owner)] = (owner, thread)
+
+    def _routed(self, function: Callable[..., object]) -> CallbackThread | None:
+        owner = getattr(function, "__self__", None)
+        entry = self._routes.get(id(owner)) if owner is not None else None
+        return entry[1] if entry is not None and entry[0] is owner else None
+
     def submit(self, function: Callable[..., object], *args: Any) -> None:
+        thread = self._routed(function) if self._routes else None
+        if thread is not None:
+            thread.submit(function, *args)
+            return
         self._queue.put((function, args))
 
     def in_thread(self) -> bool:
@@ -56,6 +76,9 @@ class CallbackThread:
         In-process delivery uses this to skip a thread switch (tens of microseconds); the
         node still runs one callback at a time, and queued callbacks keep their order.
         """
+        thread = self._routed(function) if self._routes else None
+        if thread is not None:
+            return thread.try_inline(function, *args)
         if not self._queue.empty() or not self._busy.acquire(blocking=False):
             return False
         try:

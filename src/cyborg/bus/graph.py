@@ -7,6 +7,7 @@ its tokens vanish as soon as its Zenoh session is gone, so it drops out of ``nod
 
 from __future__ import annotations
 
+import re
 import threading
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -15,6 +16,7 @@ from cyborg.bus.wire import LIVELINESS_PREFIX, EntityKind, unmangle
 
 NODE_CHUNKS = 9
 ENDPOINT_CHUNKS = 13
+_DDS_TYPE = re.compile(r"^[^:/]+::[^:/]+::dds_::[^:/]+$")
 
 
 @dataclass(frozen=True)
@@ -67,10 +69,12 @@ def parse_token(key: str) -> GraphEntity | None:
                     namespace=unmangle(chunks[7]) or "/", node=chunks[8])
     except ValueError:
         return None
+    if not chunks[8]:
+        return None
     if kind is EntityKind.NODE:
         return GraphEntity(**base) if len(chunks) == NODE_CHUNKS else None  # type: ignore[arg-type]
-    if len(chunks) != ENDPOINT_CHUNKS:
-        return None
+    if len(chunks) != ENDPOINT_CHUNKS or not _DDS_TYPE.match(chunks[10]):
+        return None  # e.g. a forged token whose type would break every query naming types
     topic = unmangle(chunks[9])
     return GraphEntity(**base, topic=topic if topic.startswith("/") else "/" + topic,  # type: ignore[arg-type]
                        dds_type=chunks[10], type_hash=chunks[11], qos=chunks[12])
@@ -92,6 +96,7 @@ class Graph:
         self._lock = threading.RLock()  # predicates of wait_for query the graph
         self._changed = threading.Condition(self._lock)
         self._listeners: list[Callable[[], None]] = []
+        self._departures: list[Callable[[GraphEntity], None]] = []
 
     # ------------------------------------------------------------------ updates
     def add(self, key: str) -> None:
@@ -108,22 +113,25 @@ class Graph:
 
     def remove(self, key: str) -> None:
         with self._changed:
-            if not self._drop(key):
+            entity = self._drop(key)
+            if entity is None:
                 return
             self._changed.notify_all()
+        for departure in list(self._departures):
+            departure(entity)
         self._notify()
 
-    def _drop(self, key: str) -> bool:
+    def _drop(self, key: str) -> GraphEntity | None:
         entity = self._entities.pop(key, None)
         if entity is None:
-            return False
+            return None
         index = (entity.topic, entity.kind)
         same = self._by_endpoint[index]
         del same[key]
         if not same:
             del self._by_endpoint[index]
         self.version += 1
-        return True
+        return entity
 
     def on_change(self, listener: Callable[[], None]) -> Callable[[], None]:
         """Call ``listener()`` (on a Zenoh thread) whenever a token appears or vanishes.
@@ -132,6 +140,11 @@ class Graph:
         """
         self._listeners.append(listener)
         return lambda: self._listeners.remove(listener) if listener in self._listeners else None
+
+    def on_departure(self, listener: Callable[[GraphEntity], None]) -> None:
+        """Call ``listener(entity)`` (on a Zenoh thread) for each entity that leaves the graph,
+        e.g. to forget what was kept about a publisher."""
+        self._departures.append(listener)
 
     def _notify(self) -> None:
         for listener in list(self._listeners):

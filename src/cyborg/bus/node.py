@@ -8,7 +8,9 @@
         chatter = node.create_publisher("chatter", "std_msgs/msg/String")
         chatter.publish(String(data="hello"))
 
-Each node runs its callbacks (subscriptions, services, timers) one at a time on its own thread.
+Each node runs its callbacks (subscriptions, services, timers) one at a time on its own thread;
+a service that must never wait behind them gets a thread of its own with
+``create_service(..., callbacks=node.callback_thread("name"))``.
 Nodes of one process normally share one :class:`~cyborg.bus.context.Context`; without one, a
 node uses the process's default context (see :func:`default_context`).
 """
@@ -62,6 +64,7 @@ class Node:
         self.fq_name = f"{namespace.rstrip('/')}/{name}"
         self.id = self.context.next_id()
         self.callbacks = CallbackThread(self.fq_name)
+        self._callback_threads: list[CallbackThread] = []
         self._entities: list[Any] = []
         self._timers: list[Timer] = []
         self._destroyed = False
@@ -80,16 +83,38 @@ class Node:
         """A publisher; ``Qos.latched()`` keeps the last message for late subscribers."""
         return self._keep(Publisher, topic, type_name, qos or Qos(depth=10))
 
-    def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], object],
-                            qos: Qos | None = None) -> Subscription:
-        """Call ``callback(message)`` for each message; use ``Qos.latched()`` for latched topics."""
-        return self._keep(Subscription, topic, type_name, callback, qos or Qos(depth=10))
+    def create_subscription(self, topic: str, type_name: str, callback: Callable[..., object],
+                            qos: Qos | None = None, *, with_info: bool = False) -> Subscription:
+        """Call ``callback(message)`` for each message; use ``Qos.latched()`` for latched topics.
+
+        ``with_info=True``: ``callback(message, info)``, ``info`` being the sample's
+        :class:`~cyborg.bus.wire.Attachment` (claimed publisher GID, sequence, timestamp) or None.
+        """
+        return self._keep(Subscription, topic, type_name, callback, qos or Qos(depth=10),
+                          with_info=with_info)
 
     # ------------------------------------------------------------------ services
     def create_service(self, name: str, service_type: str, handler: Callable[..., Any], *,
-                       deferred: bool = False) -> ServiceServer:
-        """Serve ``handler(request) -> response`` (see :class:`ServiceServer`)."""
-        return self._keep(ServiceServer, name, service_type, handler, deferred=deferred)
+                       deferred: bool = False,
+                       callbacks: CallbackThread | None = None) -> ServiceServer:
+        """Serve ``handler(request) -> response`` (see :class:`ServiceServer`).
+
+        ``callbacks`` (from :meth:`callback_thread`): run the handler there instead of on the
+        node's thread, so that the node's other callbacks never delay it.
+        """
+        server = self._keep(ServiceServer, name, service_type, handler, deferred=deferred)
+        if callbacks is not None:
+            self.callbacks.route(server, callbacks)
+        return server
+
+    def callback_thread(self, name: str) -> CallbackThread:
+        """Another thread for some of this node's callbacks (like a ROS 2 callback group with
+        an executor of its own); it stops with the node."""
+        if self._destroyed:
+            raise RuntimeError(f"node {self.fq_name} was destroyed")
+        thread = CallbackThread(f"{self.fq_name}[{name}]")
+        self._callback_threads.append(thread)
+        return thread
 
     def create_client(self, name: str, service_type: str) -> ServiceClient:
         return self._keep(ServiceClient, name, service_type)
@@ -134,6 +159,8 @@ class Node:
         if not self.context.closed:
             self._token.undeclare()
         self.callbacks.close()
+        for thread in self._callback_threads:
+            thread.close()
         self.context.forget_node(self)
 
     def __enter__(self) -> Node:

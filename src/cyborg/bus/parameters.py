@@ -225,17 +225,25 @@ class Parameters:
                  for n in request.names]
         return self._response("GetParameterTypes", types=np.array(codes, dtype=np.uint8))
 
-    def _changes(self, parameters: Any) -> Changes:
-        return {p.name: from_message(p.value) for p in parameters}
-
     def _set(self, request: Any) -> Any:
+        """One result per parameter, in order; a value that cannot be read is refused in its
+        result (as a wrong type is), never raised."""
         results = []
-        for name, value in self._changes(request.parameters).items():
-            results.append(self._result(self._try_set({name: value})))
+        for parameter in request.parameters:
+            try:
+                error = self._try_set({parameter.name: from_message(parameter.value)})
+            except ValueError as exc:
+                error = f"parameter {parameter.name!r}: {exc}"
+            results.append(self._result(error))
         return self._response("SetParameters", results=results)
 
     def _set_atomically(self, request: Any) -> Any:
-        error = self._try_set(self._changes(request.parameters))
+        try:
+            changes = {p.name: from_message(p.value) for p in request.parameters}
+        except ValueError as exc:
+            error: str | None = str(exc)
+        else:
+            error = self._try_set(changes)
         return self._response("SetParametersAtomically", result=self._result(error))
 
     def _try_set(self, changes: Changes) -> str | None:

@@ -21,16 +21,26 @@ generation in the slot (a reader slower than the grace) drops the frame; the cal
 it. Locks vanish with the process that
 held them, so a crashed reader never blocks a writer, and writers remove slot files of dead
 processes when they start.
+
+A slot reference is input like any other: any process that can reach the doorbell or Zenoh can
+send one, and any local user can put files in ``/dev/shm``. A reader therefore opens a slot
+without ever blocking (``O_NONBLOCK``, ``O_NOFOLLOW``) and maps it only if ``fstat`` shows a
+regular file owned by this user and at most ``MAX_SLOT_SIZE`` bytes long (:func:`open_slot`);
+a FIFO, a device, a socket, a link, someone else's file or a huge one is refused with
+:class:`SlotRejectedError`. No call on the way can wait, so a reference cannot park the
+thread that receives it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import mmap
 import os
 import re
 import secrets
+import stat
 import struct
 import tempfile
 import threading
@@ -72,9 +82,69 @@ class SlotRef:
         generation, length, path_length = _REF.unpack_from(data)
         path = data[_REF.size:].decode()
         name = path[len(_SLOT_START) - len(PREFIX):]  # string checks: Path is slow when cold
-        if len(path) != path_length or not path.startswith(_SLOT_START) or "/" in name:
+        if len(path) != path_length or not path.startswith(_SLOT_START) or "/" in name \
+                or "\0" in name:
             raise ValueError("not a cyborg shared-memory slot reference")
         return cls(path, generation, length)
+
+
+MAX_SLOT_SIZE = 1 << 30
+"""The largest slot file, header included, that a reader maps; a writer sends a message that
+would need a larger one inline instead."""
+
+
+class SlotRejectedError(Exception):
+    """A slot reference names something that is not one of this user's slots: a FIFO, device,
+    socket or directory, a symbolic link, another user's file, or a file too short or too big.
+    Nothing was opened that could block; the message is dropped."""
+
+
+_KINDS = {stat.S_IFIFO: "FIFO", stat.S_IFCHR: "character device", stat.S_IFBLK: "block device",
+          stat.S_IFSOCK: "socket", stat.S_IFDIR: "directory", stat.S_IFLNK: "symbolic link"}
+_OPEN_FLAGS = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_CLOEXEC
+
+
+def open_slot(path: str) -> tuple[int, os.stat_result]:
+    """Open a slot file read-only without ever blocking; (descriptor, its ``fstat``).
+
+    ``O_NONBLOCK`` makes opening a FIFO return at once instead of waiting for a writer, and
+    ``O_NOFOLLOW`` refuses a symbolic link; ``fstat`` on the descriptor (not the path, which
+    could be swapped meanwhile) then checks what was opened. Raises
+    :class:`SlotRejectedError` for anything but a regular file of this user of a slot's size,
+    and ``OSError`` (e.g. ``FileNotFoundError``) for a slot that is gone.
+    """
+    try:
+        fd = os.open(path, _OPEN_FLAGS)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise SlotRejectedError(f"{path} is a symbolic link") from None
+        if exc.errno in (errno.EACCES, errno.EPERM, errno.ENXIO, errno.ENODEV):
+            raise SlotRejectedError(
+                f"{path} cannot be read as a slot ({exc.strerror})") from None
+        raise
+    try:
+        info = os.fstat(fd)
+        problem = _problem(info)
+        if problem:
+            raise SlotRejectedError(f"{path} is {problem}")
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd, info
+
+
+def _problem(info: os.stat_result) -> str:
+    """What makes a file unfit to be mapped as a slot; empty if nothing."""
+    kind = stat.S_IFMT(info.st_mode)
+    if kind != stat.S_IFREG:
+        return f"a {_KINDS.get(kind, 'special file')}, not a regular file"
+    if info.st_uid != os.geteuid():
+        return f"owned by uid {info.st_uid}, not by this user (uid {os.geteuid()})"
+    if info.st_size < _HEADER.size:
+        return f"{info.st_size} bytes long, too short for a slot"
+    if info.st_size > MAX_SLOT_SIZE:
+        return f"{info.st_size} bytes long, more than a slot may be ({MAX_SLOT_SIZE})"
+    return ""
 
 
 REUSE_GRACE = 0.02
@@ -123,7 +193,10 @@ class SlotWriter:
         remove_stale_slots()
 
     def write(self, length: int, fill: Callable[[memoryview], object]) -> SlotRef | None:
-        """Fill ``length`` bytes of a free slot with ``fill(view)``; None if none is free."""
+        """Fill ``length`` bytes of a free slot with ``fill(view)``; None if none is free, or
+        if the message is too big for a slot readers accept (``MAX_SLOT_SIZE``)."""
+        if _HEADER.size + _capacity(length) > MAX_SLOT_SIZE:
+            return None
         slot = self._free_slot(length)
         if slot is None:
             return None
@@ -158,14 +231,18 @@ class SlotWriter:
 
     def _new_slot(self, length: int) -> _Slot:
         self._count += 1
-        capacity = -(-length // _GRANULE) * _GRANULE
-        return _Slot(SHM_DIR / f"{self._tag}-{self._count}", capacity)
+        return _Slot(SHM_DIR / f"{self._tag}-{self._count}", _capacity(length))
 
     def close(self) -> None:
         """Remove the slot files; readers holding views keep their mappings."""
         for slot in self._slots:
             slot.close()
         self._slots.clear()
+
+
+def _capacity(length: int) -> int:
+    """A slot's payload capacity for a message of ``length`` bytes: whole granules."""
+    return -(-length // _GRANULE) * _GRANULE
 
 
 class _MappedSlot:
@@ -175,14 +252,17 @@ class _MappedSlot:
     process holds on it: the first lease takes it, the last one to be collected releases it.
     The mapping is made through a descriptor of its own: mmap keeps a duplicate of the
     descriptor it maps, and that duplicate would otherwise hold the lock as long as the mapping.
+    Both are opened with :func:`open_slot` and must be the same file.
     """
 
     def __init__(self, path: str) -> None:
-        self.fd = os.open(path, os.O_RDONLY)
+        self.fd, first = open_slot(path)
         try:
-            mapping_fd = os.open(path, os.O_RDONLY)
+            mapping_fd, second = open_slot(path)
             try:
-                self.map = mmap.mmap(mapping_fd, 0, prot=mmap.PROT_READ)
+                if (second.st_dev, second.st_ino) != (first.st_dev, first.st_ino):
+                    raise SlotRejectedError(f"{path} was replaced while it was being opened")
+                self.map = mmap.mmap(mapping_fd, second.st_size, prot=mmap.PROT_READ)
             finally:
                 os.close(mapping_fd)
         except BaseException:
@@ -240,24 +320,31 @@ class SlotReader:
         """A read-only byte array over the message, or None if the slot was reused or gone.
 
         The slot stays leased (the writer cannot reuse it) until the returned array and every
-        view made from it have been garbage-collected.
+        view made from it have been garbage-collected. Raises :class:`SlotRejectedError` when
+        the reference names something that is not a slot (see :func:`open_slot`).
         """
         try:
             slot = self._slot(ref.path)
-        except (OSError, ValueError):  # gone, or empty
+        except (OSError, ValueError):  # gone
             return None
         return slot.lease(ref)
 
     def _slot(self, path: str) -> _MappedSlot:
         with self._lock:
             slot = self._slots.get(path)
-            if slot is None:
-                slot = self._slots[path] = _MappedSlot(path)
-                while len(self._slots) > self._cache_size:
-                    self._slots.popitem(last=False)[1].retire()
-            else:
+            if slot is not None:
                 self._slots.move_to_end(path)
-            return slot
+                return slot
+        opened = _MappedSlot(path)  # outside the lock: a slow open stalls no other reader
+        with self._lock:
+            slot = self._slots.get(path)
+            if slot is not None:  # another thread mapped it meanwhile
+                opened.retire()
+                return slot
+            self._slots[path] = opened
+            while len(self._slots) > self._cache_size:
+                self._slots.popitem(last=False)[1].retire()
+            return opened
 
     def close(self) -> None:
         with self._lock:

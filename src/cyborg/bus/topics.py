@@ -28,7 +28,8 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 import zenoh.ext
 
-from cyborg.bus.shm import SlotReader, SlotRef, SlotWriter
+from cyborg.bus.sequences import MAX_PUBLISHERS, SequenceTable
+from cyborg.bus.shm import SlotReader, SlotRef, SlotRejectedError, SlotWriter
 from cyborg.bus.wire import (
     Attachment,
     Durability,
@@ -47,6 +48,8 @@ if TYPE_CHECKING:
 
 SHM_THRESHOLD = 64 * 1024
 """Messages of at least this many bytes go to local processes through shared memory."""
+
+__all__ = ["MAX_PUBLISHERS", "SHM_THRESHOLD", "Publisher", "Subscription"]
 
 
 class _Endpoint:
@@ -189,19 +192,28 @@ class Publisher(_Endpoint):
 class Subscription(_Endpoint):
     """Calls ``callback(message)`` on the node's thread for each message on a topic.
 
+    With ``with_info=True`` the callback is ``callback(message, info)``: ``info`` is the
+    sample's :class:`~cyborg.bus.wire.Attachment` (publisher GID, sequence number, source
+    timestamp), or None for a sample sent without one. Nothing authenticates it: the GID says
+    which publisher a sample *claims* to come from.
+
     Up to ``qos.depth`` messages wait in the queue (keep-last: the oldest are dropped); with
-    ``History.KEEP_ALL`` the queue is unbounded. Input that cannot be decoded is dropped and
-    counted in ``context.dropped``.
+    ``History.KEEP_ALL`` the queue is unbounded. Input that cannot be used (undecodable,
+    malformed attachment, refused shared-memory slot) is dropped and counted in
+    ``context.dropped``; duplicates are recognised by sequence number
+    (:mod:`cyborg.bus.sequences`).
     """
 
     def __init__(self, node: Node, topic: str, type_name: str,
-                 callback: Callable[[Any], object], qos: Qos) -> None:
+                 callback: Callable[..., object], qos: Qos, *, with_info: bool = False) -> None:
         super().__init__(node, topic, type_name, qos, EntityKind.SUBSCRIPTION)
         self.callback = callback
+        self.with_info = with_info
         self.received = 0
         depth = None if qos.history is History.KEEP_ALL else max(qos.depth, 1)
-        self._queue: deque[Any] = deque(maxlen=depth)
-        self._last_sequence: dict[bytes, int] = {}
+        self._queue: deque[tuple[Any, Attachment | None]] = deque(maxlen=depth)
+        self._scheduled = 0  # dispatches submitted to the node's thread, one per queued message
+        self._last_sequence = SequenceTable()
         self._lock = threading.Lock()
         self._slots = SlotReader()
         session = self.context.session
@@ -231,82 +243,122 @@ class Subscription(_Endpoint):
         if type_name != self.type_name:
             self.context.drop(f"{self.topic}: type {type_name} instead of {self.type_name}")
             return
-        if not self._fresh(attachment):
+        if not self._last_sequence.record(attachment.gid, attachment.sequence):
             return
         copy = self.context.copier.copy(message, type_name)
-        if not self.node.callbacks.try_inline(self._deliver_now, copy):
-            self._enqueue(copy)
+        # Handed over directly only when nothing of this subscription is queued or about to
+        # run: a dispatch taken off the node's queue but not yet running would come second.
+        if self._scheduled or not self.node.callbacks.try_inline(self._deliver_now, copy,
+                                                                 attachment):
+            self._enqueue(copy, attachment)
 
-    def _deliver_now(self, message: Any) -> None:
+    def _deliver_now(self, message: Any, info: Attachment | None) -> None:
         if not self._closed:
             self.received += 1
-            self.callback(message)
+            if self.with_info:
+                self.callback(message, info)
+            else:
+                self.callback(message)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        attachment = sample.attachment
-        if self._accept(None if attachment is None else attachment.to_bytes()):
-            self._decode(sample.payload.to_bytes())
+        """A CDR sample from Zenoh (a Zenoh thread)."""
+        try:
+            attachment = sample.attachment
+            ok, info = self._parse(None if attachment is None else attachment.to_bytes())
+            if ok and not self._seen(info):
+                self._admit(self._decode(sample.payload.to_bytes()), info)
+        except Exception as exc:  # a defect, not bad input: contain it, say it
+            self._unexpected(exc)
 
     def _on_slot(self, sample: zenoh.Sample) -> None:
-        attachment = sample.attachment
-        self._on_reference(None if attachment is None else attachment.to_bytes(),
-                          sample.payload.to_bytes())
+        """A shared-memory slot reference that came through Zenoh (a Zenoh thread)."""
+        try:
+            attachment = sample.attachment
+            self._on_reference(None if attachment is None else attachment.to_bytes(),
+                               sample.payload.to_bytes())
+        except Exception as exc:
+            self._unexpected(exc)
 
     def _on_reference(self, attachment: bytes | None, reference: bytes) -> None:
-        """A slot reference, by Zenoh or by the doorbell: lease the slot, decode in place."""
-        if not self._accept(attachment):
+        """A slot reference, by Zenoh or by the doorbell: lease the slot, decode in place.
+
+        Opening the slot never blocks: a reference to a FIFO, a link, another user's file or
+        an oversized one is refused (:class:`~cyborg.bus.shm.SlotRejectedError`) and counted.
+        """
+        ok, info = self._parse(attachment)
+        if not ok or self._seen(info):
             return
         try:
             ref = SlotRef.decode(reference)
         except ValueError as exc:
             self.context.drop(f"{self.topic}: bad slot reference", str(exc))
             return
-        lease = self._slots.read(ref)
+        try:
+            lease = self._slots.read(ref)
+        except SlotRejectedError as exc:
+            self.context.drop(f"{self.topic}: refused shared-memory slot", str(exc))
+            return
         if lease is None:
             self.context.drop(f"{self.topic}: shared-memory slot reused before it was read")
             return
-        self._decode(lease.data)
+        self._admit(self._decode(lease.data), info)
 
-    def _accept(self, attachment: bytes | None) -> bool:
-        """False for a malformed attachment (counted) or a message already delivered."""
+    def _parse(self, attachment: bytes | None) -> tuple[bool, Attachment | None]:
+        """(usable, attachment): not usable if malformed (counted); None if there is none."""
         if attachment is None:  # not rmw_zenoh, but harmless
-            return True
+            return True, None
         try:
-            decoded = Attachment.decode(attachment)
+            return True, Attachment.decode(attachment)
         except ValueError as exc:
             self.context.drop(f"{self.topic}: bad attachment", str(exc))
-            return False
-        return self._fresh(decoded)
+            return False, None
 
-    def _fresh(self, attachment: Attachment) -> bool:
-        """False for a sequence number already seen from this publisher (via another path)."""
-        with self._lock:
-            last = self._last_sequence.get(attachment.gid, 0)
-            if attachment.sequence <= last:
-                return False
-            self._last_sequence[attachment.gid] = attachment.sequence
-            return True
+    def _seen(self, info: Attachment | None) -> bool:
+        """A message already delivered (by another path): skip decoding it again."""
+        return info is not None and self._last_sequence.seen(info.gid, info.sequence)
 
-    def _decode(self, data: bytes | memoryview) -> None:
+    def _admit(self, message: Any, info: Attachment | None) -> None:
+        """Queue a decoded message, recording its sequence number only now that it is one."""
+        if message is _UNDECODABLE:
+            return
+        if info is not None and not self._last_sequence.record(info.gid, info.sequence):
+            return
+        self._enqueue(message, info)
+
+    def _decode(self, data: bytes | memoryview) -> Any:
         try:
-            message = self.context.types.deserialize(data, self.type_name)
+            return self.context.types.deserialize(data, self.type_name)
         except Exception as exc:
             self.context.drop(f"{self.topic}: cannot decode {self.type_name}",
                               f"{type(exc).__name__}: {exc}")
-            return
-        self._enqueue(message)
+            return _UNDECODABLE
 
-    def _enqueue(self, message: Any) -> None:
+    def _unexpected(self, exc: Exception) -> None:
+        self.context.drop(f"{self.topic}: input handling failed",
+                          f"{type(exc).__name__}: {exc}")
+
+    def forget_publisher(self, gid: bytes) -> None:
+        """Forget a publisher's sequence numbers (it left the graph)."""
+        self._last_sequence.forget(gid)
+
+    def _enqueue(self, message: Any, info: Attachment | None) -> None:
+        # One dispatch per queued message, never more: when the keep-last queue is full a new
+        # message replaces the oldest and needs no dispatch of its own, so a flood while the
+        # node is busy grows neither this queue nor the node's.
         with self._lock:
-            self._queue.append(message)
+            self._queue.append((message, info))
+            if len(self._queue) <= self._scheduled:
+                return
+            self._scheduled += 1
         self.node.callbacks.submit(self._dispatch)
 
     def _dispatch(self) -> None:
         with self._lock:
+            self._scheduled -= 1
             if not self._queue:
                 return
-            message = self._queue.popleft()
-        self._deliver_now(message)
+            message, info = self._queue.popleft()
+        self._deliver_now(message, info)
 
     def destroy(self) -> None:
         if not self._withdraw():
@@ -318,3 +370,6 @@ class Subscription(_Endpoint):
         self._shm_subscriber.undeclare()
         self._zenoh.undeclare()
         self._slots.close()
+
+
+_UNDECODABLE = object()

@@ -173,17 +173,20 @@ class NavigationServices:
                          name="cyborg-load-map").start()
 
     def _load(self, path: str, responder: Responder) -> None:
+        """Load, free the one-at-a-time lock, then answer: a caller that asks again as soon
+        as it has its answer must find the lock free."""
         reply = self._classes["LoadMapFile"]
         try:
             arnl_map = self.maps.load(path)
         except MapError as exc:
+            self._loading.release()
             log.warning("load_map_file: %s", exc)
             responder.reply(reply(success=False, message=str(exc)))
         except Exception as exc:  # a listener (the simulator) failed: say so, keep serving
+            self._loading.release()
             log.error("load_map_file %r: %s: %s", path, type(exc).__name__, exc, exc_info=True)
             responder.fail(exc)
         else:
+            self._loading.release()
             responder.reply(reply(success=True, message=f"loaded {arnl_map.source}: "
                                                         f"{len(arnl_map.goals())} goals"))
-        finally:
-            self._loading.release()

@@ -3,7 +3,8 @@
 ========================  ==========  =====================================================
 name                      category    what it does
 ========================  ==========  =====================================================
-MoveTo{location,radius}   action      drive to a map goal; stall detection, retries, cancel
+MoveTo{location,radius}   action      drive to a map goal; stall detection, retries,
+                                      back-off while the robot is unreachable, cancel
 CheckBattery{threshold}   decorator   latching guard: tick the child while the battery is low
 Charge{target}            action      dock if needed; RUNNING until charged to ``target`` %
 Dock, Undock              action      dock / undock and wait until done

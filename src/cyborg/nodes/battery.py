@@ -10,6 +10,8 @@ A patrol-and-recharge tree puts them together as
   before it patrols again. With no battery reading yet, the guard stays closed.
 * :class:`Charge` docks if the robot is not docked, and stays RUNNING until the charge reaches
   ``target`` percent; it fails when docking fails. It does not undock: the next move does.
+  A refusal repeats every tick under the latching guard (the map has no dock): its warning is
+  logged once per 10 s with a count (:mod:`cyborg.nodes.rate_limited_log`).
 """
 
 from __future__ import annotations
@@ -17,9 +19,11 @@ from __future__ import annotations
 import logging
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Decorator, Status, register
+from cyborg.nodes.rate_limited_log import RateLimitedLog
 from cyborg.nodes.robot import ROBOT, DockState, robot_of
 
 log = logging.getLogger("cyborg.nodes")
+limited = RateLimitedLog(log)
 
 DOCK_START_TIMEOUT = 10.0
 """Seconds (tree clock) for the robot to report DOCKING after a dock request."""
@@ -79,12 +83,14 @@ class Charge(Action):
             accepted, message = robot.dock()
             if not accepted:
                 self.reason = f"the robot cannot dock: {message}"
-                log.warning("Charge %s: %s", self.uid, self.reason)
+                limited.warning(("Charge refused", self.uid), "Charge %s: %s", self.uid,
+                                self.reason)
                 return FAILURE
             self._requested_at = self.now
         elif self.now - self._requested_at > DOCK_START_TIMEOUT:
             self.reason = f"the robot did not start docking within {DOCK_START_TIMEOUT:g} s"
-            log.warning("Charge %s: %s", self.uid, self.reason)
+            limited.warning(("Charge timeout", self.uid), "Charge %s: %s", self.uid,
+                            self.reason)
             return FAILURE
         return RUNNING
 

@@ -21,9 +21,11 @@ from typing import Any
 
 from cyborg.bus import ActionError, ClientGoal, Node, Qos, ServiceError, new_message
 from cyborg.nav.geometry import Pose2D
+from cyborg.nodes.rate_limited_log import RateLimitedLog
 from cyborg.nodes.robot import BatteryReading, DockState, Goal, MoveOutcome, RobotError
 
 log = logging.getLogger("cyborg.nodes")
+limited = RateLimitedLog(log)
 
 GOAL = "cyborg_msgs/action/MoveToGoal_Goal"
 
@@ -84,8 +86,9 @@ class BusMove:
 
     def _cancelled(self, future: Future[bool]) -> None:
         error = future.exception()
-        if error is not None:
-            log.warning("cancelling the move to %r failed: %s", self.goal, error)
+        if error is not None:  # the robot is gone: every move's cancel fails the same way
+            limited.warning("cancel failed", "cancelling the move to %r failed: %s", self.goal,
+                            error)
 
 
 class BusRobot:

@@ -19,6 +19,9 @@ monitor is closed, its machine drops off — its hooks are released within the l
 (about 2 s), so a forgotten breakpoint or a disabled branch never outlives whoever set it.
 A request with ``keep`` set survives its client; so does one from a client the runner cannot
 see on the bus (reported in the reply).
+
+The services run on the thread the runner gives (``callbacks``), not on its node's thread, so
+a reload or anything else the node does never delays them.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import numpy as np
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Hook, HookError, HookMode, Tree
 from cyborg.bus import Node, Qos
+from cyborg.bus.executor import CallbackThread
 from cyborg.bus.services import Responder
 from cyborg.bus.wire import EntityKind, gid
 
@@ -49,7 +53,8 @@ SEE_CALLER = 1.0
 class TreeControl:
     """The control services of one tree runner; ``current()`` is the tree being ticked."""
 
-    def __init__(self, node: Node, current: Callable[[], Tree]) -> None:
+    def __init__(self, node: Node, current: Callable[[], Tree], *,
+                 callbacks: CallbackThread | None = None) -> None:
         self.node, self.current = node, current
         self.graph = node.context.graph
         self._owners: dict[str, str] = {}  # owner (client GID hex) -> its node's name
@@ -60,11 +65,12 @@ class TreeControl:
             "cyborg_msgs/msg/BehaviorTreeHooks", "cyborg_msgs/srv/ControlNode_Response",
             "std_srvs/srv/Trigger_Response", "cyborg_msgs/srv/GetBlackboard_Response")}
         node.create_service("control", "cyborg_msgs/srv/ControlNode", self._on_control,
-                            deferred=True)
-        node.create_service("resume", "std_srvs/srv/Trigger", self._on_resume)
-        node.create_service("step", "std_srvs/srv/Trigger", self._on_step)
+                            deferred=True, callbacks=callbacks)
+        node.create_service("resume", "std_srvs/srv/Trigger", self._on_resume,
+                            callbacks=callbacks)
+        node.create_service("step", "std_srvs/srv/Trigger", self._on_step, callbacks=callbacks)
         node.create_service("get_blackboard", "cyborg_msgs/srv/GetBlackboard",
-                            self._on_blackboard)
+                            self._on_blackboard, callbacks=callbacks)
         current().hooks.listeners.append(self.publish)
         self._stop_watching = self.graph.on_change(self._release_departed)
         self.publish()

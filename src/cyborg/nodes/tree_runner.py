@@ -19,16 +19,32 @@ name                        type                                what
 ``reload``                  cyborg_msgs/ReloadTree              service: load the file again
 ==========================  ==================================  ==================================
 
-plus the per-node controls of :mod:`cyborg.nodes.tree_control` (hooks, breakpoints, blackboard).
+plus the per-node controls of :mod:`cyborg.nodes.tree_control` (hooks, breakpoints, blackboard),
+and the node parameter ``reload_timeout`` (seconds, wall time; default 30).
+
+**Services never wait on each other.** ``enable`` — the stop button — is answered on a thread
+of its own, the other control services (``control``, ``step``, ``resume``,
+``get_blackboard``) on another, and neither waits for ``reload`` or for anything else the
+node's own thread does (``/clock``, parameters). A reload loads in the background.
 
 **Enable and disable.** Unlike 2018, disabling *halts* the tree: every RUNNING node is halted,
 so a MoveTo cancels its goal and the robot stops. Enabling starts the tree afresh from its root
 (memories of halted nodes are reset, as after any halt). The flag is latched on ``enabled``.
+Disabling stops the ticks at once; the halt needs the tick in progress to end, so when a node
+in it waits on a slow robot, ``enable`` answers after :data:`HALT_WAIT` seconds anyway (saying
+so) and the halt follows when that tick ends; ``enable(true)`` meanwhile is refused (the tree
+must not run before its halt), never held up.
 
-**Reload.** The file (or another one) is loaded and checked first; a file with errors is
-rejected with every problem in the reply and the running tree keeps running. A good file
-replaces the tree between two ticks: the old tree is halted, the global blackboard and the
-hooks on nodes that still exist are kept, and the new structure is published.
+**Reload.** The file (or another one) is loaded and checked first, on a thread of its own; a
+file with errors is rejected with every problem in the reply and the running tree keeps running.
+A good file replaces the tree between two ticks: the old tree is halted, the global blackboard
+and the hooks on nodes that still exist are kept, and the new structure is published. A load
+that has not finished after ``reload_timeout`` seconds is answered with ``reload timed out:
+...`` and the running tree keeps running; the load itself cannot be stopped (a thread cannot
+be killed), so it goes on in the background and whatever it ends with is discarded. One reload
+runs at a time, and hanging loads cannot pile up (see
+:mod:`cyborg.nodes.background_reload`). The loader itself refuses files that are not regular
+and caps size, nesting and node instances.
 
 **Time.** The tree ticks on the clock it is given: the wall clock, or simulated time from
 ``/clock`` (:class:`cyborg.bus.SimClock`) with ``use_sim_time``.
@@ -49,17 +65,23 @@ from cyborg.bt import (
     Clock,
     NodeRegistry,
     Tree,
-    TreeLoadError,
     TreeRunner,
     default_registry,
     load_tree,
 )
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import Node, Qos, SimClock
+from cyborg.bus.services import Responder
+from cyborg.nodes.background_reload import BackgroundReloads
 from cyborg.nodes.robot import ROBOT, Robot
 from cyborg.nodes.tree_control import TreeControl
 
 log = logging.getLogger("cyborg.nodes")
+
+RELOAD_TIMEOUT = 30.0
+"""Seconds (wall time) a reload may take before it is answered with an error."""
+HALT_WAIT = 0.5
+"""Seconds ``enable(false)`` waits for the halt before it answers (see ``set_enabled``)."""
 
 
 class TreeRunnerNode:
@@ -67,9 +89,11 @@ class TreeRunnerNode:
 
     def __init__(self, node: Node, path: str | Path, *, tree: str | None = None,
                  rate_hz: float = 10.0, clock: Clock | None = None, robot: Robot | None = None,
-                 registry: NodeRegistry | None = None, enabled: bool = True) -> None:
+                 registry: NodeRegistry | None = None, enabled: bool = True,
+                 reload_timeout: float = RELOAD_TIMEOUT) -> None:
         """Load the tree (raises :class:`~cyborg.bt.TreeLoadError`) and set up the topics and
-        services; :meth:`start` begins ticking."""
+        services; :meth:`start` begins ticking. ``reload_timeout`` is the default of the node
+        parameter of that name (a value given to the node at start-up wins)."""
         self.node, self.path, self.tree_choice = node, Path(path), tree
         self.registry = registry if registry is not None else default_registry()
         self.clock = clock
@@ -79,6 +103,12 @@ class TreeRunnerNode:
         self._enabled = enabled
         self._active: tuple[str, ...] | None = None
         self._lock = threading.Lock()
+        self._halting: threading.Thread | None = None  # halts the tree once its tick ends
+        self._reloads = BackgroundReloads(self._load_next, self._install, self._answer_reload)
+        if "reload_timeout" not in node.parameters:
+            node.parameters.declare("reload_timeout", float(reload_timeout), "seconds (wall "
+                                    "time) a reload may take before it is answered with an "
+                                    "error", limits=(0.01, 3600.0))
         types = node.types
         latched = Qos.latched()
         self._structure = node.create_publisher("behavior_tree", "cyborg_msgs/msg/BehaviorTree",
@@ -92,9 +122,12 @@ class TreeRunnerNode:
             "std_msgs/msg/Bool", "cyborg_msgs/msg/BehaviorTreeStatus",
             "builtin_interfaces/msg/Time", "std_srvs/srv/SetBool_Response",
             "cyborg_msgs/srv/ReloadTree_Response")}
-        node.create_service("enable", "std_srvs/srv/SetBool", self._on_enable)
-        node.create_service("reload", "cyborg_msgs/srv/ReloadTree", self._on_reload)
-        self.control = TreeControl(node, lambda: self.tree)
+        node.create_service("enable", "std_srvs/srv/SetBool", self._on_enable,
+                            callbacks=node.callback_thread("enable"))
+        node.create_service("reload", "cyborg_msgs/srv/ReloadTree", self._on_reload,
+                            deferred=True)
+        self.control = TreeControl(node, lambda: self.tree,
+                                   callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
         self._publish_structure()
         self._publish_enabled()
@@ -105,17 +138,30 @@ class TreeRunnerNode:
         return load_tree(path, tree=self.tree_choice, registry=self.registry, clock=self.clock,
                          blackboard=blackboard)
 
+    @property
+    def reload_timeout(self) -> float:
+        """Seconds (wall time) a reload over the bus may take: the node parameter."""
+        return float(self.node.parameters["reload_timeout"])
+
     def reload(self, path: str | Path | None = None) -> Tree:
         """Load ``path`` (default: the current file) and tick it from the next tick on.
 
-        Raises :class:`~cyborg.bt.TreeLoadError` (the old tree keeps running) on errors.
+        Raises :class:`~cyborg.bt.TreeLoadError` (the old tree keeps running) on errors. This
+        waits for the load, however long it takes; the ``reload`` service does not.
         """
         path = Path(path) if path else self.path
+        return self._install(self._load_next(path), path)
+
+    def _load_next(self, path: Path) -> Tree:
+        """Load ``path`` as the next tree: same globals and resources as the running one."""
         old = self.tree
-        tree = self._load(path, Blackboard(old.blackboard.globals,
+        return self._load(path, Blackboard(old.blackboard.globals,
                                            resources=old.blackboard.resources))
+
+    def _install(self, tree: Tree, path: Path) -> Tree:
+        # between two ticks: may wait for one, so not under _lock (enable never waits on it)
+        old = self.runner.replace_tree(tree)
         with self._lock:
-            self.runner.replace_tree(tree)
             self.tree, self.path, self._active = tree, path, None
         self.control.tree_replaced(old, tree)
         self._publish_structure()
@@ -145,20 +191,43 @@ class TreeRunnerNode:
                     return
         self.runner.run()
 
-    def set_enabled(self, enabled: bool) -> None:
-        """Run (True) or halt and pause (False) the tree; see the module docstring."""
+    def set_enabled(self, enabled: bool, *, wait: float | None = None) -> bool:
+        """Run (True) or halt and pause (False) the tree; see the module docstring.
+
+        Disabling stops the ticks at once; the halt (a MoveTo cancels its goal) needs the tick
+        that may be running to end first, which a node waiting on a slow robot can delay.
+        ``wait`` bounds how long this waits for a pending halt (None: until it is done), and
+        the result says whether the change is complete: False after disabling means the halt
+        follows later; False when enabling means nothing changed, because the tree must not
+        run again before its halt.
+        """
         with self._lock:
+            halting = self._halting
+            if halting is not None:
+                halting.join(wait if enabled else 0)
+                if not halting.is_alive():
+                    halting = self._halting = None
             if enabled == self._enabled:
-                return
-            self._enabled = enabled
+                return halting is None
             if enabled:
+                if halting is not None:
+                    return False
+                self._enabled = True
                 self.runner.resume()
             else:
-                self.runner.pause(halt=True)
+                self._enabled = False
+                self.runner.pause()  # no tick starts from now on; the halt follows
                 self._active = None
+                halting = self._halting = threading.Thread(
+                    target=self.runner.pause, kwargs={"halt": True}, daemon=True,
+                    name="cyborg-tree-halt")
+                halting.start()
         self._publish_enabled()
-        if not enabled:
-            self._publish_active(())
+        if enabled or halting is None:
+            return True
+        self._publish_active(())
+        halting.join(wait)
+        return not halting.is_alive()
 
     def stop(self) -> None:
         """Stop ticking and halt the tree (the robot stops); withdraws nothing from the bus."""
@@ -167,6 +236,7 @@ class TreeRunnerNode:
             self._thread.join(5.0)
 
     def destroy(self) -> None:
+        self._reloads.close()
         self.stop()
         self.control.destroy()
         self.node.destroy()
@@ -208,16 +278,24 @@ class TreeRunnerNode:
 
     # ------------------------------------------------------------------ services
     def _on_enable(self, request: Any) -> Any:
-        self.set_enabled(bool(request.data))
-        return self._classes["std_srvs/srv/SetBool_Response"](
-            success=True, message="enabled" if self._enabled else "disabled")
+        on = bool(request.data)
+        done = self.set_enabled(on, wait=HALT_WAIT)
+        response = self._classes["std_srvs/srv/SetBool_Response"]
+        if on and not done:
+            return response(success=False, message=(
+                "not enabled: the tree is still halting, because the tick before the disable "
+                "has not ended (a node in it is waiting, e.g. on the robot); try again"))
+        message = "enabled" if self._enabled else "disabled"
+        if not done:
+            message += ("; ticking has stopped and the tree halts when its current tick ends "
+                        "(a node in it is still waiting, e.g. on the robot)")
+        return response(success=True, message=message)
 
-    def _on_reload(self, request: Any) -> Any:
-        response = self._classes["cyborg_msgs/srv/ReloadTree_Response"]
-        try:
-            tree = self.reload(request.path or None)
-        except TreeLoadError as exc:
-            problems = "\n".join(str(problem) for problem in exc.problems)
-            return response(success=False, message=problems or str(exc))
-        return response(success=True, message=f"loaded {tree.title!r} ({len(tree)} nodes) "
-                                              f"from {self.path}")
+    def _on_reload(self, request: Any, responder: Responder) -> None:
+        """Start loading in the background and return at once (deferred: the load answers)."""
+        path = Path(request.path) if request.path else self.path
+        self._reloads.request(path, responder, self.reload_timeout)
+
+    def _answer_reload(self, responder: Responder, success: bool, message: str) -> None:
+        responder.reply(self._classes["cyborg_msgs/srv/ReloadTree_Response"](
+            success=success, message=message))
