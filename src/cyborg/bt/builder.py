@@ -10,6 +10,16 @@
   properties are checked against the class's signature and passed to its constructor.
 * With ``stub_missing``, a stub stands in for each node without a class, and for each node
   whose :attr:`~cyborg.bt.node.Node.requires` names a resource the blackboard lacks.
+* The caps of :class:`~cyborg.bt.limits.Limits` hold while building. A node deeper than
+  ``max_depth`` levels (the root tree's own node is level 1, each subtree reference adds one) is
+  an error and nothing below it is built, so neither building nor ticking can exhaust the
+  stack. The instances a tree would make are counted on the specs first
+  (:mod:`cyborg.bt.expansion`) and a tree over ``max_nodes`` is refused before any of it is
+  built, so doubled references cannot take the memory and time of 2^n copies (building counts
+  too, as a second line). A property value nested deeper than
+  :data:`~cyborg.bt.limits.MAX_VALUE_DEPTH` is an error naming the property.
+* With ``check_all`` (``check_file``) every tree of the project is built once: a reference to a
+  tree built already is not expanded again, and its depth is taken from the count above.
 
 Every problem found is collected, and :class:`~cyborg.bt.problems.TreeLoadError` lists them all.
 """
@@ -23,11 +33,14 @@ from pathlib import Path
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 from cyborg.bt.editor_v1_names import REPLACED_IN_CYBORG
+from cyborg.bt.expansion import Size, measure
+from cyborg.bt.limits import MAX_VALUE_DEPTH, Limits, nesting_exceeds
 from cyborg.bt.node import Category, Node, TickRecord
 from cyborg.bt.ports import bind_ports
-from cyborg.bt.problems import Problem, Severity
+from cyborg.bt.problems import Problem, Severity, shown
 from cyborg.bt.properties import bind
 from cyborg.bt.registry import NodeRegistry
+from cyborg.bt.specs import choose_tree
 from cyborg.bt.status import Status
 from cyborg.bt.stubs import stub_class
 
@@ -58,41 +71,27 @@ class BuildResult:
     problems: list[Problem]
 
 
-def choose_tree(project: ProjectSpec, wanted: str | None) -> tuple[TreeSpec | None, str]:
-    """The tree to run: by id or title if ``wanted``, else the selected one.
+class _TooManyNodesError(Exception):
+    """Raised by the builder at the ``max_nodes``-th + 1 instance, to stop at once."""
 
-    Returns the tree, or None and the reason.
-    """
-    trees = project.trees
-    listing = ", ".join(f"{t.title!r} ({t.id})" for t in trees) or "none"
-    if not trees:
-        return None, "the file holds no tree (only node definitions?)"
-    if wanted is not None:
-        by_id = [t for t in trees if t.id == wanted]
-        by_title = [t for t in trees if t.title == wanted]
-        if by_id:
-            return by_id[0], ""
-        if len(by_title) == 1:
-            return by_title[0], ""
-        if by_title:
-            return None, f"several trees are titled {wanted!r}; pick one by id: {listing}"
-        return None, f"no tree has the id or title {wanted!r}; trees: {listing}"
-    if project.selected_tree is not None:
-        for tree in trees:
-            if tree.id == project.selected_tree:
-                return tree, ""
-        return None, f"selectedTree {project.selected_tree!r} is not in the file; trees: {listing}"
-    referenced = {node.name for tree in trees for node in tree.nodes.values()}
-    tops = [tree for tree in trees if tree.id not in referenced]
-    if len(trees) == 1 or len(tops) == 1:
-        return (trees[0] if len(trees) == 1 else tops[0]), ""
-    return None, f"no selectedTree in the file; pick a tree by id or title: {listing}"
+    def __init__(self, tree: TreeSpec, spec: NodeSpec | None) -> None:
+        super().__init__(tree.id)
+        self.tree, self.spec = tree, spec
 
 
 class _Builder:
     def __init__(self, project: ProjectSpec, registry: NodeRegistry, blackboard: Blackboard,
-                 record: TickRecord, stub_missing: Status | None) -> None:
+                 record: TickRecord, stub_missing: Status | None, limits: Limits) -> None:
         self.project = project
+        self.limits = limits
+        self.count = 0
+        """Node instances built so far, for ``max_nodes``."""
+        self.sizes: dict[str, Size] = measure(project, limits.max_nodes)
+        self.built: set[str] = set()
+        """Ids of the trees instantiated so far."""
+        self.shallow = False
+        """Checking a project's other trees: a reference to a tree already built is not
+        expanded again (its problems are known; its size comes from :attr:`sizes`)."""
         self.registry = registry
         self.blackboard = blackboard
         self.record = record
@@ -114,17 +113,53 @@ class _Builder:
             message, source, line, None, tree.display_name if tree else None,
             spec.id if spec else None, spec.label if spec else None, field, severity))
 
+    def counted(self, tree: TreeSpec, spec: NodeSpec | None) -> None:
+        """Count one more instance; past ``max_nodes``, stop the whole build."""
+        self.count += 1
+        if self.count > self.limits.max_nodes:
+            raise _TooManyNodesError(tree, spec)
+
+    def too_deep(self, tree: TreeSpec, spec: NodeSpec, level: int) -> bool:
+        """Whether a node whose deepest level is ``level`` is past ``max_depth``; if so,
+        report it (the caller builds nothing below it)."""
+        limits = self.limits
+        if level <= limits.max_depth:
+            return False
+        self.report(f"the tree is nested more deeply than {limits.max_depth} levels (the root "
+                    "tree's own node is level 1 and each subtree reference adds one), which "
+                    f"could exhaust Python's stack when ticked; {limits.how_to_raise('max_depth')}",
+                    tree, spec, "name" if spec.name in self.trees else "children")
+        return True
+
+    def properties_too_deep(self, tree: TreeSpec, spec: NodeSpec | None,
+                            properties: dict[str, object]) -> bool:
+        """Report each property whose value nests deeper than MAX_VALUE_DEPTH."""
+        deep = [key for key, value in properties.items()
+                if nesting_exceeds(value, MAX_VALUE_DEPTH)]
+        for key in deep:
+            self.report(f"property {key!r} nests lists or objects more than {MAX_VALUE_DEPTH} "
+                        "levels deep", tree, spec, key)
+        return bool(deep)
+
     # ------------------------------------------------------------------ trees
     def instance(self, tree: TreeSpec, uid: str, prefix: str, depth: int,
-                 stack: tuple[TreeSpec, ...], title: str, outer_uid: str) -> Subtree:
-        """A Subtree node for one instance of ``tree`` and everything below it."""
+                 stack: tuple[TreeSpec, ...], title: str, outer_uid: str,
+                 level: int = 1, expand: bool = True) -> Subtree:
+        """A Subtree node (at ``level``) for one instance of ``tree`` and everything below
+        (only the Subtree node itself unless ``expand``)."""
+        self.counted(tree, None)
+        self.built.add(tree.id)
+        properties = {} if self.properties_too_deep(tree, None, tree.properties) \
+            else tree.properties
         holder = Subtree()
         holder.tree_id = tree.id
         holder.tree_title = tree.title
         holder.bind(uid=uid, node_id=uid.rsplit("/", 1)[-1], name=tree.id, title=title,
-                    label=title, description=tree.description, properties=tree.properties,
+                    label=title, description=tree.description, properties=properties,
                     tree_uid=outer_uid, subtree_depth=max(depth - 1, 0),
                     blackboard=self.blackboard, record=self.record)
+        if not expand:
+            return holder
         if tree.root is None:
             self.report("tree has no root: nothing is connected to its Root block", tree,
                         field="root")
@@ -133,7 +168,8 @@ class _Builder:
             self.report(f"root {tree.root!r} is not a node of this tree", tree, field="root")
             return holder
         reached: set[str] = set()
-        root = self.node(tree, tree.root, prefix, max(depth, 0), stack, (), reached, uid)
+        root = self.node(tree, tree.root, prefix, max(depth, 0), stack, (), reached, uid,
+                         level + 1)
         for node_id in tree.nodes.keys() - reached:
             self.report("node is not connected to the tree and is ignored", tree,
                         tree.nodes[node_id], severity=Severity.WARNING)
@@ -144,12 +180,17 @@ class _Builder:
     # ------------------------------------------------------------------ nodes
     def node(self, tree: TreeSpec, node_id: str, prefix: str, depth: int,
              stack: tuple[TreeSpec, ...], path: tuple[str, ...], reached: set[str],
-             tree_uid: str) -> Node | None:
+             tree_uid: str, level: int) -> Node | None:
         spec = tree.nodes[node_id]
         reached.add(node_id)
+        if self.too_deep(tree, spec, level):
+            _reach_below(tree, spec, reached)
+            return None
         if spec.name in self.trees:
-            return self.reference(tree, spec, prefix, depth, stack, tree_uid)
-        node = self.construct(tree, spec)
+            return self.reference(tree, spec, prefix, depth, stack, tree_uid, level)
+        self.counted(tree, spec)
+        node = None if self.properties_too_deep(tree, spec, spec.properties) \
+            else self.construct(tree, spec)
         children: list[Node] = []
         for child_id in spec.children:
             if child_id not in tree.nodes:
@@ -163,7 +204,7 @@ class _Builder:
                             "children")
             else:
                 child = self.node(tree, child_id, prefix, depth, stack, (*path, node_id),
-                                  reached, tree_uid)
+                                  reached, tree_uid, level + 1)
                 if child is not None:
                     children.append(child)
         if node is None:
@@ -203,7 +244,7 @@ class _Builder:
         node.ports = ports
 
     def reference(self, tree: TreeSpec, spec: NodeSpec, prefix: str, depth: int,
-                  stack: tuple[TreeSpec, ...], outer_uid: str) -> Node | None:
+                  stack: tuple[TreeSpec, ...], outer_uid: str, level: int) -> Node | None:
         target = self.trees[spec.name]
         if spec.children:
             self.report("a subtree reference cannot have children", tree, spec, "children")
@@ -214,8 +255,11 @@ class _Builder:
             return None
         uid = prefix + spec.id
         title = spec.label if spec.title and spec.title != spec.name else target.title
+        expand = not (self.shallow and target.id in self.built)
+        if not expand and self.too_deep(tree, spec, level - 1 + self.sizes[target.id].levels):
+            return None
         return self.instance(target, uid, uid + "/", depth + 1, (*stack, target), title,
-                             outer_uid)
+                             outer_uid, level, expand)
 
     def construct(self, tree: TreeSpec, spec: NodeSpec) -> Node | None:
         if not spec.name:
@@ -266,29 +310,68 @@ class _Builder:
 
 def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = None,
           blackboard: Blackboard | None = None, record: TickRecord | None = None,
-          stub_missing: Status | None = None, check_all: bool = False) -> BuildResult:
+          stub_missing: Status | None = None, check_all: bool = False,
+          limits: Limits | None = None) -> BuildResult:
     """Build the chosen tree (and every tree it references) into live nodes.
 
     With ``check_all`` every other tree in the project is also built, to find its problems;
     only the chosen tree is returned. Problems of both severities are in the result.
+    ``limits`` (default: :meth:`Limits.resolve() <cyborg.bt.limits.Limits.resolve>`) caps
+    the depth and the number of instances of each tree built.
     """
     builder = _Builder(project, registry, Blackboard() if blackboard is None else blackboard,
                        TickRecord() if record is None else record,
-                       stub_missing)
+                       stub_missing,
+                       limits if limits is not None else Limits.resolve(source=project.source))
     builder.problems.extend(project.problems)
     chosen, reason = choose_tree(project, tree)
     root = None
     if chosen is None:
-        if project.kind != "nodes" or tree is not None:
+        if project.kind != "nodes" or tree is not None or not check_all:
             builder.report(reason, field="selectedTree")
     else:
-        root = builder.instance(chosen, chosen.id, "", 0, (chosen,), chosen.title, chosen.id)
+        root = _build_top(builder, chosen)
     if check_all:
+        # Each other tree is built once, without expanding again the subtrees built already,
+        # so checking costs time in proportion to the file, not to the instances it makes.
+        builder.shallow = True
         for other in project.trees:
-            if other is not chosen:
-                builder.instance(other, other.id, "", 0, (other,), other.title, other.id)
+            if other.id not in builder.built:  # the chosen tree too, if it was too big
+                _build_top(builder, other)
         _check_definitions(builder)
     return BuildResult(root, chosen, builder.problems)
+
+
+def _build_top(builder: _Builder, tree: TreeSpec) -> Subtree | None:
+    """One top-level instance of ``tree``; None when it has more than ``max_nodes``."""
+    limits = builder.limits
+    builder.count = 0
+    if builder.sizes[tree.id].nodes > limits.max_nodes:
+        _too_many(builder, tree, None)
+        if not builder.shallow:
+            return None
+    try:
+        return builder.instance(tree, tree.id, "", 0, (tree,), tree.title, tree.id)
+    except _TooManyNodesError as exc:  # the count above missed some: a safety net
+        _too_many(builder, exc.tree, exc.spec)
+        return None
+
+
+def _too_many(builder: _Builder, tree: TreeSpec, spec: NodeSpec | None) -> None:
+    limits = builder.limits
+    builder.report(f"the tree expands to more than {limits.max_nodes:,} node instances (each "
+                   "use of a subtree builds its own copy of it); "
+                   f"{limits.how_to_raise('max_nodes')}", tree, spec, "root")
+
+
+def _reach_below(tree: TreeSpec, spec: NodeSpec, reached: set[str]) -> None:
+    """Mark the nodes below ``spec`` in its tree as reached, without recursion."""
+    pending = list(spec.children)
+    while pending:
+        node_id = pending.pop()
+        if node_id in tree.nodes and node_id not in reached:
+            reached.add(node_id)
+            pending.extend(tree.nodes[node_id].children)
 
 
 def _check_definitions(builder: _Builder) -> None:
@@ -300,7 +383,8 @@ def _check_definitions(builder: _Builder) -> None:
             continue
         node_type = builder.registry.get(definition.name)
         where = Problem("", definition.source or project.source, definition.line,
-                        node_title=definition.name)
+                        node_title=definition.name,
+                        field="node definitions" if project.kind == "v1" else "custom_nodes")
         if node_type is None:
             if builder.stub_missing is None and project.kind != "v1":  # v1: an error per use
                 builder.problems.append(_at(where, f"custom node {definition.name!r} is declared "
@@ -315,9 +399,9 @@ def _check_definitions(builder: _Builder) -> None:
 
 
 def _at(where: Problem, message: str, severity: Severity) -> Problem:
-    return Problem(message, where.source, where.line, None, None, None, where.node_title, None,
-                   severity)
+    return Problem(message, where.source, where.line, None, None, None, where.node_title,
+                   where.field, severity)
 
 
 def _kwargs(kwargs: dict[str, object]) -> str:
-    return ", ".join(f"{key}={value!r}" for key, value in kwargs.items())
+    return ", ".join(f"{key}={shown(value)}" for key, value in kwargs.items())

@@ -12,6 +12,7 @@ running top to bottom.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -24,10 +25,14 @@ _SHAPES = {
 }
 _FILL = {"success": "#8fd18f", "failure": "#f28b82", "running": "#fdd663", "error": "#c58af9"}
 _IDLE = "#f1f3f4"
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def quote(text: str) -> str:
-    """A DOT double-quoted string."""
+    """A DOT double-quoted string; a lone surrogate (not a character, and not writable as
+    UTF-8) becomes U+FFFD, so the output can always be written."""
+    if not text.isascii():
+        text = _SURROGATE.sub("\ufffd", text)
     escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
     return f'"{escaped}"'
 
@@ -49,9 +54,23 @@ def structure_to_dot(structure: Mapping[str, Any], *,
         '  node [fontname="Helvetica", fontsize=11];',
         '  edge [arrowsize=0.6];',
     ]
-    cluster = [0]
-
-    def emit(node: Mapping[str, Any], indent: str) -> None:
+    cluster = 0
+    # Written with a stack of things still to write instead of recursion, so a structure of
+    # any depth can be exported. An entry is a node to draw, a sibling cluster to open, or a
+    # finished line; a node's entries are pushed in reverse, to come off in writing order.
+    pending: list[tuple[str, Any, str]] = [("node", structure["root"], "    ")]
+    lines.append('  subgraph cluster_0 { label=""; peripheries=0;')  # nesting alike at all depths
+    while pending:
+        kind, item, indent = pending.pop()
+        if kind == "line":
+            lines.append(item)
+            continue
+        if kind == "cluster":  # numbered when opened, so numbers follow the writing order
+            cluster += 1
+            lines.append(f"{indent}subgraph cluster_{cluster} {{")
+            lines.append(f"{indent}  {item}")
+            continue
+        node: Mapping[str, Any] = item
         uid = node["id"]
         label = node["label"] or node["name"]
         children = node.get("children", [])
@@ -64,32 +83,34 @@ def structure_to_dot(structure: Mapping[str, Any], *,
         bold = ', color="#188038", penwidth=3' if uid in active_ids else ""
         lines.append(f"{indent}{quote(uid)} [label={quote(label)}, {attributes}, "
                      f"fillcolor={quote(fill)}{bold}];")
+        later: list[tuple[str, Any, str]] = []
         # ordering=out alone lets Graphviz swap siblings once clusters are involved; a cluster
         # per sibling (invisible unless it is a subtree instance) keeps them in tick order. A
         # left-to-right drawing stacks sibling clusters bottom-up, so they are written reversed.
         for child in (children[::-1] if rankdir == "LR" else children):
             subtree = child["category"] == "tree" and child.get("children")
             if subtree or len(children) > 1:
-                cluster[0] += 1
                 frame = (f'label={quote(child["label"])}; style=dashed; color="#9aa0a6"; '
                          "peripheries=1;" if subtree else 'label=""; peripheries=0;')
-                lines.append(f"{indent}subgraph cluster_{cluster[0]} {{")
-                lines.append(f"{indent}  {frame}")
-                emit(child, indent + "  ")
-                lines.append(f"{indent}}}")
+                later += [("cluster", frame, indent), ("node", child, indent + "  "),
+                          ("line", f"{indent}}}", "")]
             else:
-                emit(child, indent)
+                later.append(("node", child, indent))
         for child in children:
             edge_bold = (' [color="#d93025", style=dashed, penwidth=2]'
                          if uid in active_ids and child["id"] in active_ids else "")
-            lines.append(f"{indent}{quote(uid)} -> {quote(child['id'])}{edge_bold};")
-
-    lines.append('  subgraph cluster_0 { label=""; peripheries=0;')  # nesting alike at all depths
-    emit(structure["root"], "    ")
+            later.append(("line", f"{indent}{quote(uid)} -> {quote(child['id'])}{edge_bold};",
+                          ""))
+        pending.extend(reversed(later))
     lines.append("  }")
     lines.append("}")
     return "\n".join(lines) + "\n"
 
 
 def _count(node: Mapping[str, Any]) -> int:
-    return 1 + sum(_count(child) for child in node.get("children", []))
+    """Nodes in ``node``'s subtree, itself included (counted without recursion)."""
+    count, pending = 0, [node]
+    while pending:
+        count += 1
+        pending.extend(pending.pop().get("children", []))
+    return count

@@ -20,13 +20,14 @@ of ``properties``) are used, with ``properties`` winning where both set a key.
 from __future__ import annotations
 
 import bisect
-import json
 import re
 from pathlib import Path
 from typing import Any
 
 from cyborg.bt.editor_v1 import V1Reader, is_v1, is_v1_definitions, parse_definitions
-from cyborg.bt.problems import Problem, Severity, TreeLoadError
+from cyborg.bt.files import FileRefusedError, decode_json, read_text
+from cyborg.bt.limits import Limits
+from cyborg.bt.problems import Problem, Severity, TreeLoadError, shown
 from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec, render_title
 
 __all__ = ["NodeDefinition", "NodeSpec", "ProjectSpec", "TreeSpec", "parse_project",
@@ -124,7 +125,8 @@ class _Reader:
 
     def tree(self, raw: Any, index: int) -> TreeSpec | None:
         if not isinstance(raw, dict):
-            self.problem(f"tree #{index + 1} is not a JSON object")
+            self.problem(f"tree #{index + 1} is not a JSON object", key="trees",
+                         line=self.lines.of_key("trees"))
             return None
         title = _text(raw.get("title"))
         nodes = raw.get("nodes")
@@ -148,7 +150,7 @@ class _Reader:
                 tree_id = f"{base} ({copy})"
             derived.add(tree_id)
         elif not isinstance(tree_id, str):
-            self.problem(f"tree #{index + 1}: 'id' must be a string, not {tree_id!r}",
+            self.problem(f"tree #{index + 1}: 'id' must be a string, not {shown(tree_id)}",
                          key="id")
             tree_id = f"tree-{index + 1}"
         # With no id in the file, point at the tree's first node: the nearest known line.
@@ -185,7 +187,7 @@ class _Reader:
         title = _text(raw.get("title"))
         node_id = raw.get("id", key)
         if node_id != key:
-            self.problem(f"node is stored under key {key!r} but its 'id' is {node_id!r}",
+            self.problem(f"node is stored under key {key!r} but its 'id' is {shown(node_id)}",
                          tree=tree, node=key, title=title, line=line, key="id")
         name = raw.get("name")
         if not isinstance(name, str) or not name:
@@ -237,22 +239,18 @@ class _Reader:
         return result
 
 
-def parse_project(text: str, source: str = "<string>", path: Path | None = None) -> ProjectSpec:
+def parse_project(text: str, source: str = "<string>", path: Path | None = None, *,
+                  limits: Limits | None = None) -> ProjectSpec:
     """Read an export from ``text``: behavior3editor 0.3.0, or a 1.x tree file or node
     definitions (:mod:`cyborg.bt.editor_v1`, which finds the files it references from
-    ``path``). Raises :class:`TreeLoadError` naming every problem."""
+    ``path`` and charges them to ``limits``). Raises :class:`TreeLoadError` naming every
+    problem."""
     text = text.removeprefix("\ufeff")
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise TreeLoadError([Problem(f"malformed JSON: {exc.msg}", source, exc.lineno,
-                                     exc.colno)]) from None
-    except RecursionError:
-        raise TreeLoadError([Problem("malformed JSON: nested more deeply than the JSON reader "
-                                     "allows", source, 1)]) from None
+    limits = limits if limits is not None else Limits.resolve(source=source)
+    data = decode_json(text, source, limits)
     problems: list[Problem]
     if is_v1(data):
-        reader_v1 = V1Reader(source, path)
+        reader_v1 = V1Reader(source, path, limits)
         project = reader_v1.read(data, text)
         problems = reader_v1.problems
     elif is_v1_definitions(data):
@@ -268,15 +266,18 @@ def parse_project(text: str, source: str = "<string>", path: Path | None = None)
     return project
 
 
-def read_project(path: str | Path) -> ProjectSpec:
-    """Read an export file. Raises :class:`TreeLoadError` (also for an unreadable file)."""
+def read_project(path: str | Path, *, limits: Limits | None = None) -> ProjectSpec:
+    """Read an export file. Raises :class:`TreeLoadError` (also for a file that cannot or may
+    not be read: see :mod:`cyborg.bt.files`). ``limits`` default to
+    :meth:`Limits.resolve() <cyborg.bt.limits.Limits.resolve>`."""
     path = Path(path)
+    limits = limits if limits is not None else Limits.resolve(source=str(path))
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise TreeLoadError([Problem(f"cannot read the file: {reason}", str(path))]) from None
-    return parse_project(text, str(path), path)
+        text = read_text(path, limits)
+    except FileRefusedError as exc:
+        raise TreeLoadError([Problem(exc.reason, str(path), exc.line,
+                                     field=None if exc.line else "file")]) from None
+    return parse_project(text, str(path), path, limits=limits)
 
 
 def _text(value: Any) -> str:
@@ -322,6 +323,6 @@ def _settings(raw: dict[str, Any]) -> tuple[dict[str, Any], list[tuple[Severity,
                           "'properties'), as 'properties' does not set it"))
         elif properties[key] != value:
             found.append((Severity.WARNING, "parameters",
-                          f"{key!r} under 'parameters' ({value!r}) is ignored: 'properties' "
-                          f"sets it to {properties[key]!r}"))
+                          f"{key!r} under 'parameters' ({shown(value)}) is ignored: 'properties' "
+                          f"sets it to {shown(properties[key])}"))
     return merged, found

@@ -26,23 +26,27 @@ How it becomes a :class:`~cyborg.bt.editor_format.ProjectSpec`:
   blackboard variables; once any are declared, an input or output naming an undeclared one is
   a warning. ``debug``, ``group``, ``prefix``, ``custom`` and ``$``-keys do not change how a
   tree runs and are ignored.
+
+Every file is read through :mod:`cyborg.bt.files` (regular files only, never blocking) and
+charged to the load's byte budget (:class:`~cyborg.bt.limits.Limits`); nesting, counted across
+subtree files, stops at ``max_depth`` with a located error, so a chain of files referencing each
+other cannot exhaust the stack. Imports are followed without recursion.
 """
 
 from __future__ import annotations
 
 import bisect
-import json
 import re
 from pathlib import Path
 from typing import Any
 
 from cyborg.bt.editor_v1_names import EQUIVALENTS, NO_EQUIVALENT
-from cyborg.bt.problems import Problem, Severity
+from cyborg.bt.files import FileRefusedError, decode_json, read_text
+from cyborg.bt.limits import Limits
+from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 
 SETTING_FILE = "node-config.b3-setting"
-MAX_DEPTH = 200
-"""Levels of nesting a tree may have (deeper is refused with a located error, not a crash)."""
 _ID = re.compile(r'"id"\s*:\s*(?:"((?:[^"\\]|\\.)*)"|(-?\d+))')
 _CATEGORIES = ("action", "condition", "decorator", "composite")
 
@@ -81,9 +85,10 @@ def parse_definitions(raw: list[Any], source: str, text: str = "") -> tuple[
                                     field="name"))
             continue
         assert isinstance(item, dict)
-        kind = str(item.get("type", "")).lower()
+        kind = _text(item.get("type")).lower()
         category = next((c for c in _CATEGORIES if kind.startswith(c)), "")
-        defaults = {arg["name"]: arg["default"] for arg in item.get("args") or []
+        args = item.get("args")
+        defaults = {arg["name"]: arg["default"] for arg in (args if isinstance(args, list) else [])
                     if isinstance(arg, dict) and isinstance(arg.get("name"), str)
                     and "default" in arg}
         definitions.append(NodeDefinition(
@@ -118,13 +123,15 @@ class _LineIndex:
 class V1Reader:
     """Reads one v1 tree file and every file it references into a project."""
 
-    def __init__(self, source: str, path: Path | None) -> None:
+    def __init__(self, source: str, path: Path | None, limits: Limits | None = None) -> None:
         self.source = source
         self.path = path
+        self.limits = limits if limits is not None else Limits.resolve(source=source)
         self.workdir = find_workdir(path) if path is not None else None
         self.problems: list[Problem] = []
         self.trees: list[TreeSpec] = []
         self._tree_ids: dict[Path, str] = {}
+        self._unreadable: set[Path] = set()
         self._declared: set[str] = set()
         self._defaults: dict[str, dict[str, Any]] = {}
 
@@ -141,8 +148,8 @@ class V1Reader:
         project = ProjectSpec(self.source, "v1")
         project.definitions = self.definitions()
         self._defaults = {d.name: d.properties for d in project.definitions}
-        self._declared = self.declarations(data, self.source, set())
-        main = self.tree(data, text, self.source, self.path)
+        self._declared = self.declarations(data, self.source)
+        main = self.tree(data, text, self.source, self.path, 0)
         project.trees = self.trees
         project.selected_tree = main.id
         self.check_variables(project)
@@ -156,7 +163,7 @@ class V1Reader:
         folders = [self.workdir, self.path.resolve().parent]
         for folder in dict.fromkeys(f for f in folders if f is not None):
             candidate = folder / relative
-            if candidate.is_file():
+            if candidate.exists():  # a FIFO or folder is found here, and refused when read
                 return candidate.resolve()
         return None
 
@@ -170,54 +177,69 @@ class V1Reader:
                          tree=tree, node=node, line=tree.line, field=field)
             return None
         try:
-            text = path.read_text(encoding="utf-8-sig")
-            return path, json.loads(text), text
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            self.problem(f"{field} {relative!r}: cannot read {path}: {exc}", tree.source,
+            text = read_text(path, self.limits)
+            return path, decode_json(text, str(path), self.limits), text
+        except FileRefusedError as exc:
+            self.problem(f"{field} {relative!r}: cannot read {path}: {exc.reason}", tree.source,
                          tree=tree, node=node, line=tree.line, field=field)
-            return None
+        except TreeLoadError as exc:  # located in the file referenced
+            self.problems.extend(exc.problems)
+        return None
 
     def definitions(self) -> list[NodeDefinition]:
         if self.workdir is None:
             return []
         setting = self.workdir / SETTING_FILE
-        if not setting.is_file():
+        if not setting.exists():
             found = sorted(self.workdir.glob("*.b3-setting"))
             if len(found) != 1:
                 return []
             setting = found[0]
         try:
-            text = setting.read_text(encoding="utf-8-sig")
-            raw = json.loads(text)
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            self.problem(f"cannot read the node definitions: {exc}", str(setting),
-                         severity=Severity.WARNING)
+            text = read_text(setting, self.limits)
+            raw = decode_json(text, str(setting), self.limits)
+        except (FileRefusedError, TreeLoadError) as exc:
+            reason = exc.reason if isinstance(exc, FileRefusedError) else exc.problems[0].message
+            line = exc.line if isinstance(exc, FileRefusedError) else exc.problems[0].line
+            self.problem(f"cannot read the node definitions: {reason}", str(setting),
+                         line=line, field="node definitions", severity=Severity.WARNING)
             return []
         if not isinstance(raw, list):
             raw = raw.get("nodes") if isinstance(raw, dict) else None
         if not isinstance(raw, list):
-            self.problem("node definitions must be an array", str(setting),
-                         severity=Severity.WARNING)
+            self.problem("node definitions must be an array", str(setting), line=1,
+                         field="node definitions", severity=Severity.WARNING)
             return []
         definitions, problems = parse_definitions(raw, str(setting), text)
         self.problems.extend(problems)
         return definitions
 
-    def declarations(self, data: dict[str, Any], source: str, seen: set[Path]) -> set[str]:
-        """Variable names declared by a tree and, recursively, by the files it imports."""
-        raw = data.get("vars", data.get("declvar"))
-        names = {item["name"] for item in (raw if isinstance(raw, list) else [])
-                 if isinstance(item, dict) and isinstance(item.get("name"), str)}
-        holder = TreeSpec(source, _text(data.get("name")), "", None, {}, {}, 1, source)
-        for relative in _strings(data.get("import")):
-            loaded = self.load(relative, "import", holder)
-            if loaded is not None and loaded[0] not in seen and isinstance(loaded[1], dict):
-                seen.add(loaded[0])
-                names |= self.declarations(loaded[1], str(loaded[0]), seen)
+    def declarations(self, data: dict[str, Any], source: str) -> set[str]:
+        """Variable names declared by a tree and by the files it imports, and theirs (each
+        file once, followed with a work list rather than recursion)."""
+        names: set[str] = set()
+        seen: set[Path] = set()
+        pending: list[tuple[dict[str, Any], str]] = [(data, source)]
+        while pending:
+            data, source = pending.pop()
+            raw = data.get("vars", data.get("declvar"))
+            names |= {item["name"] for item in (raw if isinstance(raw, list) else [])
+                      if isinstance(item, dict) and isinstance(item.get("name"), str)}
+            holder = TreeSpec(source, _text(data.get("name")), "", None, {}, {}, 1, source)
+            for relative in _strings(data.get("import")):
+                path = self.resolve(relative)
+                if path is not None and path in seen:
+                    continue
+                loaded = self.load(relative, "import", holder)
+                if loaded is not None and isinstance(loaded[1], dict):
+                    seen.add(loaded[0])
+                    pending.append((loaded[1], str(loaded[0])))
         return names
 
     # ------------------------------------------------------------------ trees
-    def tree(self, data: dict[str, Any], text: str, source: str, path: Path | None) -> TreeSpec:
+    def tree(self, data: dict[str, Any], text: str, source: str, path: Path | None,
+             depth: int) -> TreeSpec:
+        """Read one tree file whose root sits ``depth`` levels below the main tree's root."""
         tree_id = self.tree_id(path)
         stem = path.stem if path is not None else "tree"
         title = _text(data.get("name")) or stem
@@ -230,7 +252,7 @@ class V1Reader:
         if version and not re.match(r"1\.", version):
             self.problem(f"written by behavior3editor {version}; read as a 1.x file", source,
                          line=1, tree=tree, field="version", severity=Severity.WARNING)
-        root = self.node(data["root"], tree, _LineIndex(text), source, [0])
+        root = self.node(data["root"], tree, _LineIndex(text), source, [0], depth)
         tree.root = root.id if root is not None else None
         return tree
 
@@ -248,9 +270,12 @@ class V1Reader:
         if not isinstance(raw, dict):
             self.problem("a node must be a JSON object", source, tree=tree, field="children")
             return None
-        if depth >= MAX_DEPTH:
-            self.problem(f"the tree is nested more deeply than {MAX_DEPTH} levels", source,
-                         tree=tree, line=lines.of_id(str(raw.get("id"))), field="children")
+        limits = self.limits
+        if depth >= limits.max_depth:
+            self.problem(f"the tree is nested more deeply than {limits.max_depth} levels "
+                         "(counting the files of subtrees as levels); "
+                         f"{limits.how_to_raise('max_depth')}", source, tree=tree,
+                         line=lines.of_id(str(raw.get("id"))), field="children")
             return None
         counter[0] += 1
         node_id = raw.get("id")
@@ -279,7 +304,7 @@ class V1Reader:
         spec.outputs = self.keys(raw, "output", tree, spec, source)
         path = raw.get("path")
         if isinstance(path, str) and path:
-            return self.reference(spec, path, tree, source)
+            return self.reference(spec, path, tree, source, depth)
         equivalent = EQUIVALENTS.get(spec.name)
         if equivalent is not None:
             spec.name, spec.properties = equivalent.name, equivalent.convert(args)
@@ -302,24 +327,33 @@ class V1Reader:
         return spec
 
     def reference(self, spec: NodeSpec, relative: str, tree: TreeSpec,
-                  source: str) -> NodeSpec | None:
+                  source: str, depth: int) -> NodeSpec | None:
         """A node with ``path``: the subtree file becomes a tree of the project (read once);
         the node refers to it by id."""
         spec.title = ""  # the subtree's own name labels it
         tree.nodes[spec.id] = spec
-        loaded = self.load(relative, "path", tree, spec)
-        if loaded is None:
+        resolved = self.resolve(relative)
+        known = self._tree_ids.get(resolved) if resolved is not None else None
+        if known is not None:  # read already: each file is read (and charged) once
+            spec.name = known
+            return spec
+        loaded = None if resolved in self._unreadable else self.load(relative, "path", tree,
+                                                                      spec)
+        if loaded is None:  # reported at the first reference to it
+            if resolved is not None:
+                self._unreadable.add(resolved)
             spec.name = ""
             return spec
         path, data, text = loaded
         known = self._tree_ids.get(path)
         if known is None:
             if not is_v1(data):
+                self._unreadable.add(path)
                 self.problem(f"path {relative!r}: {path} is not a behavior3 v1 tree file",
                              source, tree=tree, node=spec, field="path")
                 spec.name = ""
                 return spec
-            known = self.tree(data, text, str(path), path).id
+            known = self.tree(data, text, str(path), path, depth + 1).id
         spec.name = known
         return spec
 

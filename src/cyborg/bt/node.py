@@ -221,10 +221,13 @@ class Node:
             child.halt()
 
     def walk(self) -> Iterator[Node]:
-        """This node and its descendants, depth first, pre-order."""
-        yield self
-        for child in self.children:
-            yield from child.walk()
+        """This node and its descendants, depth first, pre-order (with a stack of its own,
+        not recursion, so a tree of any depth can be walked)."""
+        pending = [self]
+        while pending:
+            node = pending.pop()
+            yield node
+            pending.extend(reversed(node.children))
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.label or self.name!r} uid={self.uid!r}>"

@@ -7,8 +7,10 @@ so one run of ``cyborg bt validate`` reports them all.
 
 from __future__ import annotations
 
+import reprlib
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import Any
 
 
 class Severity(StrEnum):
@@ -51,7 +53,15 @@ class Problem:
             parts.append(f"node{title} (id {self.node_id})")
         context = ", ".join(parts)
         prefix = f"{where}: {self.severity.value}: "
-        return prefix + (f"{context}: " if context else "") + self.message
+        return printable(prefix + (f"{context}: " if context else "") + self.message)
+
+
+def printable(text: str) -> str:
+    """``text`` with any lone surrogate written as ``\\udcff``, so it can be encoded as UTF-8
+    (a file name with undecodable bytes holds some; printing it would raise)."""
+    if text.isascii():
+        return text
+    return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 class TreeLoadError(Exception):
@@ -63,3 +73,18 @@ class TreeLoadError(Exception):
         shown = "\n".join(f"  {p}" for p in errors)
         count = f"{len(errors)} error{'s' if len(errors) != 1 else ''}"
         super().__init__(f"cannot load the tree ({count}):\n{shown}")
+
+
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = _SHORT.maxother = 60
+_SHORT.maxlong = 40  # digits shown of a huge whole number
+_SHORT.maxlevel = 3
+
+
+def shown(value: Any) -> str:
+    """``repr(value)`` cut short for a message: a value from a file may be megabytes long or
+    nested hundreds of levels deep (a plain ``repr`` would then exhaust the stack)."""
+    try:
+        return _SHORT.repr(value)
+    except ValueError:  # an int past Python's int-to-text limit
+        return f"<a whole number of about {int(value.bit_length() * 0.30103):,} digits>"

@@ -11,6 +11,12 @@ The editor writes property names in camelCase (``maxLoop``); Python parameters a
 * ``int`` takes whole numbers (``2.0`` becomes ``2``), ``float`` takes any number, ``bool`` takes
   ``true``/``false``; a string holding a number or boolean is converted, because the editor's
   property panel lets users type numbers as text;
+* numbers must be **finite**: NaN is always refused (a NaN ``milliseconds`` made Wait run
+  forever, as every comparison with NaN is false), and so are ``inf``/``-inf`` (``Infinity``,
+  ``1e400``, ``"inf"``) and whole numbers too large for a float, except where the node says it
+  means infinity: a ``float`` parameter whose *default* is infinite (``below: float =
+  math.inf``, "no limit") also takes either infinity. A whole number of any size fits an
+  ``int`` parameter;
 * ``str``, ``Literal[...]``, ``Enum`` (by value or name), ``X | None``, ``list[X]``,
   ``dict[str, X]`` and ``Any`` are supported; other hints are passed through unchecked.
 
@@ -21,12 +27,15 @@ A required parameter with no property is an error; a property no parameter takes
 from __future__ import annotations
 
 import inspect
+import math
 import re
 import types
 import typing
 from dataclasses import dataclass
 from enum import Enum
 from typing import Any, Literal, Union
+
+from cyborg.bt.problems import shown
 
 _MISSING = inspect.Parameter.empty
 
@@ -45,6 +54,11 @@ class Param:
     @property
     def required(self) -> bool:
         return self.default is _MISSING
+
+    @property
+    def allows_infinity(self) -> bool:
+        """Whether the node declared infinity a meaningful value: its default is infinite."""
+        return isinstance(self.default, float) and math.isinf(self.default)
 
 
 @dataclass(frozen=True)
@@ -131,7 +145,7 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
             continue
         source[match.name] = key
         try:
-            kwargs[match.name] = convert(value, match.hint)
+            kwargs[match.name] = convert(value, match.hint, infinite=match.allows_infinity)
         except ValueError as exc:
             errors.append((key, f"property {key!r}: {exc}"))
     for param in signature.params:
@@ -141,21 +155,23 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
     return Binding(kwargs, errors, warnings)
 
 
-def convert(value: Any, hint: Any) -> Any:
+def convert(value: Any, hint: Any, *, infinite: bool = False) -> Any:
     """Check ``value`` against the type ``hint``, converting where the editor is loose.
 
-    Raises ValueError with a message that names the expected type and the value.
+    Numbers must be finite; ``infinite`` lets a ``float`` (at the top level, or in a union)
+    be ``inf`` or ``-inf`` too. Raises ValueError with a message that names the expected type
+    and the value.
     """
     if hint is Any or hint is inspect.Parameter.empty:
         return value
     origin = typing.get_origin(hint)
     if origin in (Union, types.UnionType):
-        return _convert_union(value, hint)
+        return _convert_union(value, hint, infinite)
     if origin is Literal:
         choices = typing.get_args(hint)
         if value in choices:
             return value
-        raise ValueError(f"expected one of {', '.join(map(repr, choices))}, got {value!r}")
+        raise ValueError(f"expected one of {', '.join(map(repr, choices))}, got {shown(value)}")
     if origin is list:
         return _convert_list(value, hint)
     if origin is dict:
@@ -169,7 +185,7 @@ def convert(value: Any, hint: Any) -> Any:
     if hint is int:
         return _convert_int(value)
     if hint is float:
-        return _convert_float(value)
+        return _convert_float(value, infinite)
     if hint is str:
         if isinstance(value, str):
             return value
@@ -189,16 +205,18 @@ def describe(hint: Any) -> str:
 
 
 def _mismatch(value: Any, hint: Any) -> ValueError:
-    return ValueError(f"expected {describe(hint)}, got {value!r} ({type(value).__name__})")
+    return ValueError(f"expected {describe(hint)}, got {shown(value)} ({type(value).__name__})")
 
 
-def _convert_union(value: Any, hint: Any) -> Any:
+def _convert_union(value: Any, hint: Any, infinite: bool) -> Any:
+    reasons = []
     for option in typing.get_args(hint):
         try:
-            return convert(value, option)
-        except ValueError:
-            continue
-    raise _mismatch(value, hint)
+            return convert(value, option, infinite=infinite)
+        except ValueError as exc:
+            reasons.append(str(exc))
+    finite = [reason for reason in reasons if "finite" in reason]
+    raise ValueError(finite[0]) if finite else _mismatch(value, hint)
 
 
 def _convert_list(value: Any, hint: Any) -> list[Any]:
@@ -229,7 +247,7 @@ def _number(value: Any, hint: type) -> float:
         raise _mismatch(value, hint)
     if isinstance(value, int | float):
         return value
-    if isinstance(value, str):
+    if isinstance(value, str) and len(value) <= 100:
         try:
             return float(value.strip())
         except ValueError:
@@ -237,15 +255,32 @@ def _number(value: Any, hint: type) -> float:
     raise _mismatch(value, hint)
 
 
+def _not_finite(value: Any, hint: type, infinite: bool) -> ValueError:
+    allowed = "a finite number or infinity" if infinite else "a finite number"
+    return ValueError(f"expected {allowed} ({describe(hint)}), got {shown(value)}")
+
+
 def _convert_int(value: Any) -> int:
     number = _number(value, int)
-    if number != number or number in (float("inf"), float("-inf")) or number != int(number):
+    if isinstance(number, int):
+        return number
+    if not math.isfinite(number):
+        raise _not_finite(value, int, False)
+    if number != int(number):
         raise _mismatch(value, int)
     return int(number)
 
 
-def _convert_float(value: Any) -> float:
-    return float(_number(value, float))
+def _convert_float(value: Any, infinite: bool = False) -> float:
+    number = _number(value, float)
+    try:
+        result = float(number)
+    except OverflowError:  # a whole number past 1.8e308
+        raise ValueError(f"expected a finite number (float), got {shown(value)}, which is too "
+                         "large for one") from None
+    if math.isnan(result) or (math.isinf(result) and not infinite):
+        raise _not_finite(value, float, infinite)
+    return result
 
 
 def _convert_enum(value: Any, hint: type[Enum]) -> Enum:
@@ -253,4 +288,4 @@ def _convert_enum(value: Any, hint: type[Enum]) -> Enum:
         if value == member.value or (isinstance(value, str) and value == member.name):
             return member
     choices = ", ".join(repr(member.value) for member in hint)
-    raise ValueError(f"expected one of {choices}, got {value!r}")
+    raise ValueError(f"expected one of {choices}, got {shown(value)}")

@@ -146,7 +146,22 @@ class TreeStructure:
         }
 
 
-def _describe(node: Node) -> dict[str, Any]:
+def _describe(root: Node) -> dict[str, Any]:
+    """The nested entries of ``root`` and its descendants, built without recursion."""
+    top = _entry(root)
+    pending = [(root, top)]
+    while pending:
+        node, entry = pending.pop()
+        children = entry["children"]
+        for child in node.children:
+            child_entry = _entry(child)
+            children.append(child_entry)
+            pending.append((child, child_entry))
+    return top
+
+
+def _entry(node: Node) -> dict[str, Any]:
+    """One node's entry, its ``children`` still empty."""
     entry: dict[str, Any] = {
         "id": node.uid,
         "node_id": node.node_id,
@@ -161,5 +176,5 @@ def _describe(node: Node) -> dict[str, Any]:
     tree_id = getattr(node, "tree_id", None)
     if tree_id is not None:
         entry["tree_id"] = tree_id
-    entry["children"] = [_describe(child) for child in node.children]
+    entry["children"] = []
     return entry

@@ -3,6 +3,7 @@
 The readers of both editor formats (:mod:`cyborg.bt.editor_format` for behavior3editor 0.3.0,
 :mod:`cyborg.bt.editor_v1` for 1.x) produce these; :mod:`cyborg.bt.builder` turns them into
 live nodes.
+:func:`choose_tree` picks the tree of a project to run.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from cyborg.bt.problems import Problem
+from cyborg.bt.problems import Problem, shown
 
 _PLACEHOLDER = re.compile(r"<(\w+)>")
 
@@ -25,7 +26,12 @@ def render_title(title: str, properties: dict[str, Any]) -> str:
 
     def fill(match: re.Match[str]) -> str:
         key = match.group(1)
-        return str(properties[key]) if key in properties else match.group(0)
+        if key not in properties:
+            return match.group(0)
+        value = properties[key]
+        if isinstance(value, str | int | float) or value is None:
+            return str(value)
+        return shown(value)  # a list or object, maybe huge: cut short
 
     return _PLACEHOLDER.sub(fill, title)
 
@@ -108,3 +114,34 @@ class ProjectSpec:
 
     def tree_by_id(self) -> dict[str, TreeSpec]:
         return {tree.id: tree for tree in self.trees}
+
+
+def choose_tree(project: ProjectSpec, wanted: str | None) -> tuple[TreeSpec | None, str]:
+    """The tree to run: by id or title if ``wanted``, else the selected one.
+
+    Returns the tree, or None and the reason.
+    """
+    trees = project.trees
+    listing = ", ".join(f"{t.title!r} ({t.id})" for t in trees) or "none"
+    if not trees:
+        return None, "the file holds no tree (only node definitions?)"
+    if wanted is not None:
+        by_id = [t for t in trees if t.id == wanted]
+        by_title = [t for t in trees if t.title == wanted]
+        if by_id:
+            return by_id[0], ""
+        if len(by_title) == 1:
+            return by_title[0], ""
+        if by_title:
+            return None, f"several trees are titled {wanted!r}; pick one by id: {listing}"
+        return None, f"no tree has the id or title {wanted!r}; trees: {listing}"
+    if project.selected_tree is not None:
+        for tree in trees:
+            if tree.id == project.selected_tree:
+                return tree, ""
+        return None, f"selectedTree {project.selected_tree!r} is not in the file; trees: {listing}"
+    referenced = {node.name for tree in trees for node in tree.nodes.values()}
+    tops = [tree for tree in trees if tree.id not in referenced]
+    if len(trees) == 1 or len(tops) == 1:
+        return (trees[0] if len(trees) == 1 else tops[0]), ""
+    return None, f"no selectedTree in the file; pick a tree by id or title: {listing}"
