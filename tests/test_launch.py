@@ -237,7 +237,7 @@ def test_cyborg_monitor_serves_and_a_taken_port_is_a_clear_error() -> None:
             [sys.executable, "-m", "cyborg", "monitor", "--port", str(port), "--duration", "5",
              "--listen", f"tcp/127.0.0.1:{bus}"], capture_output=True, text=True, timeout=60)
     assert refused.returncode == 1
-    assert f"cannot listen on 0.0.0.0:{port}" in refused.stderr
+    assert f"cannot listen on 127.0.0.1:{port}" in refused.stderr
     assert "choose another port with --port" in refused.stderr
     assert "Traceback" not in refused.stderr
     process = subprocess.Popen(

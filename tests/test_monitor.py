@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from starlette.testclient import TestClient
 
 from cyborg.bt import load_tree
 from cyborg.bt.clock import ManualClock
@@ -31,7 +30,9 @@ from tests.builders import N, tree_from
 from tests.monitor_protocol import (
     CAMPUS_TREE,
     campus_system,
+    local_client,
     monitor_for,
+    next_json,
     receive_until,
     watch,
 )
@@ -165,7 +166,7 @@ def test_the_page_gets_structure_snapshot_and_deltas_and_controls_from_loopback(
     try:
         wait_until(lambda: monitor.hub.sources["/cyborg/bt"].state is not None, 10,
                    "the structure")
-        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
+        with local_client(monitor.app) as client, \
                 client.websocket_connect("/ws") as socket:
             socket.send_json({"t": "hello", "key": "page-1"})
             seat = receive_until(socket, "seat")
@@ -217,7 +218,7 @@ def test_a_page_that_returns_to_a_robot_gets_its_tree_again(system: System,
     try:
         wait_until(lambda: all(source.state is not None
                                for source in monitor.hub.sources.values()), 10, "both trees")
-        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
+        with local_client(monitor.app) as client, \
                 client.websocket_connect("/ws") as socket:
             for namespace in ("/cyborg/bt", "/other/bt", "/cyborg/bt", "/other/bt"):
                 sent = watch(socket, namespace)
@@ -234,7 +235,7 @@ def test_a_page_that_returns_to_a_robot_gets_its_tree_again(system: System,
             socket.send_json({"t": "watch", "ns": "/other/bt"})
             receive_until(socket, "watching")
             assert all(message["t"] != "structure"
-                       for message in [socket.receive_json() for _ in range(3)]), \
+                       for message in [next_json(socket) for _ in range(3)]), \
                 "watching the tree the page shows again needs no structure"
     finally:
         monitor.stop()
@@ -245,7 +246,7 @@ def test_a_page_that_falls_behind_gets_the_tree_again_instead_of_the_backlog(
         system: System) -> None:
     monitor = monitor_for(system)
     try:
-        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client, \
+        with local_client(monitor.app) as client, \
                 client.websocket_connect("/ws") as socket:
             structure = next(message for message in watch(socket, "/cyborg/bt")
                              if message["t"] == "structure")
@@ -260,7 +261,7 @@ def test_a_page_that_falls_behind_gets_the_tree_again_instead_of_the_backlog(
             assert client.portal is not None
             client.portal.call(flood)
             fillers = []
-            while (message := socket.receive_json())["t"] != "structure":
+            while (message := next_json(socket))["t"] != "structure":
                 if message["t"] == "filler":
                     fillers.append(message["i"])
                 assert len(fillers) < QUEUE_LIMIT // 2, "the backlog was sent, not dropped"

@@ -400,4 +400,5 @@ def test_view_only_from_another_address_unless_the_token_is_given(browser: Brows
         trusted = open_page(browser, remote + "?token=s3cret", errors)
         _seat_says(trusted, "You have control")
         assert not trusted.is_disabled("#run")
+        assert "token" not in trusted.url, "the token left the address bar (and history)"
         assert errors == [], json.dumps(errors)

@@ -10,14 +10,19 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from starlette.testclient import TestClient
 from starlette.types import Message
 from starlette.websockets import WebSocketDisconnect
 
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.seat import ControlSeat, is_loopback
 from cyborg.monitor.server import create_app
-from tests.monitor_protocol import campus_system, monitor_for, peer_from_header, receive_until
+from tests.monitor_protocol import (
+    campus_system,
+    local_client,
+    monitor_for,
+    peer_from_header,
+    receive_until,
+)
 from tests.system import System, wait_until
 
 
@@ -67,7 +72,7 @@ def test_one_controlling_client_a_token_for_others_and_a_grace_period() -> None:
 def test_other_machines_watch_but_do_not_control_without_the_token(system: System) -> None:
     monitor = monitor_for(system, token="s3cret")
     try:
-        with TestClient(monitor.app, client=("192.0.2.9", 50000)) as client:
+        with local_client(monitor.app, peer="192.0.2.9") as client:
             with client.websocket_connect("/ws") as socket:
                 socket.send_json({"t": "hello", "key": "far"})
                 assert receive_until(socket, "seat")["may_control"] is False
@@ -93,8 +98,7 @@ def test_the_seat_is_the_connection_that_took_it_not_a_key_another_page_can_show
         system: System) -> None:
     monitor = monitor_for(system)
     try:
-        with TestClient(peer_from_header(monitor.app),
-                        client=("127.0.0.1", 50000)) as client:
+        with local_client(peer_from_header(monitor.app)) as client:
             with client.websocket_connect("/ws") as holder:
                 holder.send_json({"t": "hello", "key": "page-holder"})
                 receive_until(holder, "seat")
@@ -160,7 +164,8 @@ def test_pages_connecting_at_the_same_moment_are_told_apart() -> None:
                     incoming.put_nowait({"type": "websocket.disconnect", "code": 1000})
 
         scope = {"type": "websocket", "path": "/ws", "raw_path": b"/ws", "root_path": "",
-                 "scheme": "ws", "query_string": b"", "headers": [], "subprotocols": [],
+                 "scheme": "ws", "query_string": b"", "subprotocols": [],
+                 "headers": [(b"host", b"127.0.0.1:8080")],
                  "client": ("127.0.0.1", port), "server": ("127.0.0.1", 8080),
                  "asgi": {"version": "3.0"}}
         await app(scope, incoming.get, send)
@@ -178,7 +183,9 @@ def test_the_hooks_of_a_holder_that_does_not_come_back_are_released(system: Syst
     hooks = system.runner.tree.hooks
     patrol, recharge = system.uid("Patrol"), system.uid("Recharge")
     try:
-        with TestClient(monitor.app, client=("127.0.0.1", 50000)) as client:
+        wait_until(lambda: monitor.hub.sources["/cyborg/bt"].state is not None, 10,
+                   "the structure")  # else a control names a node of no tree yet
+        with local_client(monitor.app) as client:
             with client.websocket_connect("/ws") as holder:
                 holder.send_json({"t": "watch", "ns": "/cyborg/bt"})
                 commands: list[dict[str, Any]] = [

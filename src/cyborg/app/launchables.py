@@ -15,8 +15,10 @@ kind            parameters (default)
                 ``use_sim_time`` (false), ``robot_namespace`` (/cyborg), ``enabled`` (true),
                 ``nodes`` (modules of node classes to import, [])
 ``monitor``     ``trees`` (tree runner namespaces, ["/cyborg/bt"]), ``port`` (8080; 0 = any
-                free port), ``host`` (0.0.0.0), ``token`` (control from other machines;
-                default ``$CYBORG_MONITOR_TOKEN``)
+                free port), ``host`` (127.0.0.1; 0.0.0.0 = every interface),
+                ``allow_hosts`` (more names the page may be opened as), ``token_file``
+                (control from other machines; default ``$CYBORG_MONITOR_TOKEN``); ``token``
+                (the token itself) is read but never made a bus parameter
 ``camera``,     see :mod:`cyborg.app.vision_launchables`
 ``detector``
 ==============  ================================================================================
@@ -39,7 +41,14 @@ from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
 __all__ = ["KINDS", "LaunchError", "NodeSpec", "Running", "RunningMonitor", "RunningSimulator",
            "RunningTree", "SettlingRobot", "Starter", "starter_for"]
 from cyborg.bus import Context, Node, SimClock
-from cyborg.monitor import DEFAULT_PORT, Monitor, MonitorError
+from cyborg.monitor import (
+    DEFAULT_HOST,
+    DEFAULT_PORT,
+    Monitor,
+    MonitorError,
+    TokenError,
+    read_token,
+)
 from cyborg.nav.arnl_map import MapError, read_map
 from cyborg.nodes.bus_robot import BusMove, BusRobot
 from cyborg.nodes.tree_runner import TreeRunnerNode
@@ -202,30 +211,43 @@ class RunningMonitor:
 
     def describe(self) -> str:
         urls = self.monitor.urls()
-        others = f" (from other machines: {', '.join(urls[1:])})" if urls[1:] else ""
-        return (f"monitor      {self.monitor.node.fq_name}: open {urls[0]}{others}; trees "
+        others = (f" (from other machines: {', '.join(urls[1:])})" if urls[1:] else
+                  " (this machine only)" if self.monitor.on_loopback else "")
+        line = (f"monitor      {self.monitor.node.fq_name}: open {urls[0]}{others}; trees "
                 f"{', '.join(sorted(self.monitor.hub.sources))}")
+        exposure = self.monitor.exposure()
+        return f"{line}\n               {exposure}" if exposure else line
 
     def stop(self) -> None:
         self.monitor.stop()
 
 
 def start_monitor(context: Context, spec: NodeSpec) -> RunningMonitor:
-    node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
+    # the token is a secret: read here, never declared (`cyborg param get` would show it)
+    parameters = {name: value for name, value in spec.parameters.items() if name != "token"}
+    node = Node(spec.name, spec.namespace, context=context, parameters=parameters)
     try:
         params = node.parameters
         trees = params.declare("trees", ["/cyborg/bt"], "tree runner namespaces to follow",
                                read_only=True)
         port = params.declare("port", DEFAULT_PORT, "web server port (0: any free port)",
                               read_only=True)
-        host = params.declare("host", "0.0.0.0", "address to listen on", read_only=True)
-        token = params.declare("token", "", "token for control from other machines",
-                               read_only=True)
-        namespaces = [str(tree) for tree in trees if str(tree).startswith("/")]
-        if len(namespaces) != len(trees) or not namespaces:
-            raise spec.error(f"trees: namespaces such as /cyborg/bt, not {list(trees)!r}")
-        monitor = Monitor(node, namespaces=namespaces, host=str(host), port=int(port),
-                          token=str(token) or None)
+        host = params.declare("host", DEFAULT_HOST, "address to listen on (0.0.0.0: every "
+                              "interface)", read_only=True)
+        allow_hosts = params.declare("allow_hosts", ["localhost"], "names the page may be "
+                                     "opened as, beside this machine's", read_only=True)
+        token_file = params.declare("token_file", "", "file holding the token for control "
+                                    "from other machines", read_only=True)
+        try:
+            token = read_token(str(spec.parameters.get("token") or "") or None,
+                               spec.path(str(token_file)) if token_file else None)
+            monitor = Monitor(node, namespaces=[str(tree) for tree in trees], host=str(host),
+                              port=int(port), token=token,
+                              allow_hosts=[str(name) for name in allow_hosts])
+        except TokenError as exc:
+            raise spec.error(str(exc)) from None
+        except ValueError as exc:
+            raise spec.error(f"trees: {exc}") from None
         try:
             monitor.start()
         except MonitorError as exc:

@@ -4,23 +4,32 @@
 
     cyborg monitor                          # http://127.0.0.1:8080/, trees under /cyborg/bt
     cyborg monitor --port 9000 --namespace /robot1/bt --namespace /robot2/bt
-    cyborg monitor --connect tcp/robot.local:7447 --token s3cret
+    cyborg monitor --host 0.0.0.0 --token-file ~/.config/cyborg/token   # for the network
+    cyborg monitor --connect tcp/robot.local:7447                       # from a laptop
 
-Control from the page is accepted from this machine only, unless ``--token`` (or
-``CYBORG_MONITOR_TOKEN``) is set: then a page opened as ``http://HOST:PORT/?token=...`` may
-control too. Everyone else can watch. Tree runners that start later are found on the bus.
+The monitor listens on this machine only (127.0.0.1) unless ``--host`` says otherwise; then it
+prints where it listens and whether a token is set. Control from the page is accepted from the
+monitor's own page on this machine, or with the token (``--token-file PATH``, or
+``CYBORG_MONITOR_TOKEN``; ``--token`` works but shows in ``ps``): a page opened as
+``http://HOST:PORT/?token=...`` may control too. Everyone else can watch. The page answers only
+to this machine's names and addresses and to names given with ``--allow-host`` (a guard against
+DNS rebinding). Tree runners that start later are found on the bus. See docs/security.md.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from cyborg.app.launch import LaunchDescription
 from cyborg.app.launchables import NodeSpec
 from cyborg.app.sim_commands import DEFAULT_ROUTER
-from cyborg.app.up import add_bus_options, run
-from cyborg.monitor import DEFAULT_PORT
+from cyborg.app.up import access_parameters, add_access_options, add_bus_options, run
+from cyborg.monitor import DEFAULT_HOST, DEFAULT_PORT
+
+TOKEN_IN_PS = ("cyborg: warning: --token shows in `ps` to every user of this machine; prefer "
+               "--token-file PATH or CYBORG_MONITOR_TOKEN")
 
 
 def add_parser(commands: Any) -> None:
@@ -30,25 +39,33 @@ def add_parser(commands: Any) -> None:
                     "controls them (run/pause, disable, force, breakpoints).")
     monitor.add_argument("--port", type=int, default=DEFAULT_PORT,
                          help=f"web server port (default {DEFAULT_PORT}; 0: any free port)")
-    monitor.add_argument("--host", default="0.0.0.0",
-                         help="address to listen on (default: every interface; 127.0.0.1 "
-                              "keeps the page on this machine)")
+    monitor.add_argument("--host", default=DEFAULT_HOST,
+                         help=f"address to listen on (default {DEFAULT_HOST}: this machine "
+                              "only; 0.0.0.0: every interface, for other machines)")
     monitor.add_argument("--namespace", action="append", default=[], metavar="NS",
                          help="tree runner namespace to follow (repeatable; default "
                               "/cyborg/bt); others on the bus are offered too")
+    add_access_options(monitor)
     monitor.add_argument("--token", default=None,
-                         help="let pages on other machines control with ?token=... "
-                              "(default: $CYBORG_MONITOR_TOKEN)")
+                         help="the token itself (shows in `ps`: prefer --token-file or "
+                              "$CYBORG_MONITOR_TOKEN)")
     add_bus_options(monitor)
     monitor.set_defaults(handler=monitor_command)
 
 
-def monitor_command(args: argparse.Namespace) -> int:
+def monitor_description(args: argparse.Namespace) -> LaunchDescription:
+    """What ``cyborg monitor`` starts. A ``--token`` is passed on in memory only (the monitor
+    never makes it a bus parameter), with a warning that it shows in ``ps``."""
     namespaces = ["/" + namespace.strip("/") for namespace in args.namespace] or ["/cyborg/bt"]
-    parameters: dict[str, Any] = {"trees": namespaces, "port": args.port, "host": args.host}
+    parameters: dict[str, Any] = {"trees": namespaces, "port": args.port, "host": args.host,
+                                  **access_parameters(args)}
     if args.token:
+        print(TOKEN_IN_PS, file=sys.stderr)
         parameters["token"] = args.token
-    description = LaunchDescription(
+    return LaunchDescription(
         [NodeSpec("monitor", "monitor", "/cyborg", parameters, where="cyborg monitor")],
         list(args.connect), args.listen or DEFAULT_ROUTER)
-    return run(description, args, title="cyborg monitor")
+
+
+def monitor_command(args: argparse.Namespace) -> int:
+    return run(monitor_description(args), args, title="cyborg monitor")

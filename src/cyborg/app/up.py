@@ -4,7 +4,8 @@
 the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn by the project in
 ARNL format) with its navigation services, the tree runner with the bundled
 patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
-time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``), and a camera playing
+time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``; this machine only unless
+``--monitor-host 0.0.0.0``, see docs/security.md), and a camera playing
 sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
 ``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. It prints what runs
 and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
@@ -68,7 +69,11 @@ def add_parser(commands: Any) -> None:
     up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
     up.add_argument("--monitor-port", type=int, default=8080, metavar="PORT",
                     help="port of the web monitor (default 8080; 0: any free port)")
+    up.add_argument("--monitor-host", default="127.0.0.1", metavar="ADDRESS",
+                    help="address the web monitor listens on (default 127.0.0.1: this machine "
+                         "only; 0.0.0.0: every interface)")
     up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
+    add_access_options(up)
     add_vision_options(up)
     add_bus_options(up)
     up.set_defaults(handler=up_command)
@@ -92,6 +97,27 @@ def add_bus_options(parser: argparse.ArgumentParser) -> None:
                         help="stop after this many wall-clock seconds")
 
 
+def add_access_options(parser: argparse.ArgumentParser) -> None:
+    """``--allow-host`` and ``--token-file``, for ``cyborg monitor`` and ``cyborg up``."""
+    parser.add_argument("--allow-host", action="append", default=[], metavar="NAME",
+                        help="a name the page may be opened as, beside this machine's names "
+                             "and addresses (repeatable; .example.org: the domain and its "
+                             "names)")
+    parser.add_argument("--token-file", default=None, metavar="PATH",
+                        help="file whose first line is the token that lets pages on other "
+                             "machines control (?token=...); default $CYBORG_MONITOR_TOKEN")
+
+
+def access_parameters(args: argparse.Namespace) -> dict[str, Any]:
+    """The monitor's launch parameters for ``--allow-host`` and ``--token-file``."""
+    parameters: dict[str, Any] = {}
+    if args.allow_host:
+        parameters["allow_hosts"] = list(args.allow_host)
+    if args.token_file:
+        parameters["token_file"] = str(args.token_file)
+    return parameters
+
+
 def up_description(args: argparse.Namespace) -> LaunchDescription:
     """The system ``cyborg up`` starts, as a launch description."""
     if args.speed < 0:
@@ -105,7 +131,8 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     nodes = [] if args.no_monitor else [
         # first: a taken port stops the launch before the robot moves
         NodeSpec("monitor", "monitor", namespace,
-                 {"trees": [f"{namespace}/bt"], "port": args.monitor_port},
+                 {"trees": [f"{namespace}/bt"], "port": args.monitor_port,
+                  "host": args.monitor_host, **access_parameters(args)},
                  where="monitor (--monitor-port)")]
     nodes += [
         NodeSpec("simulator", "arnl", namespace, sim, where="simulator"),

@@ -22,37 +22,91 @@ ping         —                                           answered with pong (f
 ===========  ==========================================  =====================================
 
 ``enable``, ``control``, ``step`` and ``resume`` need the control seat.
+
+A message the monitor cannot read or will not carry out is answered with a *located* error::
+
+    {"t": "error", "n": 7, "req": 3, "command": "watch", "field": "ns", "pos": null,
+     "message": "message 7 (watch), field ns: '/**' is not a namespace: ..."}
+
+``n`` counts the messages this connection sent (from 1); ``req`` and ``command`` are the
+message's own (null when it could not be read), ``field`` the field at fault, ``pos`` the
+character where the JSON went wrong. Refused control commands are ``result`` messages with
+``ok: false`` (and the same ``n``). No message, however malformed, ends the connection or
+reaches the log as a traceback.
 """
 
 from __future__ import annotations
 
 import asyncio
+import logging
 from typing import Any
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
+from cyborg.monitor.limits import MessageError, check_namespace, decode
 from cyborg.monitor.source import ControlError
+
+log = logging.getLogger("cyborg.monitor")
 
 CONTROLS = ("enable", "control", "step", "resume")
 SECRET_LIMIT = 64
 
 
 class CommandError(ValueError):
-    """A command that is malformed or not allowed; the message says why."""
+    """A command that is malformed or not allowed; the message says why, ``field`` where."""
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+async def receive(hub: Hub, client: Client, text: str | None) -> None:
+    """Read one message from ``client`` (``text``, or None for a binary frame), carry it out,
+    and answer any fault as a located error (see the module docstring)."""
+    client.received += 1
+    command: Any = None
+    try:
+        if text is None:
+            raise MessageError("binary frames are not read: send JSON text")
+        if not client.bucket.take():
+            raise MessageError("too many messages: slow down (this one was not read)")
+        command = decode(text)
+        await handle(hub, client, command)
+    except (ValueError, ControlError) as exc:  # CommandError, MessageError, LimitError too
+        client.send(located_error(client, command, exc))
+    except Exception as exc:  # a bug: logged with its traceback, the connection goes on
+        log.exception("monitor: message %d of connection %d failed", client.received,
+                      client.number)
+        client.send(located_error(client, command, RuntimeError(
+            f"the monitor failed on this message ({type(exc).__name__}); see its log")))
+
+
+def located_error(client: Client, command: Any, exc: Exception) -> dict[str, Any]:
+    """The ``error`` message for ``exc``, raised by message number ``client.received``."""
+    known = command if isinstance(command, dict) else {}
+    kind = known.get("t") if isinstance(known.get("t"), str) else None
+    field = getattr(exc, "field", None)
+    pos = getattr(exc, "pos", None)
+    where = f"message {client.received}" + (f" ({kind[:40]})" if kind else "")
+    where += f", field {field}" if field else ""
+    where += f", character {pos}" if pos is not None else ""
+    return {"t": "error", "n": client.received, "req": known.get("req"), "command": kind,
+            "field": field, "pos": pos, "message": f"{where}: {exc}"}
 
 
 async def handle(hub: Hub, client: Client, command: Any) -> None:
     """Carry out one command from ``client`` and queue what it answers."""
     if not isinstance(command, dict) or not isinstance(command.get("t"), str):
-        raise CommandError('a command is a JSON object with a string "t"')
+        raise CommandError('a command is a JSON object with a string "t"', "t")
     kind, request = command["t"], command.get("req")
     if kind in CONTROLS:
+        answer = {"t": "result", "n": client.received, "req": request}
         try:
             message = await _control(hub, client, kind, command)
         except (CommandError, ControlError) as exc:
-            client.send({"t": "result", "req": request, "ok": False, "message": str(exc)})
+            client.send({**answer, "ok": False, "message": str(exc)})
         else:
-            client.send({"t": "result", "req": request, "ok": True, "message": message})
+            client.send({**answer, "ok": True, "message": message})
         return
     if kind == "hello":
         secret = command.get("seat")
@@ -63,14 +117,10 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
             client.send(hub.seat_message(client))
         client.send(hub.robots())
     elif kind == "watch":
-        namespace = command.get("ns") or hub.default_namespace
-        if not isinstance(namespace, str) or not namespace.startswith("/"):
-            raise CommandError(f"watch: ns must be a namespace such as /cyborg/bt, "
-                               f"not {namespace!r}")
-        client.watching = "/" + namespace.strip("/")
-        client.send({"t": "watching", "ns": client.watching})
-        hub.send_tree(client, client.watching)
-        hub.broadcast(hub.robots())
+        try:
+            hub.watch(client, command.get("ns") or hub.default_namespace)
+        except ValueError as exc:
+            raise CommandError(str(exc), "ns") from None
     elif kind == "refresh":
         hub.resync(client)
     elif kind == "history":
@@ -81,46 +131,55 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
                      "ticks": state.history_json() if state else []})
     elif kind == "claim":
         if not client.may_control:
-            raise CommandError("view only: control is accepted from this machine, or with "
-                               "the monitor's token")
+            raise CommandError(VIEW_ONLY)
+        held = hub.seat.holds(client.number)
         granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
-        client.send({"t": "result", "req": request, "ok": granted,
+        client.send({"t": "result", "n": client.received, "req": request, "ok": granted,
                      "message": "you have control" if granted else
                      "another page has control; take it over to control from here"})
-        if granted:
+        if granted and not held:  # every page hears of a change, and only of one
             hub.announce_seat()
     elif kind == "release":
-        hub.seat.release(client.number)
-        hub.announce_seat()
+        if hub.seat.release(client.number):
+            hub.announce_seat()
     elif kind == "ping":
         client.send({"t": "pong", "req": request})
     else:
-        raise CommandError(f"unknown command {kind!r}")
+        raise CommandError(f"unknown command {kind[:40]!r}", "t")
+
+
+VIEW_ONLY = ("view only: control is accepted from the monitor's own page on this machine, or "
+             "with the monitor's token")
 
 
 async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> str:
     if not client.may_control:
-        raise CommandError("view only: control is accepted from this machine, or with the "
-                           "monitor's token")
+        raise CommandError(VIEW_ONLY)
     if not hub.seat.holds(client.number):
         raise CommandError("another page has control (or none was taken): take control first")
     namespace = command.get("ns") or client.watching
-    source = hub.sources.get(namespace or "")
+    try:
+        namespace = check_namespace(namespace)
+    except ValueError as exc:
+        raise CommandError(f"ns: {exc}", "ns") from None
+    source = hub.sources.get(namespace)
     if source is None:
-        raise CommandError(f"no tree is watched under {namespace!r}")
+        raise CommandError(f"no tree is watched under {namespace!r}", "ns")
     if kind == "enable":
         on = command.get("on")
         if not isinstance(on, bool):
-            raise CommandError("enable: on must be true or false")
+            raise CommandError("enable: on must be true or false", "on")
         return await asyncio.to_thread(source.set_enabled, on)
     if kind in ("step", "resume"):
         return await asyncio.to_thread(source.trigger, kind)
     node_id, action = command.get("id"), command.get("action")
     if not isinstance(node_id, str) or not isinstance(action, str):
-        raise CommandError("control: id and action must be strings")
+        raise CommandError("control: id and action must be strings",
+                           "id" if not isinstance(node_id, str) else "action")
     state = source.state
     if state is None or node_id not in state.index_of:
-        raise CommandError(f"control: no node {node_id!r} in the tree under {source.namespace}")
+        raise CommandError(f"control: no node {node_id[:80]!r} in the tree under "
+                           f"{source.namespace}", "id")
     status = command.get("status") or "failure"
     once, keep = bool(command.get("once")), bool(command.get("keep"))
     message = await asyncio.to_thread(source.control, node_id, action, str(status),

@@ -17,6 +17,11 @@ bus ever waits for a browser.
   its secret goes to its holder and nobody else.
 * Every :data:`SLOW_PERIOD` the hub sends per-node timings, polls blackboards of watched trees,
   looks for new tree runners on the bus and frees the seat of a holder gone too long.
+* **What viewers cost** is bounded (:mod:`cyborg.monitor.limits`). A tree is followed (one
+  :class:`TreeSource`, its subscriptions shared by every page that watches it) when the monitor
+  was started with it (*pinned*) or while its runner is on the bus; when the runner has left
+  and the last page watching it has gone, it is freed with everything kept for it. Watching a
+  namespace no runner is in subscribes to nothing. Connections are counted per address.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from typing import Any
 from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
+from cyborg.monitor.limits import Limits, check_namespace
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import ControlError, TreeSource
 
@@ -41,6 +47,13 @@ log = logging.getLogger("cyborg.monitor")
 FRAME_INTERVAL = 1 / 60
 """Shortest time between two frames of one tree (ticks in between are merged)."""
 SLOW_PERIOD = 0.5
+FOLLOW_LIMIT = 128
+"""Most trees the monitor follows at once (runners beyond are not listed, with a warning)."""
+
+
+class LimitError(ValueError):
+    """A page asked for more than :class:`Limits` allow; the message says which limit."""
+
 
 def encode(message: dict[str, Any]) -> str:
     return json.dumps(message, separators=(",", ":"))
@@ -51,11 +64,14 @@ class Hub:
 
     def __init__(self, make_source: Callable[[str], TreeSource],
                  discover: Callable[[], list[str]], *, default_namespace: str,
-                 seat: ControlSeat) -> None:
+                 seat: ControlSeat, limits: Limits | None = None) -> None:
         self._make_source = make_source
         self._discover = discover
         self.default_namespace = default_namespace
         self.sources: dict[str, TreeSource] = {}
+        self.pinned: set[str] = set()
+        """Namespaces followed for good: the ones the monitor was started with."""
+        self.limits = limits or Limits()
         self.seat = seat
         self.clients: set[Client] = set()
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -63,16 +79,62 @@ class Hub:
         self._last_frame: dict[str, float] = {}
         self._blackboards: dict[str, str] = {}
         self._numbers = itertools.count(1)
+        self._warned_limit = False
         self.frames = 0
 
     # ------------------------------------------------------------------ sources
-    def source(self, namespace: str) -> TreeSource:
-        """The source following ``namespace``, created on first use."""
-        namespace = "/" + namespace.strip("/")
+    def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
+        """The source following ``namespace`` (a checked name), created on first use;
+        ``pinned``: followed for good (the trees the monitor was started with)."""
         found = self.sources.get(namespace)
         if found is None:
             found = self.sources[namespace] = self._make_source(namespace)
+        if pinned:
+            self.pinned.add(namespace)
         return found
+
+    def _release(self, namespace: str | None) -> bool:
+        """Stop following ``namespace`` if nothing needs it any more: not pinned, watched by
+        no page, its runner gone from the bus. Frees all kept for it; whether it was freed."""
+        if namespace is None or namespace in self.pinned or self._watchers(namespace):
+            return False
+        source = self.sources.get(namespace)
+        if source is not None and source.alive:
+            return False
+        self.sources.pop(namespace, None)
+        for kept in (self._last_frame, self._blackboards):
+            kept.pop(namespace, None)
+        self._scheduled.discard(namespace)
+        if source is None:
+            return False
+        try:
+            source.destroy()
+        except Exception:
+            log.exception("could not stop following %s", namespace)
+        return True
+
+    def watch(self, client: Client, namespace: Any) -> None:
+        """Make ``client`` watch ``namespace`` (any value: checked here) and send it the tree.
+        A namespace with no runner on the bus costs nothing: no source is made for it (the
+        periodic look follows its runner once one appears). ``ValueError`` for a bad name,
+        :class:`LimitError` past :attr:`Limits.namespaces_per_connection`."""
+        namespace = check_namespace(namespace)
+        found = False
+        if namespace not in self.sources:
+            if namespace in self._discover():  # on the bus, and not looked for yet
+                found = self._found(namespace)
+            elif namespace not in client.asked:
+                limit = self.limits.namespaces_per_connection
+                if len(client.asked) >= limit:
+                    raise LimitError(f"a page may watch at most {limit} namespaces that no "
+                                     "tree runner is in; reload the page to start again")
+                client.asked.add(namespace)
+        previous, client.watching = client.watching, namespace
+        client.send({"t": "watching", "ns": namespace})
+        self.send_tree(client, namespace)
+        freed = previous != namespace and self._release(previous)
+        if found or freed:
+            self.broadcast(self.robots())
 
     def robots(self) -> dict[str, Any]:
         return {"t": "robots", "robots": [source.describe() for source in
@@ -148,11 +210,13 @@ class Hub:
 
     def send_tree(self, client: Client, namespace: str) -> None:
         """Structure (unless the client shows this very tree now), snapshot, runner state,
-        timings."""
-        source = self.source(namespace)
-        client.send(self._runner_message(source))
-        state = source.state
-        if state is None:
+        timings; for a namespace no runner is in, that there is none."""
+        source = self.sources.get(namespace)
+        client.send(self._runner_message(source) if source is not None else
+                    {"t": "runner", "ns": namespace, "alive": False, "enabled": None,
+                     "hooks": [], "paused_at": "", "problem": ""})
+        state = source.state if source is not None else None
+        if source is None or state is None:
             client.shown = None
             client.send({"t": "structure", "ns": namespace, "v": None, "tree": None})
             return
@@ -180,16 +244,35 @@ class Hub:
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         self._loop = loop
 
+    def refusal(self, host: str | None) -> str | None:
+        """Why one more connection from ``host`` is refused, or None when it is not."""
+        limits = self.limits
+        if len(self.clients) >= limits.connections:
+            return (f"the monitor has {limits.connections} connections already; close "
+                    "monitor pages you do not use")
+        same = sum(1 for client in self.clients if client.host == host)
+        if same >= limits.connections_per_address:
+            return (f"{limits.connections_per_address} connections from {host} already; "
+                    "close monitor pages you do not use")
+        return None
+
     def connect(self, websocket: WebSocket, *, may_control: bool) -> Client:
         """A new client for an accepted ``websocket``, numbered and registered in one step
         (no other connection can come in between and get the same number)."""
-        client = Client(next(self._numbers), websocket, may_control=may_control)
+        client = Client(next(self._numbers), websocket, may_control=may_control,
+                        limits=self.limits)
         self.clients.add(client)
         return client
 
     def disconnect(self, client: Client) -> None:
+        """Forget ``client``; tell the others only what changed (the seat, the trees), so
+        pages that come and go cost the pages that stay nothing."""
         self.clients.discard(client)
-        self.seat.disconnected(client.number)
+        if self.seat.disconnected(client.number):
+            self.announce_seat()
+        watched, client.watching = client.watching, None
+        if self._release(watched):
+            self.broadcast(self.robots())
 
     def seat_message(self, client: Client) -> dict[str, Any]:
         """Who holds the seat (a connection number, which nobody can present); the seat's
@@ -217,11 +300,13 @@ class Hub:
                 log.exception("monitor periodic work failed")
 
     async def _periodic(self) -> None:
-        known = set(self.sources)
+        changed = False
         for namespace in await asyncio.to_thread(self._discover):
-            if namespace not in known:
-                self.source(namespace)
-                self.broadcast(self.robots())
+            changed = self._found(namespace) or changed
+        for namespace in list(self.sources):  # runners that left, and nobody watches
+            changed = self._release(namespace) or changed
+        if changed:
+            self.broadcast(self.robots())
         watched = {client.watching for client in self.clients if client.watching}
         for namespace in watched:
             source = self.sources.get(namespace)
@@ -249,6 +334,26 @@ class Hub:
         log.info("the control seat is free (its holder left); %d hook(s) released",
                  len(expired))
         self.announce_seat()
+
+    def _found(self, namespace: str) -> bool:
+        """A tree runner found on the bus: follow it while it is there or watched (at most
+        :data:`FOLLOW_LIMIT` at once). Whether it is new to the monitor."""
+        if namespace in self.sources:
+            return False
+        try:
+            namespace = check_namespace(namespace)
+        except ValueError:
+            return False  # not a runner's name: nothing a page could watch
+        if len(self.sources) >= FOLLOW_LIMIT:
+            if not self._warned_limit:
+                log.warning("more than %d tree runners on the bus: the monitor lists the first",
+                            FOLLOW_LIMIT)
+                self._warned_limit = True
+            return False
+        self.follow(namespace)
+        for client in self._watchers(namespace):  # pages that waited for it
+            self.send_tree(client, namespace)
+        return True
 
     async def _poll_blackboard(self, source: TreeSource) -> None:
         try:

@@ -3,10 +3,14 @@
 ::
 
     monitor = Monitor(Node("monitor", "/cyborg"), namespaces=["/cyborg/bt"], port=8080)
-    monitor.start()          # serves http://<host>:8080/ from a background thread
+    monitor.start()          # serves http://127.0.0.1:8080/ from a background thread
     print(monitor.urls())
     ...
     monitor.stop()
+
+It listens on loopback unless given another ``host`` (``0.0.0.0``: every interface); then
+:meth:`Monitor.exposure` says where, and whether other machines may control (with the token)
+or only watch. See docs/security.md.
 
 The bus node (``/cyborg/monitor`` by default) subscribes to each runner's topics and calls its
 services (:mod:`cyborg.monitor.source`); tree runners that appear on the bus later are found by
@@ -16,8 +20,8 @@ their ``behavior_tree`` topic and offered on the page too. The web side
 
 from __future__ import annotations
 
+import ipaddress
 import logging
-import os
 import socket
 import threading
 import time
@@ -27,15 +31,20 @@ import uvicorn
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
+from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
+from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.server import create_app
 from cyborg.monitor.source import TreeSource
 
 log = logging.getLogger("cyborg.monitor")
 
+__all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "TOKEN_VARIABLE", "Monitor", "MonitorError"]
+
 DEFAULT_PORT = 8080
-TOKEN_VARIABLE = "CYBORG_MONITOR_TOKEN"
+DEFAULT_HOST = "127.0.0.1"
+EVERY_INTERFACE = ("0.0.0.0", "::", "")
 STRUCTURE_TYPE = "cyborg_msgs/msg/BehaviorTree"
 
 
@@ -47,20 +56,25 @@ class Monitor:
     """See the module docstring."""
 
     def __init__(self, node: Node, *, namespaces: list[str] | None = None,
-                 host: str = "0.0.0.0", port: int = DEFAULT_PORT,
-                 token: str | None = None) -> None:
+                 host: str = DEFAULT_HOST, port: int = DEFAULT_PORT,
+                 token: str | None = None, allow_hosts: list[str] | tuple[str, ...] = (),
+                 limits: Limits | None = None) -> None:
         """Follow the tree runners under ``namespaces`` (and any found later) through
         ``node``, and serve on ``host:port`` (port 0: any free port) once started. Control
-        from other machines needs ``token`` (default: ``$CYBORG_MONITOR_TOKEN``)."""
+        from other machines needs ``token`` (default: ``$CYBORG_MONITOR_TOKEN``); requests
+        must name this machine, or one of ``allow_hosts`` (see
+        :class:`~cyborg.monitor.access.HostPolicy`). ``ValueError`` for a namespace that is
+        not one."""
         self.node = node
         self.host, self.requested_port = host, port
-        token = token if token is not None else os.environ.get(TOKEN_VARIABLE) or None
-        namespaces = namespaces or ["/cyborg/bt"]
+        namespaces = [check_namespace(namespace) for namespace in namespaces or ["/cyborg/bt"]]
         self.hub = Hub(self._make_source, self.discover, default_namespace=namespaces[0],
-                       seat=ControlSeat(token))
+                       seat=ControlSeat(read_token(token)), limits=limits)
         for namespace in namespaces:
-            self.hub.source(namespace)
-        self.app = create_app(self.hub)
+            self.hub.follow(namespace, pinned=True)
+        names = [*allow_hosts, host] if host not in EVERY_INTERFACE else list(allow_hosts)
+        self.hosts = HostPolicy(names)
+        self.app = create_app(self.hub, hosts=self.hosts)
         self._server: uvicorn.Server | None = None
         self._thread: threading.Thread | None = None
         self.port = 0
@@ -82,7 +96,7 @@ class Monitor:
         listener = _bind(self.host, self.requested_port)
         self.port = listener.getsockname()[1]
         config = uvicorn.Config(self.app, log_level="warning", lifespan="on",
-                                ws_per_message_deflate=False, ws_max_size=1 << 20)
+                                ws_per_message_deflate=False, ws_max_size=FRAME_LIMIT)
         server = self._server = uvicorn.Server(config)
         self._thread = threading.Thread(target=server.run, kwargs={"sockets": [listener]},
                                         name="cyborg-monitor-web", daemon=True)
@@ -94,6 +108,30 @@ class Monitor:
                                    f"{timeout:g} s")
             time.sleep(0.01)
         log.info("monitor serving on %s", ", ".join(self.urls()))
+        exposure = self.exposure()
+        if exposure:
+            log.info("monitor %s", exposure)
+
+    @property
+    def on_loopback(self) -> bool:
+        """Whether the monitor listens on this machine's loopback only."""
+        if self.host == "localhost":
+            return True
+        try:
+            return ipaddress.ip_address(self.host).is_loopback
+        except ValueError:
+            return False
+
+    def exposure(self) -> str | None:
+        """For a monitor that listens beyond loopback: where, and whether other machines may
+        control (with the token) or only watch. None on loopback."""
+        if self.on_loopback:
+            return None
+        every = " (every interface)" if self.host in EVERY_INTERFACE else ""
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        control = ("a token is set: other machines control with it (open ?token=...)"
+                   if self.hub.seat.token else "no token: other machines may only watch")
+        return f"listening on {host}:{self.port}{every}; {control}"
 
     def urls(self) -> list[str]:
         """Addresses to open in a browser (this machine first)."""

@@ -4,8 +4,10 @@ The monitor shows the tree to anyone who can reach it, but control (run/pause, d
 breakpoints, step) is a safety matter:
 
 * A client may control only when it connects from the monitor's own machine (a loopback
-  address), or presents the token the monitor was started with (``--token`` or
-  ``CYBORG_MONITOR_TOKEN``). Everyone else is view-only.
+  address) *through the monitor's own page* (or a script, which sends no ``Origin``), or
+  presents the token the monitor was started with (``--token-file``,
+  ``CYBORG_MONITOR_TOKEN`` or ``--token``). Everyone else is view-only; pages of other
+  origins are not even let in without the token (see :mod:`cyborg.monitor.access`).
 * Of the clients that may, one holds the **control seat** at a time. The first to ask gets it;
   another may take it over explicitly (``force``), and the previous holder is told.
 * The seat belongs to the *connection* that took it (the number the server gave it), not to
@@ -19,11 +21,12 @@ breakpoints, step) is a safety matter:
 
 from __future__ import annotations
 
-import hmac
 import ipaddress
 import secrets
 import time
 from dataclasses import dataclass, field
+
+from cyborg.monitor.access import same_secret
 
 GRACE = 10.0
 """Seconds the seat waits for a disconnected holder to come back."""
@@ -65,10 +68,13 @@ class ControlSeat:
         self.holder: SeatHolder | None = None
 
     def may_control(self, host: str | None, token: str | None) -> bool:
-        """Whether a client at ``host`` presenting ``token`` may hold the seat."""
-        if is_loopback(host):
-            return True
-        return bool(self.token and token and hmac.compare_digest(token, self.token))
+        """Whether a client at ``host`` presenting ``token`` may hold the seat (the caller
+        checks that a loopback client's page is the monitor's own)."""
+        return is_loopback(host) or self.token_matches(token)
+
+    def token_matches(self, token: str | None) -> bool:
+        """Whether ``token`` is the monitor's (any Unicode; compared in constant time)."""
+        return same_secret(token, self.token)
 
     def claim(self, client: int, *, force: bool = False) -> tuple[bool, int | None]:
         """Give the seat to ``client``; returns (granted, the client it was taken from).
@@ -88,8 +94,7 @@ class ControlSeat:
         """Move the seat to ``client`` if ``secret`` is the holder's: the holder's page on a
         new connection (a reload, a dropped link). The old connection loses the seat."""
         holder = self.holder
-        if holder is None or not secret or not hmac.compare_digest(secret.encode(),
-                                                                    holder.secret.encode()):
+        if holder is None or not same_secret(secret, holder.secret):
             return False
         holder.client, holder.connected = client, True
         return True
@@ -101,15 +106,21 @@ class ControlSeat:
         """The seat's secret, for its holder only."""
         return self.holder.secret if self.holds(client) and self.holder else None
 
-    def release(self, client: int) -> None:
-        """The holder gives the seat up (its hooks stay set)."""
+    def release(self, client: int) -> bool:
+        """The holder gives the seat up (its hooks stay set); whether it held it."""
         if self.holder is not None and self.holder.client == client:
             self.holder = None
+            return True
+        return False
 
-    def disconnected(self, client: int, now: float | None = None) -> None:
+    def disconnected(self, client: int, now: float | None = None) -> bool:
+        """``client``'s connection closed; whether it held the seat (kept for it a while)."""
         if self.holder is not None and self.holder.client == client:
             self.holder.connected = False
             self.holder.left_at = time.monotonic() if now is None else now
+            return True
+        return False
+
     def expired(self, now: float | None = None) -> set[tuple[str, str]] | None:
         """Free the seat of a holder gone longer than the grace and return the hooks it set
         (to release); None when the seat did not change."""

@@ -11,9 +11,12 @@ route                           what
 ``GET /stats``                  counters, for health checks and benchmarks
 ==============================  ===============================================================
 
-WebSocket connections must come from the page itself: a browser that opened some other site
-cannot connect (the ``Origin`` must match the ``Host``), so no web page can drive the robot
-through a user's browser.
+Every request must name this monitor in its ``Host`` header (:class:`HostGuard`; DNS
+rebinding), or it gets ``403``. A browser's WebSocket must come from the monitor's own page (its
+``Origin`` has the scheme, host and port of the request), or present the token; so no other web
+page can drive the robot through a user's browser, even one on this machine. Requests are
+bounded (:mod:`cyborg.monitor.limits`) and answered, never with a traceback. See
+docs/security.md.
 """
 
 from __future__ import annotations
@@ -25,27 +28,32 @@ import json
 import logging
 from collections.abc import AsyncIterator
 from pathlib import Path
-from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import JSONResponse, PlainTextResponse, Response
 from starlette.routing import Route, WebSocketRoute
+from starlette.types import ASGIApp, Receive, Scope, Send
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from cyborg.monitor.access import HostPolicy, own_origin
 from cyborg.monitor.client import RESYNC, Client
-from cyborg.monitor.commands import CommandError, handle
+from cyborg.monitor.commands import located_error, receive
 from cyborg.monitor.export import ExportError, render, view_dot
 from cyborg.monitor.hub import Hub
+from cyborg.monitor.limits import BODY_LIMIT, MessageError, check_namespace, decode
+from cyborg.monitor.seat import is_loopback
 
 log = logging.getLogger("cyborg.monitor")
 
 STATIC = Path(__file__).with_name("static")
-MESSAGE_LIMIT = 64 * 1024
+EXPORTS_AT_ONCE = 2
+"""Graphviz runs at a time; more export requests are told to try again (503)."""
 
 
-def create_app(hub: Hub) -> Starlette:
-    """The web application for ``hub``."""
+def create_app(hub: Hub, *, hosts: HostPolicy | None = None) -> ASGIApp:
+    """The web application for ``hub``, answering only the names ``hosts`` allows (default:
+    this machine's names and addresses)."""
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: Starlette) -> AsyncIterator[None]:
@@ -59,6 +67,7 @@ def create_app(hub: Hub) -> Starlette:
                 await periodic
 
     files = StaticCache(STATIC)
+    exports = asyncio.Semaphore(EXPORTS_AT_ONCE)
 
     async def page(request: Request) -> Response:
         return files.respond("index.html", request)
@@ -75,49 +84,68 @@ def create_app(hub: Hub) -> Starlette:
                              "dropped": sum(client.dropped for client in hub.clients)})
 
     async def export(request: Request) -> Response:
+        origin = request.headers.get("origin")
+        if origin is not None and not own_origin(origin, request.url.scheme,
+                                                 request.headers.get("host")):
+            return JSONResponse({"error": "export: refused to a page of another origin"}, 403)
         try:
-            body = await request.json()
-            namespace, file_format = body["ns"], body["format"]
+            body = decode((await _read_body(request)).decode("utf-8"))
+            namespace = check_namespace(body["ns"])
+            file_format = str(body["format"])
             collapsed = [str(uid) for uid in body.get("collapsed", [])]
-        except (ValueError, KeyError, TypeError) as exc:
+        except _TooLargeError:
+            return JSONResponse({"error": f"export: a request has at most {BODY_LIMIT} "
+                                          "bytes"}, 413)
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:
             return JSONResponse({"error": f"export: expected JSON with ns, format and "
-                                          f"collapsed ({exc})"}, 400)
-        source = hub.sources.get(str(namespace))
+                                          f"collapsed ({_reason(exc)})"}, 400)
+        source = hub.sources.get(namespace)
         state = source.state if source else None
         if state is None:
             return JSONResponse({"error": f"no tree under {namespace!r}"}, 404)
+        if exports.locked():
+            return JSONResponse({"error": "export: Graphviz is busy; try again"}, 503)
         text = view_dot(state.structure, statuses=state.statuses_by_id(),
                         active=state.active_ids(), collapsed=collapsed)
-        try:
-            result = await asyncio.to_thread(render, text, str(file_format),
-                                             state.structure.get("title") or "behaviour_tree")
-        except ExportError as exc:
-            return JSONResponse({"error": str(exc)}, 400)
+        async with exports:
+            try:
+                result = await asyncio.to_thread(render, text, file_format,
+                                                 state.structure.get("title") or "behaviour_tree")
+            except (ExportError, ValueError) as exc:
+                return JSONResponse({"error": str(exc)}, 400)
         return Response(result.content, media_type=result.media_type, headers={
             "Content-Disposition": f'attachment; filename="{result.filename}"'})
 
     async def websocket(socket: WebSocket) -> None:
-        if not _same_origin(socket):
+        origin = socket.headers.get("origin")
+        own = origin is None or own_origin(origin, socket.url.scheme,
+                                           socket.headers.get("host"))
+        token_ok = hub.seat.token_matches(socket.query_params.get("token"))
+        if not own and not token_ok:
             await socket.close(code=1008, reason="cross-origin connections are refused")
             return
-        token = socket.query_params.get("token")
         host = socket.client.host if socket.client else None
-        may_control = hub.seat.may_control(host, token)
         await socket.accept()
-        client = hub.connect(socket, may_control=may_control)
+        refusal = hub.refusal(host)  # counted and connected with no await between
+        if refusal is not None:
+            await socket.send_text(json.dumps({"t": "error", "n": 0, "req": None,
+                                               "command": None, "field": None, "pos": None,
+                                               "message": refusal}))
+            await socket.close(code=1008, reason="too many connections")
+            return
+        client = hub.connect(socket, may_control=token_ok or (own and is_loopback(host)))
         writer = asyncio.create_task(_write(hub, client))
         if socket.query_params.get("watch"):  # the page's first connection: no round trip
-            await handle(hub, client, {"t": "watch", "ns": hub.default_namespace})
+            try:
+                hub.watch(client, hub.default_namespace)
+            except ValueError as exc:
+                client.send(located_error(client, None, exc))
         try:
             while True:
-                text = await socket.receive_text()
-                if len(text) > MESSAGE_LIMIT:
-                    client.send({"t": "error", "message": "message too long"})
-                    continue
-                try:
-                    await handle(hub, client, json.loads(text))
-                except (CommandError, ValueError) as exc:
-                    client.send({"t": "error", "message": str(exc)})
+                message = await socket.receive()
+                if message["type"] == "websocket.disconnect":
+                    break
+                await receive(hub, client, message.get("text"))
         except WebSocketDisconnect:
             pass
         finally:
@@ -125,7 +153,6 @@ def create_app(hub: Hub) -> Starlette:
             with contextlib.suppress(asyncio.CancelledError, Exception):
                 await writer
             hub.disconnect(client)
-            hub.announce_seat()
 
     routes = [
         Route("/", page),
@@ -135,7 +162,65 @@ def create_app(hub: Hub) -> Starlette:
         WebSocketRoute("/ws", websocket),
         Route("/static/{path:path}", static),
     ]
-    return Starlette(routes=routes, lifespan=lifespan)
+    return HostGuard(Starlette(routes=routes, lifespan=lifespan), hosts or HostPolicy())
+
+
+class HostGuard:
+    """ASGI middleware: ``403`` to every HTTP request and WebSocket whose ``Host`` header
+    :class:`HostPolicy` does not allow (with a denial response where the server supports it,
+    else a close before the handshake, which servers answer with 403)."""
+
+    def __init__(self, app: ASGIApp, hosts: HostPolicy) -> None:
+        self.app, self.hosts = app, hosts
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        host = _header(scope, b"host")
+        if self.hosts.allows(host):
+            await self.app(scope, receive, send)
+            return
+        log.info("refused a request for host %r (not an allowed name)", host)
+        refusal = PlainTextResponse(self.hosts.refusal(host), 403)
+        if scope["type"] == "http" or "websocket.http.response" in scope.get("extensions", {}):
+            await refusal(scope, receive, send)
+        else:
+            await send({"type": "websocket.close", "code": 1008})
+
+
+def _header(scope: Scope, name: bytes) -> str | None:
+    for key, value in scope.get("headers") or ():
+        if key == name:
+            return bytes(value).decode("latin-1")
+    return None
+
+
+class _TooLargeError(Exception):
+    pass
+
+
+async def _read_body(request: Request) -> bytes:
+    """The request's body, up to :data:`BODY_LIMIT` bytes (:class:`_TooLargeError` beyond)."""
+    length = request.headers.get("content-length", "")
+    if length.isdigit() and int(length) > BODY_LIMIT:
+        raise _TooLargeError
+    chunks, size = [], 0
+    try:
+        async for chunk in request.stream():
+            size += len(chunk)
+            if size > BODY_LIMIT:
+                raise _TooLargeError
+            chunks.append(chunk)
+    except ClientDisconnect:
+        raise ValueError("the client went away") from None
+    return b"".join(chunks)
+
+
+def _reason(exc: Exception) -> str:
+    if isinstance(exc, KeyError):
+        return f"missing {exc}"
+    return str(exc) if isinstance(exc, MessageError | ValueError) else type(exc).__name__
 
 
 class StaticCache:
@@ -177,12 +262,3 @@ async def _write(hub: Hub, client: Client) -> None:
         except Exception:
             return
         client.sent += 1
-
-
-def _same_origin(socket: WebSocket) -> bool:
-    """A browser's WebSocket carries its page's Origin; it must be this server's page.
-    Clients that send no Origin (scripts, not browsers) are let through."""
-    origin = socket.headers.get("origin")
-    if not origin:
-        return True
-    return urlsplit(origin).netloc == socket.headers.get("host", "")

@@ -202,8 +202,18 @@ class TreeSource:
                 "problem": self.problem}
 
     def destroy(self) -> None:
+        """Withdraw the subscriptions and service clients, and let go of the tree (the bus
+        node may keep its withdrawn entities, and through them this object, until the node
+        itself is destroyed)."""
         self._remove_graph_listener()
         for subscription in self._subscriptions:
             subscription.destroy()
         for client in self._clients.values():
             client.destroy()
+        self._subscriptions, self._clients = [], {}
+        self.state = None
+        self._listener = _ignore
+
+
+def _ignore(_namespace: str, _what: str) -> None:
+    """The listener of a source that was destroyed."""

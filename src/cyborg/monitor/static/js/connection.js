@@ -96,9 +96,16 @@ export function keepSeatSecret(secret) {
   sessionStorage.setItem(SEAT_ITEM, secret);
 }
 
-// The control token, from `?token=` in the page's address (kept for this tab).
+// The control token, from `?token=` in the page's address (kept for this tab). It is then
+// taken out of the address bar, so it stays out of the browser's history and off screen.
 function pageToken() {
-  const fromUrl = new URLSearchParams(location.search).get("token");
-  if (fromUrl) sessionStorage.setItem("cyborg-monitor-token", fromUrl);
+  const params = new URLSearchParams(location.search);
+  const fromUrl = params.get("token");
+  if (fromUrl) {
+    sessionStorage.setItem("cyborg-monitor-token", fromUrl);
+    params.delete("token");
+    const query = params.toString();
+    history.replaceState(history.state, "", `${location.pathname}${query ? `?${query}` : ""}${location.hash}`);
+  }
   return fromUrl || sessionStorage.getItem("cyborg-monitor-token") || "";
 }
