@@ -66,6 +66,13 @@ def until_subscribed(attacker: Context, topic: str, timeout: float = 5.0) -> Non
     time.sleep(0.05)  # the subscriber's declaration travels beside its token
 
 
+def until_served(attacker: Context, service: str, timeout: float = 5.0) -> None:
+    """Wait until the attacker's graph shows a server of ``service``."""
+    assert wait_for(lambda: attacker.graph.count(service, EntityKind.SERVICE_SERVER) > 0,
+                    timeout), f"no server of {service} in the graph"
+    time.sleep(0.05)
+
+
 def forged(sequence: int, gid: bytes | None = None) -> bytes:
     """An rmw_zenoh attachment with any sequence number and GID (random by default)."""
     return Attachment(sequence, time.time_ns(), gid if gid is not None else os.urandom(16)) \

@@ -338,3 +338,37 @@ def test_blackboard_compare(stored: object, value: str, equal: bool, ticks_child
     if stored is not None:
         tree.blackboard["k"] = stored
     assert tree.tick().status is (SUCCESS if ticks_child else FAILURE)
+
+
+# ---------------------------------------------------------------------------------- time jumps
+class JumpingClock(ManualClock):
+    """A manual clock that can be set back, as a restarted simulation's /clock is."""
+
+    def jump_to(self, seconds: float) -> None:
+        self._now = seconds
+
+
+def test_stall_detection_after_the_clock_went_back() -> None:
+    """After a backward jump MoveTo's stall window counts from the jump, not from the old
+    start (which would leave a stalled robot unnoticed for as long as the jump)."""
+    robot, clock = FakeRobot(), JumpingClock(1000.0)
+    tree = robot_tree(N("MoveTo", location="home", retries=2), robot, clock)
+    run(tree, clock, 1.0)
+    clock.jump_to(100.0)
+    run(tree, clock, 10.5)
+    assert robot.moves[0].cancelled and len(robot.moves) == 2
+
+
+def test_charge_and_undock_time_out_after_the_clock_went_back() -> None:
+    robot, clock = FakeRobot(), JumpingClock(1000.0)
+    robot.set_battery(20.0)
+    charge = robot_tree(N("Charge", target=90), robot, clock)
+    run(charge, clock, 1.0)
+    clock.jump_to(100.0)
+    assert FAILURE in run(charge, clock, 10.5)
+    robot = FakeRobot()
+    robot.set_battery(80.0, DockState.DOCKED)
+    undock = robot_tree(N("Undock", timeout=5), robot, clock)
+    run(undock, clock, 1.0)
+    clock.jump_to(10.0)
+    assert FAILURE in run(undock, clock, 5.5)

@@ -7,6 +7,7 @@ with, or breaks on, names and ids a remote sender chooses. Loopback only, every 
 from __future__ import annotations
 
 import threading
+import time
 import uuid
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -14,11 +15,20 @@ from typing import Any
 
 import numpy as np
 import pytest
+import zenoh
 
 from cyborg.bus import BusConfig, Context, Node, ServiceError, new_message, shm
 from cyborg.bus.actions import MAX_RESULT_WAITERS
 from cyborg.bus.shm import SlotWriter
-from tests.bus_peer import forged, linked_contexts, raw_put, until_subscribed, wait_for
+from cyborg.bus.wire import data_key
+from tests.bus_peer import (
+    forged,
+    linked_contexts,
+    raw_put,
+    until_served,
+    until_subscribed,
+    wait_for,
+)
 
 STRING = "std_msgs/msg/String"
 ACTION = "cyborg_msgs/action/MoveToGoal"
@@ -160,3 +170,68 @@ def test_garbage_parameter_values_are_refused_in_the_result(bus: Context) -> Non
         results = response.results if service == "set_parameters" else [response.result]
         assert not results[0].successful and "unknown parameter type 77" in results[0].reason
     assert node.parameters["threshold"] == 0.5
+
+
+def test_a_long_lived_node_forgets_what_it_destroyed(bus: Context) -> None:
+    """Subscriptions, clients and timers made and destroyed one by one (a monitor viewer coming
+    and going for days) leave nothing in the node or the context."""
+    node = Node("long_lived", context=bus)
+    publisher = node.create_publisher("kept", STRING)
+    for index in range(300):
+        subscription = node.create_subscription(f"viewer{index}", STRING, lambda _m: None)
+        client = node.create_client(f"service{index}", "std_srvs/srv/Trigger")
+        timer = node.create_timer(60.0, lambda: None)
+        subscription.destroy()
+        client.destroy()
+        timer.cancel()
+    assert len(node._entities) <= 40
+    assert publisher in node._entities
+    assert len(node._timers) <= 1
+    assert not [topic for topic in bus._local if "viewer" in topic]
+    node.destroy()
+
+
+def test_calls_to_a_busy_service_are_refused_beyond_a_bound(
+        pair: tuple[Context, Context]) -> None:
+    """300 calls to a server whose handler is stuck used to queue 300 requests on its node;
+    now at most ``max_pending`` wait and the rest get "busy" at once, and the server serves
+    again once the handler is free."""
+    victim, attacker = pair
+    gate = threading.Event()
+    node = Node("slow_server", context=victim)
+    server = node.create_service("slow", "std_srvs/srv/Trigger",
+                                 lambda request: (gate.wait(20), new_message(
+                                     victim.types, "std_srvs/srv/Trigger_Response",
+                                     {"success": True}))[1])
+    server.max_pending = 8
+    until_served(attacker, "/slow")
+    key = data_key(attacker.domain, "/slow", "std_srvs/srv/Trigger",
+                   attacker.types.hash("std_srvs/srv/Trigger"))
+    payload = bytes(attacker.types.serialize(new_message(
+        attacker.types, "std_srvs/srv/Trigger_Request", {}), "std_srvs/srv/Trigger_Request"))
+    try:
+        pending = [attacker.session.get(key, payload=payload, attachment=forged(index + 1),
+                                        timeout=30) for index in range(40)]
+        busy: list[str] = []
+        deadline = time.monotonic() + 5
+        while len(busy) < 31 and time.monotonic() < deadline:
+            for receiver in list(pending):
+                try:
+                    reply = receiver.try_recv()
+                except zenoh.ZError:  # answered and closed
+                    pending.remove(receiver)
+                    continue
+                if reply is not None:
+                    pending.remove(receiver)
+                    if reply.err is not None:
+                        busy.append(reply.err.payload.to_string())
+            time.sleep(0.05)
+        assert len(busy) == 31, busy  # one handler running, 8 waiting, the rest refused
+        assert all("service /slow is busy: 8 requests are waiting" in text for text in busy)
+        assert node.callbacks._queue.qsize() <= 8
+    finally:
+        gate.set()
+    client = Node("caller", context=attacker).create_client("/slow", "std_srvs/srv/Trigger")
+    assert client.call(new_message(attacker.types, "std_srvs/srv/Trigger_Request", {}),
+                       timeout=10).success
+    node.destroy()

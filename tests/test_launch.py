@@ -18,7 +18,7 @@ import pytest
 from cyborg.app.cli import main
 from cyborg.app.launch import Launch, read_launch
 from cyborg.app.launchables import LaunchError, RunningSimulator, RunningTree
-from cyborg.bus import BusConfig, Context
+from cyborg.bus import BusConfig, Context, SimClock
 from tests.system import interruptible
 
 
@@ -123,6 +123,28 @@ def test_nodes_that_cannot_start_stop_what_started(tmp_path: Path, shared: Path)
     with Context(BusConfig.isolated()) as context, \
             pytest.raises(LaunchError, match=r"missing.toml: node 1 \(arnl\): .*nowhere.map"):
         Launch(read_launch(missing), context).start()
+
+
+def test_the_clock_limits_are_launch_parameters(tmp_path: Path, shared: Path) -> None:
+    text = _launch_file(tmp_path, shared).read_text().replace(
+        "use_sim_time = true }", "use_sim_time = true, clock_jump_limit = 2.5, "
+        "clock_stall_timeout = 30 }")
+    (tmp_path / "robot.toml").write_text(text)
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(read_launch(tmp_path / "robot.toml"), context)
+        launch.start()
+        try:
+            clock = launch.running[1].runner.clock  # type: ignore[attr-defined]
+            assert isinstance(clock, SimClock)
+            assert (clock.jump_limit, clock.stall_timeout) == (2.5, 30.0)
+        finally:
+            launch.stop()
+    (tmp_path / "robot.toml").write_text(text.replace("clock_jump_limit = 2.5",
+                                                      "clock_jump_limit = -1"))
+    with Context(BusConfig.isolated()) as context, \
+            pytest.raises(LaunchError, match=r"robot.toml: node 2 \(tree_runner\): parameter "
+                                             r"'clock_jump_limit': -1.0 is outside"):
+        Launch(read_launch(tmp_path / "robot.toml"), context).start()
 
 
 def test_launch_in_one_process(tmp_path: Path, shared: Path) -> None:

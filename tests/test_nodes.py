@@ -833,3 +833,28 @@ def test_halting_an_ancestor_first_halts_a_descendant_left_running_under_a_finis
     assert halted.index("n5") < halted.index("n2") and halted.index("n6") < halted.index("n2")
     assert sorted(halted) == sorted(set(halted))  # each exactly once
     assert tree.running == []
+
+
+class JumpingClock(ManualClock):
+    """A manual clock that can also be set back, as a restarted simulation's /clock is."""
+
+    def jump_to(self, seconds: float) -> None:
+        self._now = seconds
+
+
+@pytest.mark.parametrize(("spec", "done"), [
+    (N("Wait", milliseconds=250), SUCCESS),
+    (N("MaxTime", leaf("a", "R"), maxTime=250), FAILURE),
+    (N("Delay", N("Succeeder"), milliseconds=250), SUCCESS),
+])
+def test_a_backward_clock_jump_restarts_timing_instead_of_freezing_it(
+        spec: N, done: Status) -> None:
+    """The clock going back 90 s (a simulation restarted) used to keep a Wait RUNNING until
+    time passed its old start again; now the count restarts, as ROS 2 timers reset."""
+    clock = JumpingClock(100.0)
+    tree = tree_from(spec, clock=clock)
+    assert tree.tick().status is RUNNING
+    clock.jump_to(10.0)
+    assert tree.tick().status is RUNNING
+    clock.advance(0.25)
+    assert tree.tick().status is done

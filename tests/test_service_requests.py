@@ -142,6 +142,34 @@ def test_stop_answers_while_a_map_loads(robot: tuple[Node, Simulator], tmp_path:
     assert loading.result(timeout=20).success and sim.map.source == str(path)
 
 
+def test_stop_answers_while_a_plan_is_slow(robot: tuple[Node, Simulator],
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """stop, dock and undock have a thread of their own: a slow make_plan (a large map) or
+    closest-goal search on the node's thread never queues the stop button behind it."""
+    node, _sim = robot
+    slow = threading.Event()
+    from cyborg.nav.services import NavigationMap
+    real = NavigationMap.plan
+
+    def slowly(self: NavigationMap, *args: Any, **options: Any) -> Any:
+        slow.wait(10)
+        return real(self, *args, **options)
+
+    monkeypatch.setattr(NavigationMap, "plan", slowly)
+    service = "cyborg_msgs/srv/MakePlan"
+    planning = node.create_client("make_plan", service).call_async(
+        request(node, service, goal={"x": 8.0, "y": 3.0}, start={"x": 2.0, "y": 3.0},
+                              use_start=True), timeout=20)
+    time.sleep(0.3)
+    try:
+        started = time.monotonic()
+        assert call(node, "stop", TRIGGER, request(node, TRIGGER), timeout=3).success
+        assert time.monotonic() - started < 2.0
+    finally:
+        slow.set()
+    assert planning.result(timeout=20).found
+
+
 @pytest.mark.parametrize("pose", [{"x": math.nan}, {"y": math.inf}, {"x": 8.0, "y": 3.0,
                                                                       "theta": math.nan}])
 def test_move_to_goal_with_a_pose_that_is_not_finite_fails_to_plan(

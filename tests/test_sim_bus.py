@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -159,3 +160,22 @@ def test_sim_clock_follows_the_simulation(robot: tuple[Node, Simulator, Simulati
     stop.set()
     clock.sleep_until(clock.now() + 1e6, stop)  # returns at once when woken
     clock.destroy()
+
+
+def test_closing_the_bus_under_a_running_simulation_ends_it_quietly(
+        shared: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """A context closed while the loop still steps (an interrupted stop, an exception path):
+    the loop ends, and no "the simulation stopped" error is reported."""
+    sim = Simulator(read_map(shared / "maps" / "AMROffice.map"), start="Dock")
+    loop = SimulationLoop(sim, speed=0)
+    with Context(BusConfig.isolated()) as context:
+        SimulatorNode(Node("arnl", "/cyborg", context=context), loop)
+        loop.start()
+        deadline = time.monotonic() + 5
+        while sim.time < 1.0 and time.monotonic() < deadline:
+            time.sleep(0.01)
+    deadline = time.monotonic() + 5
+    while loop.running and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert not loop.running and loop.error is None
+    assert not [r for r in caplog.records if "simulation stopped" in r.getMessage()]

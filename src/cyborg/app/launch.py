@@ -158,7 +158,12 @@ class Launch:
         try:
             for spec in self.description.nodes:
                 if spec.process == process:
-                    self.running.append(starter_for(spec)(self.context, spec))
+                    try:
+                        self.running.append(starter_for(spec)(self.context, spec))
+                    except LaunchError:
+                        raise
+                    except ValueError as exc:  # a parameter out of its limits or of a wrong type
+                        raise spec.error(str(exc)) from exc
         except BaseException:
             self.stop()
             raise

@@ -41,6 +41,7 @@ from cyborg.bt import Clock, MonotonicClock, TreeLoadError, default_registry
 __all__ = ["KINDS", "LaunchError", "NodeSpec", "Running", "RunningMonitor", "RunningSimulator",
            "RunningTree", "SettlingRobot", "Starter", "starter_for"]
 from cyborg.bus import Context, Node, SimClock
+from cyborg.bus.clock import JUMP_LIMIT, STALL_TIMEOUT
 from cyborg.monitor import (
     DEFAULT_HOST,
     DEFAULT_PORT,
@@ -175,6 +176,13 @@ def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
                                 read_only=True)
         rate = params.declare("rate", 10.0, "ticks per second", read_only=True)
         sim_time = params.declare("use_sim_time", False, "tick on /clock", read_only=True)
+        jump_limit = params.declare(
+            "clock_jump_limit", JUMP_LIMIT, "seconds /clock may jump before it is reported "
+            "(and, forward from a publisher not in the graph, refused)", read_only=True,
+            limits=(1e-3, 1e9))
+        stall_timeout = params.declare(
+            "clock_stall_timeout", STALL_TIMEOUT, "wall seconds without /clock advancing "
+            "before the runner says so", read_only=True, limits=(1e-3, 1e9))
         robot_ns = params.declare("robot_namespace", "/cyborg", "the robot's namespace",
                                   read_only=True)
         enabled = params.declare("enabled", True, "tick from the start", read_only=True)
@@ -185,7 +193,9 @@ def start_tree_runner(context: Context, spec: NodeSpec) -> RunningTree:
             registry.import_modules([module for module in modules if module])
         except ImportError as exc:
             raise spec.error(str(exc)) from exc
-        clock: Clock = SimClock(node) if sim_time else MonotonicClock()
+        clock: Clock = SimClock(node, jump_limit=float(jump_limit),
+                                stall_timeout=float(stall_timeout)) if sim_time \
+            else MonotonicClock()
         robot_node = Node(f"{spec.name}_robot", spec.namespace, context=context)
         robot = SettlingRobot(robot_node, str(robot_ns))
         try:

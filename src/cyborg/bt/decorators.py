@@ -10,7 +10,7 @@ RunOnce) live in node memory and are not reset when the node starts again.
 
 from __future__ import annotations
 
-from cyborg.bt.node import Decorator, elapsed_ms
+from cyborg.bt.node import Decorator
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 
@@ -154,7 +154,7 @@ class Timeout(Decorator):
         self.memory["start"] = self.now
 
     def tick(self) -> Status:
-        if elapsed_ms(self.now, self.memory["start"]) >= self.limit_ms:
+        if self.ms_since() >= self.limit_ms:
             self.child.halt()
             return FAILURE
         return self.child.execute()
@@ -185,7 +185,7 @@ class Delay(Decorator):
         self.memory["start"] = self.now
 
     def tick(self) -> Status:
-        if elapsed_ms(self.now, self.memory["start"]) < self.delay_ms:
+        if self.ms_since() < self.delay_ms:
             return RUNNING
         return self.child.execute()
 

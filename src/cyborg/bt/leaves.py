@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from cyborg.bt.node import Action, elapsed_ms
+from cyborg.bt.node import Action
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 
@@ -53,6 +53,6 @@ class Wait(Action):
         self.memory["start"] = self.now
 
     def tick(self) -> Status:
-        if elapsed_ms(self.now, self.memory["start"]) >= self.milliseconds:
+        if self.ms_since() >= self.milliseconds:
             return SUCCESS
         return RUNNING

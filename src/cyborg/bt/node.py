@@ -175,6 +175,20 @@ class Node:
         """Time of the current tick in seconds, from the tree's clock (simulated or real)."""
         return self._record.now
 
+    def ms_since(self, key: str = "start") -> float:
+        """Milliseconds from ``memory[key]`` (a time taken from :attr:`now`, usually in
+        ``on_start``) to now.
+
+        When the clock went back past that time (a restarted simulation, a backward jump of
+        ``/clock``), the count restarts from now, as ROS 2 resets its timers on a backward
+        jump: a Wait never waits for time to pass its start again.
+        """
+        start = self.memory[key]
+        now = self._record.now
+        if now < start:
+            self.memory[key] = start = now
+        return elapsed_ms(now, start)
+
     def execute(self) -> Status:
         """Tick this node once inside the tree's current tick. Parents call this, not tick()."""
         try:

@@ -177,6 +177,8 @@ class Context:
             subscribers = self._local.get(topic, [])
             if subscription in subscribers:
                 subscribers.remove(subscription)
+            if not subscribers:
+                self._local.pop(topic, None)
 
     def local_subscriptions(self, topic: str) -> tuple[Any, ...]:
         with self._lock:
@@ -190,8 +192,11 @@ class Context:
 
     def unlatch(self, topic: str, publisher: Any) -> None:
         with self._lock:
-            self._latched[topic] = [d for d in self._latched.get(topic, [])
-                                    if d[0] is not publisher]
+            entries = [d for d in self._latched.get(topic, []) if d[0] is not publisher]
+            if entries:
+                self._latched[topic] = entries
+            else:
+                self._latched.pop(topic, None)
 
     # ------------------------------------------------------------------ dropped input
     def drop(self, reason: str, detail: str = "") -> None:

@@ -66,6 +66,7 @@ class Node:
         self.callbacks = CallbackThread(self.fq_name)
         self._callback_threads: list[CallbackThread] = []
         self._entities: list[Any] = []
+        self._kept_after_prune = 16
         self._timers: list[Timer] = []
         self._destroyed = False
         self.token_key = node_token(self.context.domain, self.context.zid, self.id,
@@ -73,6 +74,11 @@ class Node:
         self._token = self.context.session.liveliness().declare_token(self.token_key)
         self.context.register_node(self)
         self.parameters = Parameters(self, overrides=parameters or {})
+
+    @property
+    def destroyed(self) -> bool:
+        """True once :meth:`destroy` has run (or begun)."""
+        return self._destroyed
 
     @property
     def types(self) -> MessageTypes:
@@ -136,6 +142,7 @@ class Node:
         if self._destroyed:
             raise RuntimeError(f"node {self.fq_name} was destroyed")
         timer = Timer(self, period, callback)
+        self._timers = [t for t in self._timers if not t.cancelled]
         self._timers.append(timer)
         return timer
 
@@ -145,6 +152,11 @@ class Node:
             raise RuntimeError(f"node {self.fq_name} was destroyed")
         entity = factory(self, *args, **options)
         self._entities.append(entity)
+        if len(self._entities) >= 2 * self._kept_after_prune:
+            # entities destroyed one by one (a viewer's subscriptions, a reload's clients) are
+            # forgotten here, so a node that lives for days does not hold them all
+            self._entities = [e for e in self._entities if not getattr(e, "_closed", False)]
+            self._kept_after_prune = max(16, len(self._entities))
         return entity
 
     def destroy(self) -> None:
@@ -194,6 +206,10 @@ class Timer:
         self._pending.clear()
         if not self._stop.is_set():
             self.callback()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._stop.is_set()
 
     def cancel(self) -> None:
         self._stop.set()

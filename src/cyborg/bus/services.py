@@ -82,6 +82,10 @@ class RequestError(ServiceError):
 
 
 _BAD_REQUEST = "bad request: "
+MAX_PENDING_REQUESTS = 64
+"""Requests one server queues while its handler is busy; more are answered "busy" at once
+(a flood of calls must not grow a node's memory without bound). ``server.max_pending`` changes
+it for one server."""
 _MAX_ERROR = 300  # characters of an error text that travel
 
 
@@ -253,6 +257,9 @@ class ServiceServer(_ServiceEndpoint):
         self.handled = 0
         self.checks: list[Callable[[Any], object]] = []
         self._traced: set[type] = set()  # exception types whose traceback was logged
+        self.max_pending = MAX_PENDING_REQUESTS
+        self._pending = 0  # requests queued for the handler, not yet started
+        self._pending_lock = threading.Lock()
         self._queryable = self.context.session.declare_queryable(
             self.key, self._on_query, complete=True)
 
@@ -268,9 +275,21 @@ class ServiceServer(_ServiceEndpoint):
                                       f"({len(payload)} bytes): {exc}").encode())
             query.drop()
             return
+        with self._pending_lock:
+            busy = self._pending >= self.max_pending
+            if not busy:
+                self._pending += 1
+        if busy:
+            self.context.drop(f"{self.name}: busy", f"{self.max_pending} requests waiting")
+            query.reply_err(_one_line(f"service {self.name} is busy: {self.max_pending} "
+                                      "requests are waiting; try again later").encode())
+            query.drop()
+            return
         self.node.callbacks.submit(self._handle, Responder(self, query, attachment), request)
 
     def _handle(self, responder: Responder, request: Any) -> None:
+        with self._pending_lock:
+            self._pending -= 1
         self.handled += 1
         try:
             for check in self.checks:

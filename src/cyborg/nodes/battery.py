@@ -87,6 +87,8 @@ class Charge(Action):
                                 self.reason)
                 return FAILURE
             self._requested_at = self.now
+        elif self.now < self._requested_at:  # the clock went back: count again from now
+            self._requested_at = self.now
         elif self.now - self._requested_at > DOCK_START_TIMEOUT:
             self.reason = f"the robot did not start docking within {DOCK_START_TIMEOUT:g} s"
             limited.warning(("Charge timeout", self.uid), "Charge %s: %s", self.uid,

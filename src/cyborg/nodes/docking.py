@@ -42,6 +42,8 @@ class _DockAction(Action):
                 self.reason = message
                 return FAILURE
             self._asked = True
+        if self.now < self._started:  # the clock went back: count again from now
+            self._started = self.now
         if self.now - self._started > self.timeout:
             self.reason = f"not {self.wanted.value} after {self.timeout:g} s"
             return FAILURE

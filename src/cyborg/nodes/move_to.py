@@ -116,6 +116,7 @@ class MoveTo(Action):
         self._start()
 
     def tick(self) -> Status:
+        self._after_clock_went_back()
         if self.move is None and self._retry_at is not None:
             if self.now < self._retry_at:
                 return RUNNING  # backing off
@@ -153,6 +154,18 @@ class MoveTo(Action):
     def on_halt(self) -> None:
         if self.move is not None:
             self.move.cancel()
+
+    def _after_clock_went_back(self) -> None:
+        """A deadline further away than it can be set means the clock went back (a restarted
+        simulation, a backward /clock jump): count again from now, as ROS 2 resets its timers,
+        instead of waiting for time to pass the old start again."""
+        now = self.now
+        if self._deadline - now > max(self.progress_timeout, self.start_timeout):
+            self._deadline = now + self.start_timeout
+        if self._retry_at is not None and self._retry_at - now > self._delay:
+            self._retry_at = now + self._delay
+        if self._next_try - now > self._delay:
+            self._next_try = now + self._delay
 
     # ------------------------------------------------------------------ steps
     def _start(self) -> None:

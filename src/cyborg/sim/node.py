@@ -80,9 +80,12 @@ class SimulatorNode:
         self.maps.listeners.append(self._map_changed)
         self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
         trigger = "std_srvs/srv/Trigger"
-        node.create_service("dock", trigger, self._dock)
-        node.create_service("undock", trigger, self._undock)
-        node.create_service("stop", trigger, self._stop)
+        # stop, dock and undock answer on a thread of their own: a slow plan, a closest-goal
+        # search or a goal being accepted never delays the stop button
+        motion = node.callback_thread("motion")
+        node.create_service("dock", trigger, self._dock, callbacks=motion)
+        node.create_service("undock", trigger, self._undock, callbacks=motion)
+        node.create_service("stop", trigger, self._stop, callbacks=motion)
         node.create_action_server("move_to_goal", "cyborg_msgs/action/MoveToGoal", self._move)
         loop.on_sensor.append(self._publish)
 
@@ -97,6 +100,19 @@ class SimulatorNode:
         return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
 
     def _publish(self, sim: Simulator) -> None:
+        if self.node.destroyed:
+            # the node went first (its context closed, or a stop whose join timed out): the
+            # simulation ends here quietly instead of failing on a withdrawn publisher
+            self.loop.stop()
+            return
+        try:
+            self._publish_step(sim)
+        except RuntimeError:
+            if not self.node.destroyed:  # destroyed while publishing: the same quiet end
+                raise
+            self.loop.stop()
+
+    def _publish_step(self, sim: Simulator) -> None:
         self._feedback(sim)
         with self._stepped:
             self._stepped.notify_all()
