@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 
 from cyborg.bt import TickSnapshot, TreeRunner, loads_tree
-from cyborg.bus import BusConfig, Context, Node
+from cyborg.bus import BusConfig, Context, Node, Qos
 from cyborg.bus.clock import CLOCK_TYPE, SimClock
 from tests.builders import N, registry, tree_json
 from tests.bus_peer import forged, linked_contexts, raw_put, until_subscribed, wait_for
@@ -244,3 +244,16 @@ def test_in_process_clock_messages_keep_their_order(bus: Context) -> None:
     assert wait_for(lambda: clock.now() == 2.0)
     time.sleep(0.05)
     assert clock.now() == 2.0 and clock._epoch == 0  # never went back to 1.0
+
+
+def test_a_clock_created_after_a_latched_clock_message_follows_it_without_error(
+        bus: Context, caplog: pytest.LogCaptureFixture) -> None:
+    """A /clock message already waiting in the process (latched) arrives while the SimClock
+    subscribes; it used to raise AttributeError ('topic') inside the callback."""
+    node = Node("sim", context=bus)
+    publisher = node.create_publisher("/clock", CLOCK_TYPE, Qos.latched())
+    publisher.publish(clock_message(bus.types, 42.0))
+    with caplog.at_level(logging.WARNING):
+        clock = SimClock(Node("runner", context=bus))
+        assert clock.wait_for_time(5) and clock.now() == 42.0
+    assert not [record for record in caplog.records if "raised" in record.getMessage()]

@@ -19,13 +19,12 @@ of ``properties``) are used, with ``properties`` winning where both set a key.
 
 from __future__ import annotations
 
-import bisect
-import re
 from pathlib import Path
 from typing import Any
 
 from cyborg.bt.editor_v1 import V1Reader, is_v1, is_v1_definitions, parse_definitions
 from cyborg.bt.files import FileRefusedError, decode_json, read_text
+from cyborg.bt.json_text import TextLines, first_lines
 from cyborg.bt.limits import Limits
 from cyborg.bt.problems import Problem, Severity, TreeLoadError, shown
 from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec, render_title
@@ -37,16 +36,9 @@ class _Lines:
     """Line numbers of object keys and ``"id"`` values in the raw JSON text."""
 
     def __init__(self, text: str) -> None:
-        self._starts = [0] + [m.end() for m in re.finditer("\n", text)]
-        self._keys: dict[str, int] = {}
-        for match in re.finditer(r'"((?:[^"\\]|\\.)*)"\s*:\s*\{', text):
-            self._keys.setdefault(match.group(1), self._line(match.start()))
-        self._ids: dict[str, int] = {}
-        for match in re.finditer(r'"(?:id|name)"\s*:\s*"((?:[^"\\]|\\.)*)"', text):
-            self._ids.setdefault(match.group(1), self._line(match.start()))
-
-    def _line(self, offset: int) -> int:
-        return bisect.bisect_right(self._starts, offset)
+        lines = TextLines(text)
+        self._keys = first_lines(text, r'"((?:[^"\\]|\\.)*)"\s*:\s*\{', lines)
+        self._ids = first_lines(text, r'"(?:id|name)"\s*:\s*"((?:[^"\\]|\\.)*)"', lines)
 
     def of_key(self, key: str) -> int | None:
         return self._keys.get(key, self._ids.get(key))

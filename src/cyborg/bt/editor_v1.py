@@ -35,13 +35,13 @@ other cannot exhaust the stack. Imports are followed without recursion.
 
 from __future__ import annotations
 
-import bisect
 import re
 from pathlib import Path
 from typing import Any
 
 from cyborg.bt.editor_v1_names import EQUIVALENTS, NO_EQUIVALENT
 from cyborg.bt.files import FileRefusedError, decode_json, read_text
+from cyborg.bt.json_text import TextLines, first_lines
 from cyborg.bt.limits import Limits
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.specs import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
@@ -101,17 +101,9 @@ class _LineIndex:
     """Lines of node ids and definition names in a file's text."""
 
     def __init__(self, text: str) -> None:
-        self._starts = [0] + [m.end() for m in re.finditer("\n", text)]
-        self._ids: dict[str, int] = {}
-        for match in _ID.finditer(text):
-            value = match.group(1) if match.group(1) is not None else match.group(2)
-            self._ids.setdefault(value, self._line(match.start()))
-        self._names: dict[str, int] = {}
-        for match in re.finditer(r'"name"\s*:\s*"((?:[^"\\]|\\.)*)"', text):
-            self._names.setdefault(match.group(1), self._line(match.start()))
-
-    def _line(self, offset: int) -> int:
-        return bisect.bisect_right(self._starts, offset)
+        lines = TextLines(text)
+        self._ids = first_lines(text, _ID, lines)
+        self._names = first_lines(text, r'"name"\s*:\s*"((?:[^"\\]|\\.)*)"', lines)
 
     def of_id(self, node_id: str) -> int | None:
         return self._ids.get(node_id)

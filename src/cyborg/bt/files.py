@@ -25,8 +25,6 @@ Failures raise :class:`FileRefusedError` (reading) or :class:`~cyborg.bt.problem
 
 from __future__ import annotations
 
-import bisect
-import itertools
 import json
 import os
 import re
@@ -34,16 +32,13 @@ import stat
 from pathlib import Path
 from typing import Any
 
+from cyborg.bt.json_text import TextLines, too_deep
 from cyborg.bt.limits import MAX_INT_DIGITS, Limits, size
 from cyborg.bt.problems import Problem, TreeLoadError
 
 _CHUNK = 1 << 20
 _ESCAPE = re.compile(r"\\(?:u([0-9a-fA-F]{4})|.)", re.DOTALL)
 _RAW_SURROGATE = re.compile("[\ud800-\udfff]")
-_NOT_BRACKET = re.compile(r"[^\[\]{}]+")
-_BRACKET_OR_STRING = re.compile(r'"(?:[^"\\]|\\.)*(?:"|\\?\Z)|[\[\]{}]')  # a string may run
-# to the end (malformed, but then it ends the scan: no quadratic retries from later quotes)
-_STEP = {"[": 1, "{": 1, "]": -1, "}": -1}
 
 
 class FileRefusedError(Exception):
@@ -123,7 +118,7 @@ def decode_json(text: str, source: str, limits: Limits) -> Any:
     column) of malformed JSON, of nesting deeper than ``limits`` allow, of an integer with too
     many digits, or of a lone surrogate."""
     text = text.removeprefix("\ufeff")
-    deep = _too_deep(text, limits.max_nesting)
+    deep = too_deep(text, limits.max_nesting)
     if deep is not None:
         line, column = _position(text, deep)
         raise TreeLoadError([Problem(
@@ -151,25 +146,6 @@ def decode_json(text: str, source: str, limits: Limits) -> Any:
             "replace it with the character meant (a pair such as \\ud83e\\udd16 is fine)",
             source, line, column)])
     return data
-
-
-def _too_deep(text: str, cap: int) -> int | None:
-    """Offset of the first bracket opening level ``cap + 1`` (brackets in strings do not
-    count); None when there is none. Quick when no bracket, in a string or not, is that deep."""
-    brackets = _NOT_BRACKET.sub("", text)
-    if len(brackets) <= cap or max(itertools.accumulate(map(_STEP.__getitem__, brackets)),
-                                   default=0) <= cap:
-        return None
-    depth = 0
-    for match in _BRACKET_OR_STRING.finditer(text):
-        token = match.group()
-        if token in "[{":
-            depth += 1
-            if depth > cap:
-                return match.start()
-        elif token in "]}":
-            depth -= 1
-    return None
 
 
 class _TooManyDigitsError(ValueError):
@@ -218,6 +194,4 @@ def _lone_surrogate(text: str) -> tuple[int, str] | None:
 def _position(text: str, offset: int) -> tuple[int | None, int | None]:
     if offset < 0:
         return None, None
-    starts = [0] + [m.end() for m in re.finditer("\n", text)]
-    line = bisect.bisect_right(starts, offset)
-    return line, offset - starts[line - 1] + 1
+    return TextLines(text).position(offset)

@@ -50,11 +50,8 @@ class Category(StrEnum):
 
 
 class TickRecord:
-    """What one tick of a tree leaves behind; shared by every node of that tree.
-
-    The tree replaces the lists at the start of each tick, so a finished tick's lists can be
-    handed to a snapshot without copying.
-    """
+    """What one tick of a tree leaves behind; shared by every node of that tree. The tree
+    replaces the lists at each tick's start, so a snapshot can take them without copying."""
 
     __slots__ = ("durations", "halted", "now", "running", "visits")
 
@@ -176,15 +173,9 @@ class Node:
         return self._record.now
 
     def ms_since(self, key: str = "start") -> float:
-        """Milliseconds from ``memory[key]`` (a time taken from :attr:`now`, usually in
-        ``on_start``) to now.
-
-        When the clock went back past that time (a restarted simulation, a backward jump of
-        ``/clock``), the count restarts from now, as ROS 2 resets its timers on a backward
-        jump: a Wait never waits for time to pass its start again.
-        """
-        start = self.memory[key]
-        now = self._record.now
+        """Milliseconds from ``memory[key]`` (a time from :attr:`now`) to now; if the clock went
+        back past it (a restarted simulation), counting restarts now, as ROS 2 timers reset."""
+        start, now = self.memory[key], self._record.now
         if now < start:
             self.memory[key] = start = now
         return elapsed_ms(now, start)
@@ -402,11 +393,8 @@ def _no_children(node: Node) -> list[str]:
 
 
 def elapsed_ms(now: float, start: float) -> float:
-    """Milliseconds from ``start`` to ``now`` (seconds), rounded to the nanosecond.
-
-    The rounding absorbs floating-point noise, so that ``0.7 - 0.2`` counts as the 500 ms it
-    is meant to be and a 500 ms Wait does not need an extra tick.
-    """
+    """Milliseconds from ``start`` to ``now`` (seconds), rounded to the nanosecond so that
+    ``0.7 - 0.2`` counts as 500 ms and a 500 ms Wait needs no extra tick."""
     return round((now - start) * 1000.0, 6)
 
 

@@ -89,6 +89,7 @@ class SimClock:
         self._said_ignored = -_REPEAT
         self._gids: tuple[int, frozenset[bytes]] = (-1, frozenset())
         self._changed = threading.Condition()
+        self.topic = topic  # set before subscribing: a latched message may arrive at once
         self._subscription = node.create_subscription(topic, CLOCK_TYPE, self._on_clock,
                                                       with_info=True)
         self.topic = self._subscription.topic

@@ -29,6 +29,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from cyborg.bt.json_text import too_deep
+
 MESSAGE_LIMIT = 64 * 1024
 """Longest message a page may send, in characters (the page's own are under 1 KiB)."""
 FRAME_LIMIT = 2 * MESSAGE_LIMIT
@@ -42,8 +44,6 @@ NAMESPACE_LIMIT = 200
 """Longest namespace, in characters."""
 
 _NAMESPACE = re.compile(r"^(?:/[A-Za-z][A-Za-z0-9_]*)+$")
-_TOKENS = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]')
-"""JSON strings (skipped whole, even unterminated) and brackets."""
 
 
 @dataclass(frozen=True)
@@ -98,17 +98,9 @@ def decode(text: str) -> Any:
 
 
 def _check_depth(text: str) -> None:
-    if text.count("[") + text.count("{") <= DEPTH_LIMIT:
-        return  # cannot nest deeper: the common case, no scan
-    depth = 0
-    for match in _TOKENS.finditer(text):
-        token = match.group()
-        if token in ("[", "{"):
-            depth += 1
-            if depth > DEPTH_LIMIT:
-                raise MessageError(f"nested deeper than {DEPTH_LIMIT} levels", match.start())
-        elif token in ("]", "}"):
-            depth -= 1
+    deep = too_deep(text, DEPTH_LIMIT)
+    if deep is not None:
+        raise MessageError(f"nested deeper than {DEPTH_LIMIT} levels", deep)
 
 
 def _no_constant(name: str) -> Any:
