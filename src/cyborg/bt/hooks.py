@@ -21,12 +21,19 @@ One hook model covers what a monitor needs (Groot2 calls these hooks too)::
 
 Every hook has an ``owner`` (a name chosen by whoever set it, e.g. the monitor's bus identity);
 :meth:`TreeHooks.clear_owner` removes all of an owner's hooks when it goes away. Hooks are keyed
-by node id, so they survive a reload of the same tree. A hooked node gets a wrapped
-``execute``; nodes without hooks run exactly as before, at no extra cost.
+by node id, so they survive a reload of the same tree.
 
-**Timing.** With ``hooks.timing = True`` every node gets the wrapped ``execute`` and each visit's
-wall time (the node and its subtree, breakpoint waits left out) goes into the tick's snapshot
-(:attr:`~cyborg.bt.snapshot.TickSnapshot.visit_durations`); monitors show it per node.
+**How.** Hooks work through the node's own extension points, as BehaviorTree.CPP's Groot2
+publisher does: a hooked node's :attr:`~cyborg.bt.node.Node.pre_tick` slot waits at a
+breakpoint or substitutes the disabled status, its :attr:`~cyborg.bt.node.Node.post_tick` slot
+replaces a forced result. Callbacks a node already had stay in force behind the hook and are
+back in their slots when it is cleared. Nothing else of the node changes; a node without hooks
+has empty slots and ticks at full speed. While a tick is stepped, every node gets the pre-tick
+slot, so that the next one about to tick stops.
+
+**Timing** is not a hook: it is an option of the tree, :attr:`Tree.timing
+<cyborg.bt.tree.Tree.timing>`, applied between ticks (``hooks.timing`` is kept as another name
+for it).
 """
 
 from __future__ import annotations
@@ -41,7 +48,8 @@ from typing import TYPE_CHECKING
 from cyborg.bt.status import FAILURE, RUNNING, SUCCESS, Status
 
 if TYPE_CHECKING:
-    from cyborg.bt.node import Node
+    from cyborg.bt.node import Node, PostTick, PreTick
+    from cyborg.bt.tree import Tree
 
 
 class HookMode(StrEnum):
@@ -76,68 +84,20 @@ class HookError(ValueError):
     """A hook that cannot be set; the message names the node and the reason."""
 
 
-class NodeHook:
-    """What a hooked node carries: its hook, and the ``execute`` that applies it."""
-
-    __slots__ = ("hook", "node", "owner")
-
-    def __init__(self, owner: TreeHooks, node: Node, hook: Hook | None) -> None:
-        self.owner, self.node, self.hook = owner, node, hook
-
-    def execute(self) -> Status:
-        """Stands in for ``node.execute`` while the node is hooked (or the tree is timed)."""
-        owner = self.owner
-        if not owner.timing:
-            return self.apply()
-        started, waited = perf_counter(), owner.waited
-        status = self.apply()
-        elapsed = perf_counter() - started - (owner.waited - waited)
-        record = self.node._record
-        record.durations[len(record.visits) - 1] = elapsed
-        return status
-
-    def apply(self) -> Status:
-        """Tick the node with its hook applied."""
-        node = self.node
-        replaced = self.before(node)
-        if replaced is not None:
-            return node._skip(replaced)
-        status = type(node).execute(node)
-        forced = self.after(node, status)
-        if forced is not status:
-            node._replace_result(status, forced)
-        return forced
-
-    def before(self, node: Node) -> Status | None:
-        """Called before the node ticks; a status means "do not tick, return this"."""
-        hooks, hook = self.owner, self.hook
-        if hooks.stepping or (hook is not None and hook.mode is HookMode.BREAKPOINT):
-            hooks.wait_at(node, hook)
-        if hook is not None and hook.mode is HookMode.DISABLE:
-            return hook.status
-        return None
-
-    def after(self, node: Node, status: Status) -> Status:
-        hook = self.hook
-        if hook is None or hook.mode is not HookMode.FORCE:
-            return status
-        if hook.once:
-            self.owner.clear(hook.node)
-        return hook.status
-
-
 class TreeHooks:
     """The hooks of one tree (``tree.hooks``); safe to change from any thread."""
 
-    def __init__(self, nodes: Iterable[Node]) -> None:
+    def __init__(self, nodes: Iterable[Node], tree: Tree | None = None) -> None:
         self._nodes = {node.uid: node for node in nodes}
+        self._tree = tree
         self._hooks: dict[str, Hook] = {}
+        self._held: dict[str, tuple[PreTick | None, PostTick | None]] = {}
+        """Node id -> the callbacks its slots had before this object took them."""
         self._lock = threading.Condition()
         self._released = 0  # bumped to let waiting ticks go on
         self.stepping = False
-        self._timing = False
         self.waited = 0.0
-        """Seconds ticks have spent waiting at breakpoints (kept out of the timings)."""
+        """Seconds ticks have spent waiting at breakpoints."""
         self.paused_at: str | None = None
         """Id of the node a tick is waiting before, or None."""
         self.listeners: list[Callable[[], None]] = []
@@ -155,7 +115,7 @@ class TreeHooks:
                             f"not {hook.status.label}")
         with self._lock:
             self._hooks[hook.node] = hook
-            self._attach(node, hook)
+            self._attach(node)
         self._changed()
 
     def disable(self, uid: str, status: Status = FAILURE, *, owner: str = "") -> None:
@@ -173,7 +133,7 @@ class TreeHooks:
             hook = self._hooks.pop(uid, None)
             if hook is None:
                 return False
-            self._attach(self._nodes[uid], None)
+            self._attach(self._nodes[uid])
             if self.paused_at == uid and not self.stepping:
                 self._release_locked()
         self._changed()
@@ -203,15 +163,42 @@ class TreeHooks:
     # ------------------------------------------------------------------ timing
     @property
     def timing(self) -> bool:
-        """Whether every visit is timed (see the module docstring)."""
-        return self._timing
+        """Another name for :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>` (applied between
+        ticks); False for hooks made without a tree."""
+        return self._tree is not None and self._tree.timing
 
     @timing.setter
     def timing(self, on: bool) -> None:
-        with self._lock:
-            self._timing = bool(on)
-            for uid, node in self._nodes.items():
-                self._attach(node, self._hooks.get(uid))
+        if self._tree is None:
+            raise RuntimeError("these hooks belong to no tree: set Tree.timing instead")
+        self._tree.timing = on
+
+    # ------------------------------------------------------------------ the nodes' slots
+    def before_tick(self, node: Node) -> Status | None:
+        """The pre-tick callback of a hooked node: wait at a breakpoint (or while stepping),
+        return the status of a disabled node, else what the node's own callback says."""
+        hook = self._hooks.get(node.uid)
+        if self.stepping or (hook is not None and hook.mode is HookMode.BREAKPOINT):
+            self.wait_at(node, hook)
+        if hook is not None and hook.mode is HookMode.DISABLE:
+            return hook.status
+        held = self._held.get(node.uid)
+        return None if held is None or held[0] is None else held[0](node)
+
+    def after_tick(self, node: Node, status: Status) -> Status | None:
+        """The post-tick callback of a hooked node: the node's own callback, then a forced
+        result (a ``once`` hook goes away here)."""
+        held = self._held.get(node.uid)
+        if held is not None and held[1] is not None:
+            replaced = held[1](node, status)
+            if replaced is not None:
+                status = replaced
+        hook = self._hooks.get(node.uid)
+        if hook is None or hook.mode is not HookMode.FORCE:
+            return status
+        if hook.once:
+            self.clear(hook.node)
+        return hook.status
 
     # ------------------------------------------------------------------ pausing
     def wait_at(self, node: Node, hook: Hook | None) -> None:
@@ -250,8 +237,7 @@ class TreeHooks:
                 return False
             self.stepping = True
             for node in self._nodes.values():
-                if node.hook is None:
-                    self._attach(node, None)
+                self._attach(node)
             self._release_locked()
         return True
 
@@ -276,20 +262,20 @@ class TreeHooks:
         return dropped
 
     # ------------------------------------------------------------------ internals
-    def _attach(self, node: Node, hook: Hook | None) -> None:
-        if hook is None and not self.stepping and not self._timing:
-            node.hook = None
-            node.__dict__.pop("execute", None)
-        else:
-            attached = node.hook = NodeHook(self, node, hook)
-            node.execute = attached.execute  # type: ignore[method-assign]
+    def _attach(self, node: Node) -> None:
+        """Take ``node``'s slots if it is hooked or a tick is stepped; give them back if not."""
+        uid = node.uid
+        wanted = self.stepping or uid in self._hooks
+        if wanted and uid not in self._held:
+            self._held[uid] = (node.pre_tick, node.post_tick)
+            node.pre_tick, node.post_tick = self.before_tick, self.after_tick
+        elif not wanted and uid in self._held:
+            node.pre_tick, node.post_tick = self._held.pop(uid)
 
     def _detach_steps(self) -> None:
-        for node in self._nodes.values():
-            attached = node.hook
-            if attached is not None and attached.hook is None and not self._timing:
-                node.hook = None
-                node.__dict__.pop("execute", None)
+        for uid in list(self._held):
+            if uid not in self._hooks:
+                self._attach(self._nodes[uid])
 
     def _release_locked(self) -> None:
         self._released += 1

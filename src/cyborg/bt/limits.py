@@ -17,7 +17,8 @@ cap for ``cyborg bt`` and the tree runner), else from this module's constants, w
 may also change. An error names the cap and both ways to raise it.
 
 **Why 150 levels.** Ticking recurses: a parent's ``tick`` calls its child's ``execute``, two
-Python frames per level, four when hooks wrap every node (``tree.hooks.timing``). 150 levels
+Python frames per level, four when a node goes through its pre/post-tick slots (hooked, or
+``tree.timing``). 150 levels
 take at most :data:`FRAMES_PER_LEVEL` x 150 = 600 of Python's default recursion limit of 1,000,
 leaving :data:`STACK_RESERVE` = 400 frames for the code that ticks the tree and for the leaves'
 own calls. A deeper tree would load and then fail on every tick with ``RecursionError``, so it is

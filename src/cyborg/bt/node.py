@@ -14,6 +14,10 @@ RUNNING, or until it is halted::
   (a higher-priority branch took over, a timeout fired, the tree was stopped). Use it to cancel
   what the node started. Halting goes deepest first, so a child is halted before its parent.
 
+Around each tick a node has two *extension points*, ``node.pre_tick`` and ``node.post_tick``
+(:mod:`cyborg.bt.extension`, as BehaviorTree.CPP's pre- and post-tick callbacks); the tree's
+hooks and its timing work through them.
+
 A node's code may raise: the node then returns ERROR, the exception is logged once with its
 traceback and the node's id, and the tree keeps ticking.
 
@@ -30,13 +34,19 @@ from collections.abc import Callable, Iterator
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from cyborg.bt.extension import ExtensionPoints, TickRecord
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
-    from cyborg.bt.hooks import NodeHook
 
 log = logging.getLogger("cyborg.bt")
+
+PreTick = Callable[["Node"], Status | None]
+"""A ``node.pre_tick`` callback: a status means "do not tick, return this" (see
+:mod:`cyborg.bt.extension`)."""
+PostTick = Callable[["Node", Status], Status | None]
+"""A ``node.post_tick`` callback: a status other than the one given replaces it."""
 
 
 class Category(StrEnum):
@@ -49,26 +59,7 @@ class Category(StrEnum):
     TREE = "tree"
 
 
-class TickRecord:
-    """What one tick of a tree leaves behind; shared by every node of that tree. The tree
-    replaces the lists at each tick's start, so a snapshot can take them without copying."""
-
-    __slots__ = ("durations", "halted", "now", "running", "visits")
-
-    def __init__(self) -> None:
-        self.now = 0.0
-        """Time of the current tick, in seconds of the tree's clock."""
-        self.visits: list[tuple[Node, Status]] = []
-        """Every node executed in this tick, in completion order (children before parents)."""
-        self.running: list[Node] = []
-        """Nodes that returned RUNNING in this tick, deepest first."""
-        self.halted: list[Node] = []
-        """Nodes halted in this tick, deepest first."""
-        self.durations: dict[int, float] = {}
-        """Wall time of each visit (index into ``visits``), when the tree's hooks time nodes."""
-
-
-class Node:
+class Node(ExtensionPoints):
     """Base class of every node. Subclass :class:`Action`, :class:`Condition`,
     :class:`Composite` or :class:`Decorator` rather than this class."""
 
@@ -122,9 +113,6 @@ class Node:
     last_error: BaseException | None = None
     """The last exception the node's code raised, if any."""
     error_count: int = 0
-    hook: NodeHook | None = None
-    """Set by :class:`~cyborg.bt.hooks.TreeHooks` while the node is disabled, forced or has a
-    breakpoint; ``None`` otherwise."""
     _record: TickRecord
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -133,6 +121,10 @@ class Node:
         # activations of nodes that finish at once, and two empty calls would double their cost.
         cls._starts = cls.on_start is not Node.on_start
         cls._ends = cls.on_end is not Node.on_end
+        # Neither: an execute without the two tests (an execute not the engine's is kept).
+        if cls.execute in _ENGINE_EXECUTES:
+            lean = not (cls._starts or cls._ends)
+            cls.execute = Node._execute_lean if lean else Node.execute  # type: ignore[method-assign]
 
     # ----------------------------------------------------------------- hooks to override
     def on_start(self) -> None:
@@ -173,15 +165,31 @@ class Node:
         return self._record.now
 
     def ms_since(self, key: str = "start") -> float:
-        """Milliseconds from ``memory[key]`` (a time from :attr:`now`) to now; if the clock went
-        back past it (a restarted simulation), counting restarts now, as ROS 2 timers reset."""
-        start, now = self.memory[key], self._record.now
+        """Milliseconds from ``memory[key]`` (a time taken from :attr:`now`, usually in
+        ``on_start``) to now.
+
+        When the clock went back past that time (a restarted simulation, a backward jump of
+        ``/clock``), the count restarts from now, as ROS 2 resets its timers on a backward
+        jump: a Wait never waits for time to pass its start again.
+        """
+        start = self.memory[key]
+        now = self._record.now
         if now < start:
             self.memory[key] = start = now
         return elapsed_ms(now, start)
 
     def execute(self) -> Status:
-        """Tick this node once inside the tree's current tick. Parents call this, not tick()."""
+        """Tick this node once inside the tree's current tick. Parents call this, not tick().
+
+        Goes through the extension points when this node uses one (see
+        :mod:`cyborg.bt.extension`); otherwise they cost the test below, and one test only
+        while no node of the tree uses them. A class that overrides neither :meth:`on_start`
+        nor :meth:`on_end` runs :meth:`_execute_lean` instead, chosen when the class is made.
+        """
+        record = self._record
+        if record.hooked and self in record.hooked:
+            return self._execute_hooked()
+        # The steps of ExtensionPoints._tick_once, inline: the path of nearly every visit.
         try:
             if self._starts and self.status is not RUNNING:
                 self.on_start()
@@ -191,12 +199,28 @@ class Node:
         except Exception as exc:
             status = self._raised(exc)
         self.status = status
-        record = self._record
         record.visits.append((self, status))
         if status is RUNNING:
             record.running.append(self)
         elif self._ends:
             self._end(status)
+        return status
+
+    def _execute_lean(self) -> Status:
+        """:meth:`execute` less the tests for :meth:`on_start` and :meth:`on_end`."""
+        record = self._record
+        if record.hooked and self in record.hooked:
+            return self._execute_hooked()
+        try:
+            status = self.tick()
+            if status.__class__ is not Status:
+                status = self._coerce(status)
+        except Exception as exc:
+            status = self._raised(exc)
+        self.status = status
+        record.visits.append((self, status))
+        if status is RUNNING:
+            record.running.append(self)
         return status
 
     def halt(self) -> None:
@@ -238,29 +262,6 @@ class Node:
         return f"<{type(self).__name__} {self.label or self.name!r} uid={self.uid!r}>"
 
     # ----------------------------------------------------------------- internals
-    def _skip(self, status: Status) -> Status:
-        """Return ``status`` without ticking (a disabled node); a RUNNING subtree is halted."""
-        self.halt()
-        self.status = status
-        self._record.visits.append((self, status))
-        return status
-
-    def _replace_result(self, original: Status, forced: Status) -> None:
-        """Make ``forced`` the result of the execute that just returned ``original``.
-
-        This node's entries are the last ones appended to the tick record (children finish
-        first), so they are patched in place; a RUNNING node forced to finish ends normally.
-        """
-        record = self._record
-        self.status = forced
-        record.visits[-1] = (self, forced)
-        if original is RUNNING:
-            record.running.pop()
-            if self._ends:
-                self._end(forced)
-        elif forced is RUNNING:
-            record.running.append(self)
-
     def _end(self, status: Status) -> None:
         try:
             self.on_end(status)
@@ -296,21 +297,9 @@ class Node:
             )
         return ERROR
 
-    def bind(
-        self,
-        *,
-        uid: str,
-        node_id: str,
-        name: str,
-        title: str,
-        label: str,
-        description: str,
-        properties: dict[str, Any],
-        tree_uid: str,
-        subtree_depth: int,
-        blackboard: Blackboard,
-        record: TickRecord,
-    ) -> None:
+    def bind(self, *, uid: str, node_id: str, name: str, title: str, label: str,
+             description: str, properties: dict[str, Any], tree_uid: str, subtree_depth: int,
+             blackboard: Blackboard, record: TickRecord) -> None:
         """Attach the node to a tree. Called by the builder right after construction."""
         self.uid = uid
         self.node_id = node_id
@@ -326,6 +315,7 @@ class Node:
         self.tree_memory = blackboard.tree_scope(tree_uid)
         self._record = record
         self.children = []
+        self._rehook()  # a slot filled before the node was bound takes effect now
 
     def adopt(self, children: list[Node]) -> None:
         """Attach ``children`` in order. Decorators also get :attr:`Decorator.child`."""
@@ -340,6 +330,9 @@ class Node:
         reported as an error naming the node.
         """
         return []
+
+
+_ENGINE_EXECUTES = (Node.execute, Node._execute_lean)
 
 
 class Action(Node):
@@ -393,8 +386,11 @@ def _no_children(node: Node) -> list[str]:
 
 
 def elapsed_ms(now: float, start: float) -> float:
-    """Milliseconds from ``start`` to ``now`` (seconds), rounded to the nanosecond so that
-    ``0.7 - 0.2`` counts as 500 ms and a 500 ms Wait needs no extra tick."""
+    """Milliseconds from ``start`` to ``now`` (seconds), rounded to the nanosecond.
+
+    The rounding absorbs floating-point noise, so that ``0.7 - 0.2`` counts as the 500 ms it
+    is meant to be and a 500 ms Wait does not need an extra tick.
+    """
     return round((now - start) * 1000.0, 6)
 
 
@@ -413,6 +409,8 @@ __all__ = [
     "Decorator",
     "Node",
     "NodeFactory",
+    "PostTick",
+    "PreTick",
     "Status",
     "TickRecord",
     "elapsed_ms",

@@ -63,7 +63,8 @@ class TickSnapshot:
 
     @property
     def timed(self) -> bool:
-        """Whether this tick's visits were timed (``tree.hooks.timing``)."""
+        """Whether this tick's visits were timed (:attr:`Tree.timing
+        <cyborg.bt.tree.Tree.timing>`)."""
         return bool(self._durations)
 
     @property

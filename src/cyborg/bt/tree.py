@@ -8,6 +8,11 @@
 The same pass also halts a node left RUNNING under a parent that itself completed (a custom
 composite that forgot its child), so an abandoned action can always cancel what it started.
 Every tick returns a :class:`~cyborg.bt.snapshot.TickSnapshot`.
+
+**Timing.** ``Tree(..., timing=True)``, or ``tree.timing = True`` at any time from any thread,
+makes every tick from the next one on record each visit's wall time in its snapshot
+(:attr:`~cyborg.bt.snapshot.TickSnapshot.visit_durations`); a change is applied when a tick
+begins, never inside one, so a tick is timed completely or not at all.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ class Tree:
 
     def __init__(self, root: Node, *, record: TickRecord, blackboard: Blackboard,
                  clock: Clock | None = None, source: str = "", tree_id: str = "",
-                 title: str = "") -> None:
+                 title: str = "", timing: bool = False) -> None:
         self.root = root
         self.blackboard = blackboard
         self.clock: Clock = clock or MonotonicClock()
@@ -46,8 +51,12 @@ class Tree:
             node.index = index
         self.by_uid: dict[str, Node] = {node.uid: node for node in self.nodes}
         self._structure: TreeStructure | None = None
-        self.hooks = TreeHooks(self.nodes)
+        self.hooks = TreeHooks(self.nodes, self)
         """Per-node control: disable, force, breakpoints (see :mod:`cyborg.bt.hooks`)."""
+        self._timing = False  # what the nodes do now
+        self._timing_wanted = bool(timing)  # what the next tick does
+        if timing:
+            self._apply_timing()
 
     def __iter__(self) -> Iterator[Node]:
         return iter(self.nodes)
@@ -56,12 +65,35 @@ class Tree:
         return len(self.nodes)
 
     @property
+    def timing(self) -> bool:
+        """Whether ticks time every visit (the node and its subtree, breakpoint waits and
+        other :attr:`Node.pre_tick <cyborg.bt.node.Node.pre_tick>` time left out) into their
+        snapshots, for monitors. Off by default: it makes a tick three to four times as slow.
+
+        Setting it takes effect when the next tick begins (never inside a tick); reading it
+        gives the setting, and :attr:`TickSnapshot.timed
+        <cyborg.bt.snapshot.TickSnapshot.timed>` whether a given tick was timed.
+        """
+        return self._timing_wanted
+
+    @timing.setter
+    def timing(self, on: bool) -> None:
+        self._timing_wanted = bool(on)
+
+    def _apply_timing(self) -> None:
+        self._timing = on = self._timing_wanted
+        for node in self.nodes:
+            node.timed = on
+
+    @property
     def running(self) -> list[Node]:
         """Nodes RUNNING after the last tick, deepest first."""
         return list(self._running)
 
     def tick(self) -> TickSnapshot:
         """Tick the root once, halt what was abandoned, and return the tick's snapshot."""
+        if self._timing_wanted is not self._timing:
+            self._apply_timing()
         record = self._record
         record.now = now = self.clock.now()
         visits: list[tuple[Node, Status]] = []
