@@ -31,6 +31,7 @@ import uvicorn
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
+from cyborg.interfaces import tree_runner
 from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
@@ -45,7 +46,6 @@ __all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "TOKEN_VARIABLE", "Monitor", "Monitor
 DEFAULT_PORT = 8080
 DEFAULT_HOST = "127.0.0.1"
 EVERY_INTERFACE = ("0.0.0.0", "::", "")
-STRUCTURE_TYPE = "cyborg_msgs/msg/BehaviorTree"
 
 
 class MonitorError(RuntimeError):
@@ -67,7 +67,8 @@ class Monitor:
         not one."""
         self.node = node
         self.host, self.requested_port = host, port
-        namespaces = [check_namespace(namespace) for namespace in namespaces or ["/cyborg/bt"]]
+        namespaces = [check_namespace(namespace)
+                      for namespace in namespaces or [tree_runner.NAMESPACE]]
         self.hub = Hub(self._make_source, self.discover, default_namespace=namespaces[0],
                        seat=ControlSeat(read_token(token)), limits=limits)
         for namespace in namespaces:
@@ -84,11 +85,9 @@ class Monitor:
 
     def discover(self) -> list[str]:
         """Namespaces of the tree runners on the bus (found by their structure topic)."""
-        found = set()
-        for entity in self.node.context.graph.entities([EntityKind.PUBLISHER]):
-            if entity.topic.endswith("/behavior_tree") and entity.type_name == STRUCTURE_TYPE:
-                found.add(entity.topic.removesuffix("/behavior_tree") or "/")
-        return sorted(found)
+        found = {tree_runner.runner_namespace(entity.topic, entity.type_name)
+                 for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
+        return sorted(namespace for namespace in found if namespace is not None)
 
     # ------------------------------------------------------------------ serving
     def start(self, timeout: float = 10.0) -> None:

@@ -1,9 +1,10 @@
 """One tree runner, followed over the bus: its topics in, its control services out.
 
-A :class:`TreeSource` subscribes to a runner's namespace (``/cyborg/bt`` by default; see
-docs/controller.md for the topics) and keeps a :class:`~cyborg.monitor.tree_state.TreeState`
-up to date. It tells its listener what changed (``"structure"``, ``"tick"``, ``"enabled"``,
-``"hooks"``, ``"alive"``) from the bus threads; the listener hands that to the web side.
+A :class:`TreeSource` subscribes to a runner's namespace (``/cyborg/bt`` by default; the topics
+and services are those of :mod:`cyborg.interfaces.tree_runner`) and keeps a
+:class:`~cyborg.monitor.tree_state.TreeState` up to date. It tells its listener what changed
+(``"structure"``, ``"tick"``, ``"enabled"``, ``"hooks"``, ``"alive"``) from the bus threads; the
+listener hands that to the web side.
 
 It also follows the runner's liveliness: when the runner's process goes away the source says
 ``alive = False`` (the page shows it), and when a runner comes back its latched structure
@@ -23,6 +24,9 @@ from typing import Any
 from cyborg.bt.status import Status
 from cyborg.bus import Node, Qos, new_message
 from cyborg.bus.wire import EntityKind
+from cyborg.interfaces import tree_runner
+from cyborg.interfaces.contract import Service
+from cyborg.interfaces.tree_runner import HookAction, HookStatus
 from cyborg.monitor.tree_state import StructureError, TreeState, status_name
 
 log = logging.getLogger("cyborg.monitor")
@@ -30,10 +34,10 @@ log = logging.getLogger("cyborg.monitor")
 Listener = Callable[[str, str], None]
 """``listener(namespace, what)``."""
 
-HOOK_MODES = {1: "disable", 2: "force", 3: "breakpoint"}
-CONTROL_ACTIONS = {"clear": 0, "disable": 1, "force": 2, "breakpoint": 3}
-STATUSES = {status.label: int(status) for status in (Status.SUCCESS, Status.FAILURE,
-                                                     Status.RUNNING)}
+HOOK_MODES = {int(action): action.label for action in HookAction
+              if action is not HookAction.CLEAR}
+CONTROL_ACTIONS = {action.label: int(action) for action in HookAction}
+STATUSES = {Status(int(status)).label: int(status) for status in HookStatus}
 """The statuses a hook may give, by name."""
 SERVICE_TIMEOUT = 5.0
 
@@ -58,28 +62,16 @@ class TreeSource:
         self.problem = ""
         """Why the last structure could not be used, if it could not."""
         ns = self.namespace
-        latched = Qos.latched()
         self._subscriptions = [
-            node.create_subscription(f"{ns}/behavior_tree", "cyborg_msgs/msg/BehaviorTree",
-                                     self._on_structure, latched),
-            node.create_subscription(f"{ns}/behavior_tree_updates",
-                                     "cyborg_msgs/msg/BehaviorTreeNodes", self._on_active,
-                                     latched),
-            node.create_subscription(f"{ns}/enabled", "std_msgs/msg/Bool", self._on_enabled,
-                                     latched),
-            node.create_subscription(f"{ns}/hooks", "cyborg_msgs/msg/BehaviorTreeHooks",
-                                     self._on_hooks, latched),
-            node.create_subscription(f"{ns}/status", "cyborg_msgs/msg/BehaviorTreeStatus",
-                                     self._on_status, Qos(depth=50)),
+            tree_runner.STRUCTURE.subscription(node, self._on_structure, ns),
+            tree_runner.ACTIVE_PATH.subscription(node, self._on_active, ns),
+            tree_runner.ENABLED.subscription(node, self._on_enabled, ns),
+            tree_runner.HOOKS.subscription(node, self._on_hooks, ns),
+            tree_runner.STATUS.subscription(node, self._on_status, ns, qos=Qos(depth=50)),
         ]
-        self._clients = {
-            "enable": node.create_client(f"{ns}/enable", "std_srvs/srv/SetBool"),
-            "control": node.create_client(f"{ns}/control", "cyborg_msgs/srv/ControlNode"),
-            "step": node.create_client(f"{ns}/step", "std_srvs/srv/Trigger"),
-            "resume": node.create_client(f"{ns}/resume", "std_srvs/srv/Trigger"),
-            "get_blackboard": node.create_client(f"{ns}/get_blackboard",
-                                                 "cyborg_msgs/srv/GetBlackboard"),
-        }
+        self._clients = {service.name: service.client(node, ns) for service in (
+            tree_runner.ENABLE, tree_runner.CONTROL, tree_runner.STEP, tree_runner.RESUME,
+            tree_runner.GET_BLACKBOARD)}
         self._remove_graph_listener = node.context.graph.on_change(self._check_alive)
         self._check_alive()
 
@@ -88,7 +80,7 @@ class TreeSource:
         try:
             state = TreeState(message.tree)
         except StructureError as exc:
-            self.problem = f"{self.namespace}/behavior_tree: {exc}"
+            self.problem = f"{tree_runner.STRUCTURE.full_name(self.namespace)}: {exc}"
             log.warning("%s", self.problem)
             return
         self.problem = ""
@@ -129,7 +121,8 @@ class TreeSource:
 
     def _check_alive(self) -> None:
         graph = self.node.context.graph
-        alive = graph.count(f"{self.namespace}/behavior_tree", EntityKind.PUBLISHER) > 0
+        alive = graph.count(tree_runner.STRUCTURE.full_name(self.namespace),
+                            EntityKind.PUBLISHER) > 0
         if alive != self.alive:
             self.alive = alive
             if not alive:
@@ -143,16 +136,16 @@ class TreeSource:
             log.exception("monitor listener failed on %s %s", self.namespace, what)
 
     # ------------------------------------------------------------------ services out
-    def _call(self, service: str, type_name: str, **fields: Any) -> Any:
-        client = self._clients[service]
-        request = new_message(self.node.types, f"{type_name}_Request", fields)
+    def _call(self, service: Service, **fields: Any) -> Any:
+        client = self._clients[service.name]
+        request = new_message(self.node.types, service.request_type, fields)
         try:
             return client.call(request, timeout=SERVICE_TIMEOUT)
         except Exception as exc:
-            raise ControlError(f"{self.namespace}/{service}: {exc}") from exc
+            raise ControlError(f"{self.namespace}/{service.name}: {exc}") from exc
 
     def set_enabled(self, on: bool) -> str:
-        response = self._call("enable", "std_srvs/srv/SetBool", data=on)
+        response = self._call(tree_runner.ENABLE, data=on)
         if not response.success:
             raise ControlError(f"{self.namespace}/enable: {response.message}")
         self.enabled = on
@@ -168,7 +161,7 @@ class TreeSource:
         if status not in STATUSES:
             raise ControlError(f"unknown status {status!r}; expected one of "
                                f"{', '.join(STATUSES)}")
-        response = self._call("control", "cyborg_msgs/srv/ControlNode", node_id=node_id,
+        response = self._call(tree_runner.CONTROL, node_id=node_id,
                               action=CONTROL_ACTIONS[action], status=STATUSES[status],
                               once=once, keep=keep)
         if not response.success:
@@ -177,16 +170,17 @@ class TreeSource:
 
     def trigger(self, service: str) -> str:
         """Call ``step`` or ``resume``."""
-        if service not in ("step", "resume"):
+        triggers = {trigger.name: trigger for trigger in (tree_runner.STEP, tree_runner.RESUME)}
+        if service not in triggers:
             raise ControlError(f"unknown trigger {service!r}")
-        response = self._call(service, "std_srvs/srv/Trigger")
+        response = self._call(triggers[service])
         if not response.success:
             raise ControlError(f"{service}: {response.message}")
         return str(response.message)
 
     def blackboard(self) -> dict[str, Any]:
         """The runner's blackboard as JSON (``{"global", "tree", "node"}`` scopes)."""
-        response = self._call("get_blackboard", "cyborg_msgs/srv/GetBlackboard")
+        response = self._call(tree_runner.GET_BLACKBOARD)
         try:
             data = json.loads(response.json)
         except ValueError as exc:

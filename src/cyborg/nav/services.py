@@ -1,6 +1,7 @@
 """Navigation services on the bus, with the 2018 names and without the 2018 defects.
 
-Under the robot's namespace (``/cyborg`` by default):
+Under the robot's namespace (``/cyborg`` by default), as :mod:`cyborg.interfaces.robot` names
+them (:data:`~cyborg.interfaces.robot.NAVIGATION_SERVICES`):
 
 ===============================  ==============================  ===============================
 service                          type                            answers
@@ -38,6 +39,14 @@ import numpy as np
 
 from cyborg.bus import Node, new_message
 from cyborg.bus.services import RequestError, Responder
+from cyborg.interfaces.robot import (
+    AVAILABLE_GOALS,
+    CLOSEST_GOAL,
+    DISTANCE_TO_GOAL,
+    LOAD_MAP_FILE,
+    MAKE_PLAN,
+    NAVIGATION_SERVICES,
+)
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose, Pose2D
 from cyborg.nav.planner import Planner, PlanResult
@@ -102,19 +111,15 @@ class NavigationServices:
         self.node, self.maps, self.pose = node, maps, pose
         types = node.types
         self._goal_type = types.message_class("cyborg_msgs/msg/GoalWithHeading")
-        self._classes = {name: types.message_class(f"cyborg_msgs/srv/{name}_Response")
-                         for name in ("AvailableGoals", "DistanceToGoal", "ClosestGoal",
-                                      "MakePlan", "LoadMapFile")}
+        self._classes = {service: types.message_class(service.response_type)
+                         for service in NAVIGATION_SERVICES}
         self._loading = threading.Lock()  # one map at a time
-        for name, service, handler in (
-                ("nav/get_available_goals", "AvailableGoals", self.available_goals),
-                ("nav/get_distance_to_goal", "DistanceToGoal", self.distance_to_goal),
-                ("nav/get_closest_goal", "ClosestGoal", self.closest_goal),
-                ("make_plan", "MakePlan", self.make_plan)):
-            node.create_service(name, f"cyborg_msgs/srv/{service}", handler).checks.append(
-                require_finite)
-        node.create_service("load_map_file", "cyborg_msgs/srv/LoadMapFile", self.load_map_file,
-                            deferred=True)
+        for service, handler in ((AVAILABLE_GOALS, self.available_goals),
+                                 (DISTANCE_TO_GOAL, self.distance_to_goal),
+                                 (CLOSEST_GOAL, self.closest_goal),
+                                 (MAKE_PLAN, self.make_plan)):
+            service.server(node, handler).checks.append(require_finite)
+        LOAD_MAP_FILE.server(node, self.load_map_file, deferred=True)
 
     def _robot(self) -> Pose2D:
         pose = self.pose()
@@ -128,12 +133,12 @@ class NavigationServices:
                                  position=Pose2D(item.x, item.y, item.theta).to_message(
                                      self.node.types), has_heading=item.has_heading)
                  for item in self.maps.map.goals()]
-        return self._classes["AvailableGoals"](goals=goals)
+        return self._classes[AVAILABLE_GOALS](goals=goals)
 
     def distance_to_goal(self, request: Any) -> Any:
         goal = Pose.from_message(request.goal).to_pose2d()
         result = self.maps.plan(self._robot(), goal)
-        return self._classes["DistanceToGoal"](distance=result.length)
+        return self._classes[DISTANCE_TO_GOAL](distance=result.length)
 
     def closest_goal(self, _request: Any) -> Any:
         robot = self._robot()
@@ -142,13 +147,13 @@ class NavigationServices:
             length = self.maps.plan(robot, Pose2D(item.x, item.y)).length
             if length < best:
                 best_name, best = item.name, length
-        return self._classes["ClosestGoal"](name=best_name, distance=best)
+        return self._classes[CLOSEST_GOAL](name=best_name, distance=best)
 
     def make_plan(self, request: Any) -> Any:
         start = Pose2D.from_message(request.start) if request.use_start else self._robot()
         goal = Pose2D.from_message(request.goal)
         result = self.maps.plan(start, goal)
-        response = self._classes["MakePlan"]
+        response = self._classes[MAKE_PLAN]
         if result.path is None:
             empty = new_message(self.node.types, "nav_msgs/msg/Path",
                                 {"header": {"frame_id": "map"}})
@@ -159,7 +164,7 @@ class NavigationServices:
 
     def load_map_file(self, request: Any, responder: Responder) -> None:
         """Load on a thread of its own and answer from there (deferred), one map at a time."""
-        reply = self._classes["LoadMapFile"]
+        reply = self._classes[LOAD_MAP_FILE]
         path = request.path
         if not path.lower().endswith(".map"):
             responder.reply(reply(success=False, message=f"load_map_file: {path[:80]!r} is not "
@@ -175,7 +180,7 @@ class NavigationServices:
     def _load(self, path: str, responder: Responder) -> None:
         """Load, free the one-at-a-time lock, then answer: a caller that asks again as soon
         as it has its answer must find the lock free."""
-        reply = self._classes["LoadMapFile"]
+        reply = self._classes[LOAD_MAP_FILE]
         try:
             arnl_map = self.maps.load(path)
         except MapError as exc:

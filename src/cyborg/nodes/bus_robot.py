@@ -3,7 +3,7 @@
 Under the robot's namespace (``/cyborg`` by default) it uses the topics ``pose`` and
 ``battery_status``, the services ``nav/get_available_goals``, ``nav/get_distance_to_goal``,
 ``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action
-(see :mod:`cyborg.sim.node` for the full interface)::
+(see :mod:`cyborg.interfaces.robot` for the full interface, which the simulator serves)::
 
     robot = BusRobot(Node("bt", "/cyborg"), "/cyborg")
     move = robot.move_to("room1")
@@ -19,7 +19,8 @@ import threading
 from concurrent.futures import Future
 from typing import Any
 
-from cyborg.bus import ActionError, ClientGoal, Node, Qos, ServiceError, new_message
+from cyborg.bus import ActionError, ClientGoal, Node, ServiceError, new_message
+from cyborg.interfaces import robot
 from cyborg.nav.geometry import Pose2D
 from cyborg.nodes.rate_limited_log import RateLimitedLog
 from cyborg.nodes.robot import BatteryReading, DockState, Goal, MoveOutcome, RobotError
@@ -27,7 +28,7 @@ from cyborg.nodes.robot import BatteryReading, DockState, Goal, MoveOutcome, Rob
 log = logging.getLogger("cyborg.nodes")
 limited = RateLimitedLog(log)
 
-GOAL = "cyborg_msgs/action/MoveToGoal_Goal"
+GOAL = robot.MOVE_TO_GOAL.goal_type
 
 
 class BusMove:
@@ -94,7 +95,8 @@ class BusMove:
 class BusRobot:
     """:class:`~cyborg.nodes.robot.Robot` on the bus, for the robot under ``namespace``."""
 
-    def __init__(self, node: Node, namespace: str = "/cyborg", *, timeout: float = 5.0) -> None:
+    def __init__(self, node: Node, namespace: str = robot.NAMESPACE, *,
+                 timeout: float = 5.0) -> None:
         self.node, self.timeout = node, timeout
         prefix = "/" + namespace.strip("/") if namespace.strip("/") else ""
         self.namespace = prefix or "/"
@@ -102,19 +104,12 @@ class BusRobot:
         self._battery: BatteryReading | None = None
         self._goals: dict[str, Goal] | None = None
         self._lock = threading.Lock()
-        latched = Qos.latched()
-        node.create_subscription(f"{prefix}/pose", "geometry_msgs/msg/Pose2D", self._on_pose)
-        node.create_subscription(f"{prefix}/battery_status", "cyborg_msgs/msg/BatteryStatus",
-                                 self._on_battery, latched)
-        self._clients = {name: node.create_client(f"{prefix}/{name}", kind) for name, kind in (
-            ("nav/get_available_goals", "cyborg_msgs/srv/AvailableGoals"),
-            ("nav/get_distance_to_goal", "cyborg_msgs/srv/DistanceToGoal"),
-            ("nav/get_closest_goal", "cyborg_msgs/srv/ClosestGoal"),
-            ("dock", "std_srvs/srv/Trigger"),
-            ("undock", "std_srvs/srv/Trigger"),
-            ("stop", "std_srvs/srv/Trigger"))}
-        self._action = node.create_action_client(f"{prefix}/move_to_goal",
-                                                 "cyborg_msgs/action/MoveToGoal")
+        robot.POSE.subscription(node, self._on_pose, namespace)
+        robot.BATTERY_STATUS.subscription(node, self._on_battery, namespace)
+        self._clients = {service.name: service.client(node, namespace) for service in (
+            robot.AVAILABLE_GOALS, robot.DISTANCE_TO_GOAL, robot.CLOSEST_GOAL, robot.DOCK,
+            robot.UNDOCK, robot.STOP)}
+        self._action = robot.MOVE_TO_GOAL.client(node, namespace)
 
     # ------------------------------------------------------------------ state
     def _on_pose(self, message: Any) -> None:
@@ -139,7 +134,7 @@ class BusRobot:
 
     def wait_until_ready(self, timeout: float = 10.0) -> bool:
         """Wait (wall time) until the robot's services answer and its pose is known."""
-        client = self._clients["nav/get_available_goals"]
+        client = self._clients[robot.AVAILABLE_GOALS.name]
         if not client.wait_for_service(timeout):
             return False
         return bool(self._action.wait_for_server(timeout))
@@ -156,7 +151,7 @@ class BusRobot:
     def goals(self, refresh: bool = False) -> dict[str, Goal]:
         with self._lock:
             if self._goals is None or refresh:
-                reply = self._call("nav/get_available_goals")
+                reply = self._call(robot.AVAILABLE_GOALS.name)
                 self._goals = {goal.name: Goal(goal.name, Pose2D.from_message(goal.position),
                                                goal.comment, bool(goal.has_heading))
                                for goal in reply.goals}
@@ -177,23 +172,23 @@ class BusRobot:
         return bool(reply.success), str(reply.message)
 
     def dock(self) -> tuple[bool, str]:
-        return self._trigger("dock")
+        return self._trigger(robot.DOCK.name)
 
     def undock(self) -> tuple[bool, str]:
-        return self._trigger("undock")
+        return self._trigger(robot.UNDOCK.name)
 
     def stop(self) -> None:
-        self._trigger("stop")
+        self._trigger(robot.STOP.name)
 
     def distance_to(self, goal: Pose2D) -> Future[float]:
         pose = goal.to_pose()
         fields = {"goal": {"position": {"x": pose.position.x, "y": pose.position.y},
                            "orientation": {"z": pose.orientation.z, "w": pose.orientation.w}}}
         return self.node.context.calls.submit(
-            lambda: float(self._call("nav/get_distance_to_goal", **fields).distance))
+            lambda: float(self._call(robot.DISTANCE_TO_GOAL.name, **fields).distance))
 
     def closest_goal(self) -> Future[tuple[str, float]]:
         def ask() -> tuple[str, float]:
-            reply = self._call("nav/get_closest_goal")
+            reply = self._call(robot.CLOSEST_GOAL.name)
             return str(reply.name), float(reply.distance)
         return self.node.context.calls.submit(ask)

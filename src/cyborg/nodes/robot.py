@@ -6,6 +6,9 @@ tree runner puts in the blackboard's resources (``blackboard.resources["robot"]`
 ARNL-like interface on the bus, simulated or not); tests may pass anything with the same
 methods.
 
+:class:`MoveOutcome` and :class:`DockState` are the robot interface's own
+(:mod:`cyborg.interfaces.robot`), taken from its message definitions.
+
 Nothing here blocks a tick for long: moving returns a :class:`Move` handle that is polled,
 distance queries return futures, and cancelling is sent in the background.
 """
@@ -15,33 +18,15 @@ from __future__ import annotations
 import math
 from concurrent.futures import Future
 from dataclasses import dataclass
-from enum import IntEnum, StrEnum
 from typing import Protocol
 
 from cyborg.bt import Node
+from cyborg.interfaces.robot import DockState as DockState
+from cyborg.interfaces.robot import MoveOutcome as MoveOutcome
 from cyborg.nav.geometry import Pose2D
 
 ROBOT = "robot"
 """The key of the robot in ``Blackboard.resources``."""
-
-
-class MoveOutcome(IntEnum):
-    """How a move ended (the MoveToGoal action's outcome)."""
-
-    SUCCEEDED = 1
-    FAILED = 2
-    """Gave up on the way (stalled, blocked, preempted): trying again may help."""
-    CANCELED = 3
-    NO_PATH = 4
-    """No such goal or no path to it: trying again will not help."""
-
-
-class DockState(StrEnum):
-    UNDOCKED = "UNDOCKED"
-    DOCKING = "DOCKING"
-    DOCKED = "DOCKED"
-    UNDOCKING = "UNDOCKING"
-    UNKNOWN = ""
 
 
 @dataclass(frozen=True)

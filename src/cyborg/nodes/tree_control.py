@@ -1,6 +1,6 @@
 """Per-node control of a running tree over the bus, for monitors and tools.
 
-Services under the tree runner's namespace:
+Services under the tree runner's namespace, as :mod:`cyborg.interfaces.tree_runner` names them:
 
 =================  ============================  ===============================================
 name               type                          what
@@ -36,16 +36,24 @@ from typing import Any
 import numpy as np
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Hook, HookError, HookMode, Tree
-from cyborg.bus import Node, Qos
+from cyborg.bus import Node
 from cyborg.bus.executor import CallbackThread
 from cyborg.bus.services import Responder
 from cyborg.bus.wire import EntityKind, gid
+from cyborg.interfaces import tree_runner
+from cyborg.interfaces.tree_runner import HookAction, HookStatus
 
 log = logging.getLogger("cyborg.nodes")
 
-ACTIONS = {1: HookMode.DISABLE, 2: HookMode.FORCE, 3: HookMode.BREAKPOINT}
+ACTIONS = {int(HookAction.DISABLE): HookMode.DISABLE, int(HookAction.FORCE): HookMode.FORCE,
+           int(HookAction.BREAKPOINT): HookMode.BREAKPOINT}
 CODES = {mode: code for code, mode in ACTIONS.items()}
-STATUSES = {1: SUCCESS, 2: FAILURE, 3: RUNNING}
+STATUSES = {int(HookStatus.SUCCESS): SUCCESS, int(HookStatus.FAILURE): FAILURE,
+            int(HookStatus.RUNNING): RUNNING}
+_ACTION_CHOICES = ", ".join(f"{int(code)} {code.label}" for code in HookAction)
+_STATUS_NAMES = [f"{int(code)} {code.name.lower()}" for code in HookStatus]
+_STATUS_CHOICES = f"{', '.join(_STATUS_NAMES[:-1])} or {_STATUS_NAMES[-1]}"
+"""The codes, for error messages: ``0 clear, 1 disable, ...``, ``1 success, ... or 3 running``."""
 SEE_CALLER = 1.0
 """Seconds to wait for a caller's liveliness token to show up in the graph."""
 
@@ -59,18 +67,14 @@ class TreeControl:
         self.graph = node.context.graph
         self._owners: dict[str, str] = {}  # owner (client GID hex) -> its node's name
         self._lock = threading.Lock()
-        self._hooks = node.create_publisher("hooks", "cyborg_msgs/msg/BehaviorTreeHooks",
-                                            Qos.latched())
+        self._hooks = tree_runner.HOOKS.publisher(node)
         self._classes = {name: node.types.message_class(name) for name in (
-            "cyborg_msgs/msg/BehaviorTreeHooks", "cyborg_msgs/srv/ControlNode_Response",
-            "std_srvs/srv/Trigger_Response", "cyborg_msgs/srv/GetBlackboard_Response")}
-        node.create_service("control", "cyborg_msgs/srv/ControlNode", self._on_control,
-                            deferred=True, callbacks=callbacks)
-        node.create_service("resume", "std_srvs/srv/Trigger", self._on_resume,
-                            callbacks=callbacks)
-        node.create_service("step", "std_srvs/srv/Trigger", self._on_step, callbacks=callbacks)
-        node.create_service("get_blackboard", "cyborg_msgs/srv/GetBlackboard",
-                            self._on_blackboard, callbacks=callbacks)
+            tree_runner.HOOKS.type_name, tree_runner.CONTROL.response_type,
+            tree_runner.STEP.response_type, tree_runner.GET_BLACKBOARD.response_type)}
+        tree_runner.CONTROL.server(node, self._on_control, deferred=True, callbacks=callbacks)
+        tree_runner.RESUME.server(node, self._on_resume, callbacks=callbacks)
+        tree_runner.STEP.server(node, self._on_step, callbacks=callbacks)
+        tree_runner.GET_BLACKBOARD.server(node, self._on_blackboard, callbacks=callbacks)
         current().hooks.listeners.append(self.publish)
         self._stop_watching = self.graph.on_change(self._release_departed)
         self.publish()
@@ -79,7 +83,7 @@ class TreeControl:
     def publish(self) -> None:
         hooks = self.current().hooks
         entries = hooks.hooks()
-        self._hooks.publish(self._classes["cyborg_msgs/msg/BehaviorTreeHooks"](
+        self._hooks.publish(self._classes[tree_runner.HOOKS.type_name](
             node_ids=[hook.node for hook in entries],
             actions=np.array([CODES[hook.mode] for hook in entries], np.uint8),
             statuses=np.array([int(hook.status) for hook in entries], np.uint8),
@@ -123,25 +127,23 @@ class TreeControl:
 
     # ------------------------------------------------------------------ services
     def _on_control(self, request: Any, responder: Responder) -> None:
-        response = self._classes["cyborg_msgs/srv/ControlNode_Response"]
+        response = self._classes[tree_runner.CONTROL.response_type]
         hooks = self.current().hooks
         uid, action = str(request.node_id), int(request.action)
         note = ""
         try:
-            if action == 0:
+            if action == HookAction.CLEAR:
                 cleared = hooks.clear(uid)
                 responder.reply(response(success=True, message="cleared" if cleared else
                                          f"node {uid} had no hook"))
                 return
             mode = ACTIONS.get(action)
             if mode is None:
-                raise HookError(f"unknown action {action}: use 0 clear, 1 disable, 2 force, "
-                                "3 breakpoint")
+                raise HookError(f"unknown action {action}: use {_ACTION_CHOICES}")
             status = SUCCESS
             if mode is not HookMode.BREAKPOINT:
                 if int(request.status) not in STATUSES:
-                    raise HookError(f"status {request.status} is not 1 success, 2 failure or "
-                                    "3 running")
+                    raise HookError(f"status {request.status} is not {_STATUS_CHOICES}")
                 status = STATUSES[int(request.status)]
             owner = ""
             if not request.keep:
@@ -159,7 +161,7 @@ class TreeControl:
         responder.reply(response(success=True, message=f"{mode.value} set on {uid}{note}"))
 
     def _trigger(self, success: bool, message: str) -> Any:
-        return self._classes["std_srvs/srv/Trigger_Response"](success=success, message=message)
+        return self._classes[tree_runner.STEP.response_type](success=success, message=message)
 
     def _on_resume(self, _request: Any) -> Any:
         resumed = self.current().hooks.resume()
@@ -171,7 +173,7 @@ class TreeControl:
 
     def _on_blackboard(self, _request: Any) -> Any:
         scopes = self.current().blackboard.as_dict()
-        return self._classes["cyborg_msgs/srv/GetBlackboard_Response"](
+        return self._classes[tree_runner.GET_BLACKBOARD.response_type](
             json=json.dumps(jsonable(scopes), sort_keys=True))
 
     def destroy(self) -> None:

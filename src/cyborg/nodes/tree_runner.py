@@ -1,6 +1,7 @@
 """The tree runner on the bus: load a behavior3editor tree, tick it, publish what it does.
 
-Under the runner's namespace (``/cyborg/bt`` by default, as in 2018):
+Under the runner's namespace (``/cyborg/bt`` by default, as in 2018), as
+:mod:`cyborg.interfaces.tree_runner` names them:
 
 ==========================  ==================================  ==================================
 name                        type                                what
@@ -70,8 +71,9 @@ from cyborg.bt import (
     load_tree,
 )
 from cyborg.bt.snapshot import TickSnapshot
-from cyborg.bus import Node, Qos, SimClock
+from cyborg.bus import Node, SimClock
 from cyborg.bus.services import Responder
+from cyborg.interfaces import tree_runner
 from cyborg.nodes.background_reload import BackgroundReloads
 from cyborg.nodes.robot import ROBOT, Robot
 from cyborg.nodes.tree_control import TreeControl
@@ -110,22 +112,17 @@ class TreeRunnerNode:
                                     "time) a reload may take before it is answered with an "
                                     "error", limits=(0.01, 3600.0))
         types = node.types
-        latched = Qos.latched()
-        self._structure = node.create_publisher("behavior_tree", "cyborg_msgs/msg/BehaviorTree",
-                                                latched)
-        self._updates = node.create_publisher("behavior_tree_updates",
-                                              "cyborg_msgs/msg/BehaviorTreeNodes", latched)
-        self._enabled_pub = node.create_publisher("enabled", "std_msgs/msg/Bool", latched)
-        self._status = node.create_publisher("status", "cyborg_msgs/msg/BehaviorTreeStatus")
+        self._structure = tree_runner.STRUCTURE.publisher(node)
+        self._updates = tree_runner.ACTIVE_PATH.publisher(node)
+        self._enabled_pub = tree_runner.ENABLED.publisher(node)
+        self._status = tree_runner.STATUS.publisher(node)
         self._classes = {name: types.message_class(name) for name in (
-            "cyborg_msgs/msg/BehaviorTree", "cyborg_msgs/msg/BehaviorTreeNodes",
-            "std_msgs/msg/Bool", "cyborg_msgs/msg/BehaviorTreeStatus",
-            "builtin_interfaces/msg/Time", "std_srvs/srv/SetBool_Response",
-            "cyborg_msgs/srv/ReloadTree_Response")}
-        node.create_service("enable", "std_srvs/srv/SetBool", self._on_enable,
-                            callbacks=node.callback_thread("enable"))
-        node.create_service("reload", "cyborg_msgs/srv/ReloadTree", self._on_reload,
-                            deferred=True)
+            tree_runner.STRUCTURE.type_name, tree_runner.ACTIVE_PATH.type_name,
+            tree_runner.ENABLED.type_name, tree_runner.STATUS.type_name,
+            "builtin_interfaces/msg/Time", tree_runner.ENABLE.response_type,
+            tree_runner.RELOAD.response_type)}
+        tree_runner.ENABLE.server(node, self._on_enable, callbacks=node.callback_thread("enable"))
+        tree_runner.RELOAD.server(node, self._on_reload, deferred=True)
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
@@ -244,13 +241,14 @@ class TreeRunnerNode:
     # ------------------------------------------------------------------ publishing
     def _publish_structure(self) -> None:
         text = json.dumps(self.tree.structure.to_json(), separators=(",", ":"))
-        self._structure.publish(self._classes["cyborg_msgs/msg/BehaviorTree"](tree=text))
+        self._structure.publish(self._classes[tree_runner.STRUCTURE.type_name](tree=text))
 
     def _publish_enabled(self) -> None:
-        self._enabled_pub.publish(self._classes["std_msgs/msg/Bool"](data=self._enabled))
+        self._enabled_pub.publish(self._classes[tree_runner.ENABLED.type_name](
+            data=self._enabled))
 
     def _publish_active(self, active: tuple[str, ...]) -> None:
-        self._updates.publish(self._classes["cyborg_msgs/msg/BehaviorTreeNodes"](
+        self._updates.publish(self._classes[tree_runner.ACTIVE_PATH.type_name](
             ids=list(active)))
 
     def _on_tick(self, snapshot: TickSnapshot) -> None:
@@ -258,18 +256,16 @@ class TreeRunnerNode:
         if active != self._active:
             self._active = active
             self._publish_active(active)
-        hooks = self.tree.hooks
+        tree = self.tree
         if self._status.subscription_count() == 0:
-            if hooks.timing:
-                hooks.timing = False  # nodes run unwrapped again
+            tree.timing = False  # from the next tick on, nodes run untimed again
             return  # nobody listens: skip building the message
-        if not hooks.timing:
-            hooks.timing = True  # per-node timings from the next tick on
+        tree.timing = True  # per-node timings from the next tick on
         seconds = snapshot.time
         stamp = self._classes["builtin_interfaces/msg/Time"](
             sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9) % 1_000_000_000)
         visited = snapshot.visited
-        self._status.publish(self._classes["cyborg_msgs/msg/BehaviorTreeStatus"](
+        self._status.publish(self._classes[tree_runner.STATUS.type_name](
             stamp=stamp, tick=snapshot.tick, duration=snapshot.duration,
             status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
             visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
@@ -280,7 +276,7 @@ class TreeRunnerNode:
     def _on_enable(self, request: Any) -> Any:
         on = bool(request.data)
         done = self.set_enabled(on, wait=HALT_WAIT)
-        response = self._classes["std_srvs/srv/SetBool_Response"]
+        response = self._classes[tree_runner.ENABLE.response_type]
         if on and not done:
             return response(success=False, message=(
                 "not enabled: the tree is still halting, because the tick before the disable "
@@ -297,5 +293,5 @@ class TreeRunnerNode:
         self._reloads.request(path, responder, self.reload_timeout)
 
     def _answer_reload(self, responder: Responder, success: bool, message: str) -> None:
-        responder.reply(self._classes["cyborg_msgs/srv/ReloadTree_Response"](
+        responder.reply(self._classes[tree_runner.RELOAD.response_type](
             success=success, message=message))

@@ -3,24 +3,15 @@
 A model, not a measurement of the LX: a full battery lasts ``idle_hours`` standing still
 (13 h by default); driving adds ``driving_drain`` percent per hour at 1 m/s; docked, the charger
 fills ``charge_rate`` percent per hour, bulk charging to 80 %, then more slowly (overcharge
-stage) to 100 %, then float. Charging states use rosarnl's numbers.
+stage) to 100 %, then float. Charging states use rosarnl's numbers, as BatteryStatus.msg declares
+them (:class:`cyborg.interfaces.robot.ChargingState`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import IntEnum
 
-
-class ChargingState(IntEnum):
-    """rosarnl BatteryStatus.charging_state."""
-
-    UNKNOWN = -1
-    NOT = 0
-    BULK = 1
-    OVERCHARGE = 2
-    FLOAT = 3
-    BALANCE = 4
+from cyborg.interfaces.robot import ChargingState as ChargingState
 
 
 @dataclass

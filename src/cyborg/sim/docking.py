@@ -4,7 +4,8 @@
 forward ``depth`` metres onto the charger (stopping early if the bumper touches), then wait
 ``power_delay`` seconds for the charger's power → ``DOCKED`` (charging). ``DOCKED`` → (undock)
 → ``UNDOCKING``: charging off, wait ``undock_wait`` seconds, back out → ``UNDOCKED``. A failed
-drive to the dock returns to ``UNDOCKED`` with the reason in ``message``.
+drive to the dock returns to ``UNDOCKED`` with the reason in ``message``. The states are those
+``battery_status`` reports (:class:`cyborg.interfaces.robot.DockState`).
 """
 
 from __future__ import annotations
@@ -12,12 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
-
-class DockState(StrEnum):
-    UNDOCKED = "UNDOCKED"
-    DOCKING = "DOCKING"
-    DOCKED = "DOCKED"
-    UNDOCKING = "UNDOCKING"
+from cyborg.interfaces.robot import DockState as DockState
 
 
 class DockPhase(StrEnum):

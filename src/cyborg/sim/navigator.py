@@ -1,40 +1,26 @@
 """Going to a goal, as ARNL's goto mode does: plan, follow, replan around obstacles, give up.
 
-States are rosarnl's ``arnl_path_state`` strings. A goal that cannot be planned ends at once in
-``FAILED_PLAN``; while moving, an obstacle the map does not know about (a box, a person) that
-blocks the path ahead triggers a replan that treats the laser's returns as walls; when the
-distance still to go *along the path* has not shrunk for ``stall_timeout`` seconds the goal
-ends in ``FAILED_MOVE``. Cancelling ends it in ``ABORTED_PATHPLAN`` and stops the robot.
+States are rosarnl's ``arnl_path_state`` strings (:class:`cyborg.interfaces.robot.PathState`).
+A goal that cannot be planned ends at once in ``FAILED_PLAN``; while moving, an obstacle the
+map does not know about (a box, a person) that blocks the path ahead triggers a replan that
+treats the laser's returns as walls; when the distance still to go *along the path* has not
+shrunk for ``stall_timeout`` seconds the goal ends in ``FAILED_MOVE``. Cancelling ends it in
+``ABORTED_PATHPLAN`` and stops the robot.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from enum import StrEnum
 
 import numpy as np
 from numba import njit
 
+from cyborg.interfaces.robot import PathState as PathState
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
 from cyborg.sim.motion_check import Motion, Surroundings, safest_command
-
-
-class PathState(StrEnum):
-    NOT_INITIALIZED = "NOT_INITIALIZED"
-    PLANNING_PATH = "PLANNING_PATH"
-    MOVING_TO_GOAL = "MOVING_TO_GOAL"
-    REACHED_GOAL = "REACHED_GOAL"
-    FAILED_PLAN = "FAILED_PLAN"
-    FAILED_MOVE = "FAILED_MOVE"
-    ABORTED_PATHPLAN = "ABORTED_PATHPLAN"
-    INVALID = "INVALID"
-
-    @property
-    def finished(self) -> bool:
-        return self not in (PathState.PLANNING_PATH, PathState.MOVING_TO_GOAL)
 
 
 @dataclass(frozen=True)

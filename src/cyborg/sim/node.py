@@ -1,6 +1,7 @@
 """The simulated robot on the bus, with an ARNL-like interface (as rosarnl offered in 2018).
 
-Under the robot's namespace (``/cyborg`` by default), node ``arnl``:
+Under the robot's namespace (``/cyborg`` by default), node ``arnl``, it serves the contract of
+:mod:`cyborg.interfaces.robot`:
 
 ==========================  ==================================  ==================================
 name                        type                                what
@@ -33,17 +34,19 @@ from typing import Any
 
 import numpy as np
 
-from cyborg.bus import Node, Qos, ServerGoal, new_message
+from cyborg.bus import Node, ServerGoal, new_message
+from cyborg.interfaces import robot
+from cyborg.interfaces.robot import DockState, MoveOutcome, PathState
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.nav.services import NavigationMap, NavigationServices
-from cyborg.sim.docking import DockState
-from cyborg.sim.navigator import PathState
 from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
-SUCCEEDED, FAILED, CANCELED, NO_PATH = 1, 2, 3, 4  # MoveToGoal result outcomes
+SUCCEEDED, FAILED, CANCELED, NO_PATH = (int(MoveOutcome.SUCCEEDED), int(MoveOutcome.FAILED),
+                                       int(MoveOutcome.CANCELED), int(MoveOutcome.NO_PATH))
+"""MoveToGoal's result outcomes (see :class:`cyborg.interfaces.robot.MoveOutcome`)."""
 FEEDBACK_PERIOD = 0.25
 """Simulated seconds between move_to_goal feedback messages (and checks of the goal)."""
 
@@ -65,28 +68,25 @@ class SimulatorNode:
         self._newest_goal = 0
         self._active_goal: ServerGoal | None = None
         self._feedback_at = -math.inf
-        self._feedback_class = types.message_class("cyborg_msgs/action/MoveToGoal_Feedback")
-        self.clock = node.create_publisher("/clock", "rosgraph_msgs/msg/Clock")
-        self.pose = node.create_publisher("pose", "geometry_msgs/msg/Pose2D")
-        self.odom = node.create_publisher("odom", "nav_msgs/msg/Odometry")
-        self.scan = node.create_publisher("scan", "sensor_msgs/msg/LaserScan")
-        latched = Qos.latched()
-        self.bumpers = node.create_publisher("bumper_state", "cyborg_msgs/msg/BumperState", latched)
-        self.battery = node.create_publisher("battery_status", "cyborg_msgs/msg/BatteryStatus",
-                                             latched)
-        self.path_state = node.create_publisher("arnl_path_state", "std_msgs/msg/String", latched)
-        self.path = node.create_publisher("path", "nav_msgs/msg/Path", latched)
+        self._feedback_class = types.message_class(robot.MOVE_TO_GOAL.feedback_type)
+        self.clock = robot.CLOCK.publisher(node)
+        self.pose = robot.POSE.publisher(node)
+        self.odom = robot.ODOM.publisher(node)
+        self.scan = robot.SCAN.publisher(node)
+        self.bumpers = robot.BUMPER_STATE.publisher(node)
+        self.battery = robot.BATTERY_STATUS.publisher(node)
+        self.path_state = robot.PATH_STATE.publisher(node)
+        self.path = robot.PATH.publisher(node)
         self.maps = NavigationMap(self.sim.map, self.sim.planner)
         self.maps.listeners.append(self._map_changed)
         self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
-        trigger = "std_srvs/srv/Trigger"
         # stop, dock and undock answer on a thread of their own: a slow plan, a closest-goal
         # search or a goal being accepted never delays the stop button
         motion = node.callback_thread("motion")
-        node.create_service("dock", trigger, self._dock, callbacks=motion)
-        node.create_service("undock", trigger, self._undock, callbacks=motion)
-        node.create_service("stop", trigger, self._stop, callbacks=motion)
-        node.create_action_server("move_to_goal", "cyborg_msgs/action/MoveToGoal", self._move)
+        robot.DOCK.server(node, self._dock, callbacks=motion)
+        robot.UNDOCK.server(node, self._undock, callbacks=motion)
+        robot.STOP.server(node, self._stop, callbacks=motion)
+        robot.MOVE_TO_GOAL.server(node, self._move)
         loop.on_sensor.append(self._publish)
 
     # ------------------------------------------------------------------ publishing
@@ -117,17 +117,17 @@ class SimulatorNode:
         with self._stepped:
             self._stepped.notify_all()
         message = self.types.message_class
-        self.clock.publish(message("rosgraph_msgs/msg/Clock")(clock=self._stamp()))
+        self.clock.publish(message(robot.CLOCK.type_name)(clock=self._stamp()))
         if sim.time - self._battery_at >= 1.0:
             self._battery_at = sim.time
             self._publish_battery(sim)
         state = (sim.base.bumpers.front, sim.base.bumpers.rear, sim.navigator.state)
         if state != self._last_state:
             self._last_state = state
-            self.bumpers.publish(message("cyborg_msgs/msg/BumperState")(
+            self.bumpers.publish(message(robot.BUMPER_STATE.type_name)(
                 header=self._header("base_link"), front_bumpers=np.array([state[0]]),
                 rear_bumpers=np.array([state[1]])))
-            self.path_state.publish(message("std_msgs/msg/String")(data=state[2].value))
+            self.path_state.publish(message(robot.PATH_STATE.type_name)(data=state[2].value))
         follower = sim.navigator.follower
         if follower is not None and follower.path is not self._path_shown:
             self._path_shown = follower.path
@@ -143,14 +143,14 @@ class SimulatorNode:
 
     def _publish_battery(self, sim: Simulator) -> None:
         battery = sim.battery
-        self.battery.publish(self.types.message_class("cyborg_msgs/msg/BatteryStatus")(
+        self.battery.publish(self.types.message_class(robot.BATTERY_STATUS.type_name)(
             header=self._header("base_link"), charging_state=int(battery.state),
             charge_percent=battery.charge_percent, voltage=battery.voltage,
             charging=battery.charging, dock_state=sim.docking.state.value))
 
     def _odometry(self, sim: Simulator) -> Any:
         pose = sim.pose.to_pose()
-        odometry = new_message(self.types, "nav_msgs/msg/Odometry", {
+        odometry = new_message(self.types, robot.ODOM.type_name, {
             "child_frame_id": "base_link",
             "pose": {"pose": {"position": {"x": pose.position.x, "y": pose.position.y},
                               "orientation": {"z": pose.orientation.z,
@@ -162,7 +162,7 @@ class SimulatorNode:
 
     def _scan(self, sim: Simulator) -> Any:
         spec = sim.laser.spec
-        return self.types.message_class("sensor_msgs/msg/LaserScan")(
+        return self.types.message_class(robot.SCAN.type_name)(
             header=self._header("laser"), angle_min=spec.angle_min,
             angle_max=spec.angle_min + spec.angle_increment * (spec.beams - 1),
             angle_increment=spec.angle_increment, time_increment=0.0,
@@ -179,7 +179,7 @@ class SimulatorNode:
 
     # ------------------------------------------------------------------ services
     def _trigger(self, success: bool, message: str) -> Any:
-        return self.types.message_class("std_srvs/srv/Trigger_Response")(
+        return self.types.message_class(robot.DOCK.response_type)(
             success=success, message=message)
 
     def _dock(self, _request: Any) -> Any:
@@ -211,7 +211,7 @@ class SimulatorNode:
         newer one's is preempted at once.
         """
         request = goal.request
-        result = self.types.message_class("cyborg_msgs/action/MoveToGoal_Result")
+        result = self.types.message_class(robot.MOVE_TO_GOAL.result_type)
         with self.loop.lock:
             if goal.cancel_requested:
                 goal.canceled()

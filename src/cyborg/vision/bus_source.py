@@ -11,7 +11,8 @@ import queue
 from collections.abc import Iterator
 from typing import Any
 
-from cyborg.bus import Node, Qos
+from cyborg.bus import Node
+from cyborg.interfaces.detector import CAMERA_STREAMS
 from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.frames import Frame, FrameSource, VisionError
 from cyborg.vision.image_messages import stamp_ns
@@ -32,8 +33,8 @@ class BusSource(FrameSource):
         self.pairer = ExactPairer(streams, max_pending=10)
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=2)
         self._subscriptions = [
-            node.create_subscription(getattr(topics, stream), "sensor_msgs/msg/Image",
-                                     self._receiver(stream), Qos(depth=2))
+            CAMERA_STREAMS[stream].remapped(getattr(topics, stream)).subscription(
+                node, self._receiver(stream))
             for stream in streams]
         self._index = 0
 

@@ -8,6 +8,7 @@ has no depth, and a depth topic with a publisher that never publishes would keep
 waiting for depth (:mod:`~cyborg.vision.camera_inputs`) instead of detecting. Files are played at
 ``rate`` frames per second (looping when asked); a camera at its own pace. On the robot a
 ZED driver publishes the same; in simulation this node stands in for it with recorded frames.
+The topics are those of :mod:`cyborg.interfaces.detector`.
 """
 
 from __future__ import annotations
@@ -19,15 +20,17 @@ from collections.abc import Callable
 
 import numpy as np
 
-from cyborg.bus import Node, Qos
+from cyborg.bus import Node
 from cyborg.bus.topics import Publisher
+from cyborg.interfaces.contract import Topic
+from cyborg.interfaces.detector import DEPTH, IMAGE, RIGHT_IMAGE
 from cyborg.vision.frames import FrameSource, VisionError
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image
 
 log = logging.getLogger(__name__)
 
-IMAGE_TOPIC, RIGHT_TOPIC, DEPTH_TOPIC = "left/image_raw", "right/image_raw", \
-    "depth/depth_registered"
+IMAGE_TOPIC, RIGHT_TOPIC, DEPTH_TOPIC = IMAGE.name, RIGHT_IMAGE.name, DEPTH.name
+"""The topics' names in the camera's namespace."""
 
 
 class CameraNode:
@@ -38,7 +41,7 @@ class CameraNode:
                  now_ns: Callable[[], int] = time.time_ns) -> None:
         self.node, self.open_source = node, open_source
         self.rate, self.loop, self.frame_id, self.now_ns = rate, loop, frame_id, now_ns
-        self.image = node.create_publisher(IMAGE_TOPIC, "sensor_msgs/msg/Image", Qos(depth=2))
+        self.image = IMAGE.publisher(node)
         self.right: Publisher | None = None
         """The right images' publisher, created with the first right image (None: none yet)."""
         self.depth: Publisher | None = None
@@ -77,9 +80,9 @@ class CameraNode:
         # partners are advertised before the image: a detector that sees the image already
         # sees their publishers, and waits for them
         if right is not None and self.right is None:
-            self.right = self._advertise(RIGHT_TOPIC)
+            self.right = self._advertise(RIGHT_IMAGE)
         if depth is not None and self.depth is None:
-            self.depth = self._advertise(DEPTH_TOPIC)
+            self.depth = self._advertise(DEPTH)
         types, stamp = self.node.types, self.now_ns()
         if right is not None and self.right is not None:
             self.right.publish(bgr_to_image(types, right, stamp, self.frame_id))
@@ -88,8 +91,8 @@ class CameraNode:
         self.image.publish(bgr_to_image(types, left, stamp, self.frame_id))
         self.published += 1
 
-    def _advertise(self, topic: str) -> Publisher:
-        return self.node.create_publisher(topic, "sensor_msgs/msg/Image", Qos(depth=2))
+    def _advertise(self, topic: Topic) -> Publisher:
+        return topic.publisher(self.node)
 
     def stop(self) -> None:
         self._stop.set()

@@ -7,7 +7,8 @@ header stamp and unpaired messages are counted (:attr:`DetectorNode.dropped`). D
 images are waited for only while their topic has a publisher in the bus graph: a camera without
 depth (a video file) is detected on the image alone, with distance NaN (unknown). Images that
 find no partner for 5 s are detected alone too, and the log says once which topic is silent
-(:mod:`~cyborg.vision.camera_inputs`). Publishes, in the node's namespace:
+(:mod:`~cyborg.vision.camera_inputs`). Publishes, in the node's namespace (the contract is
+:mod:`cyborg.interfaces.detector`):
 
 ==================  ==================================  ========================================
 topic               type                                content
@@ -30,8 +31,17 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from cyborg.bus import Node, Qos
+from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
+from cyborg.interfaces.detector import (
+    CAMERA_STREAMS,
+    CLASSES,
+    CONFIDENCE_THRESHOLD,
+    DETECTION_IMAGE,
+    DETECTIONS,
+    IOU_THRESHOLD,
+    PREDICTIONS,
+)
 from cyborg.vision.camera_inputs import CameraInputs
 from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.frames import VisionError
@@ -55,30 +65,26 @@ class DetectorNode:
         detector = pipeline.detector
         params = node.parameters
         detector.confidence = float(params.declare(
-            "confidence_threshold", detector.confidence, "detections below this are dropped",
+            CONFIDENCE_THRESHOLD, detector.confidence, "detections below this are dropped",
             limits=(0.0, 1.0)))
         detector.iou = float(params.declare(
-            "iou_threshold", detector.iou, "overlap above which boxes of one class merge",
+            IOU_THRESHOLD, detector.iou, "overlap above which boxes of one class merge",
             limits=(0.0, 1.0)))
         detector.classes = frozenset(
             str(name) for name in params.declare(
-                "classes", [""], "labels to keep (empty: every class)") if name)
+                CLASSES, [""], "labels to keep (empty: every class)") if name)
         params.on_set(self._check)
         params.on_change(self._apply)
         self.processed = self.skipped = self.failed = 0
         self.last: Result | None = None
-        self.predictions = node.create_publisher("predictions", "cyborg_msgs/msg/Predictions",
-                                                 Qos.latched())
-        self.detections = node.create_publisher("detections",
-                                                "vision_msgs/msg/Detection2DArray", Qos(depth=5))
-        self.image = node.create_publisher("detection_image", "sensor_msgs/msg/Image",
-                                           Qos(depth=1))
+        self.predictions = PREDICTIONS.publisher(node)
+        self.detections = DETECTIONS.publisher(node)
+        self.image = DETECTION_IMAGE.publisher(node)
         self.inputs = CameraInputs(topics, self.publishers, clock=clock, patience=patience,
                                    name=node.fq_name)
         for stream in topics.streams():
-            topic = getattr(topics, stream)
-            node.create_subscription(topic, "sensor_msgs/msg/Image",
-                                     self._receiver(stream), Qos(depth=2))
+            CAMERA_STREAMS[stream].remapped(getattr(topics, stream)).subscription(
+                node, self._receiver(stream))
 
     @property
     def dropped(self) -> int:
@@ -93,18 +99,18 @@ class DetectorNode:
 
     def _check(self, changes: dict[str, Any]) -> None:
         labels = set(self.pipeline.detector.labels)
-        unknown = [name for name in changes.get("classes", []) if name and name not in labels]
+        unknown = [name for name in changes.get(CLASSES, []) if name and name not in labels]
         if unknown:
             raise ValueError(f"classes: unknown labels {', '.join(map(repr, unknown))}")
 
     def _apply(self, changes: dict[str, Any]) -> None:
         detector = self.pipeline.detector
-        if "confidence_threshold" in changes:
-            detector.confidence = float(changes["confidence_threshold"])
-        if "iou_threshold" in changes:
-            detector.iou = float(changes["iou_threshold"])
-        if "classes" in changes:
-            detector.classes = frozenset(str(name) for name in changes["classes"] if name)
+        if CONFIDENCE_THRESHOLD in changes:
+            detector.confidence = float(changes[CONFIDENCE_THRESHOLD])
+        if IOU_THRESHOLD in changes:
+            detector.iou = float(changes[IOU_THRESHOLD])
+        if CLASSES in changes:
+            detector.classes = frozenset(str(name) for name in changes[CLASSES] if name)
 
     def _receiver(self, stream: str) -> Callable[[Any], None]:
         def receive(message: Any) -> None:

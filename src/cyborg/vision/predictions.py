@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from cyborg.bus import MessageTypes
+from cyborg.interfaces.detector import DETECTIONS, PREDICTIONS
 from cyborg.vision.detector import Detection
 
 
@@ -31,7 +32,7 @@ class _Classes:
         self.point32, self.polygon = get("geometry_msgs/msg/Point32"), \
             get("geometry_msgs/msg/Polygon")
         self.prediction = get("cyborg_msgs/msg/Prediction")
-        self.predictions = get("cyborg_msgs/msg/Predictions")
+        self.predictions = get(PREDICTIONS.type_name)
         self.point, self.quaternion = get("geometry_msgs/msg/Point"), \
             get("geometry_msgs/msg/Quaternion")
         self.pose = get("geometry_msgs/msg/Pose")
@@ -41,7 +42,7 @@ class _Classes:
         self.point2d, self.pose2d = get("vision_msgs/msg/Point2D"), get("vision_msgs/msg/Pose2D")
         self.bbox = get("vision_msgs/msg/BoundingBox2D")
         self.detection = get("vision_msgs/msg/Detection2D")
-        self.array = get("vision_msgs/msg/Detection2DArray")
+        self.array = get(DETECTIONS.type_name)
 
 
 _CACHE: dict[int, _Classes] = {}

@@ -1,0 +1,33 @@
+"""Contracts: the names, types and values two programs on the bus must agree on, written once.
+
+A **contract** is what a server and its clients share: the names of the topics, services and
+actions under a namespace, the message type of each, whether a topic is latched, the default
+namespace, and the constants that travel in the messages (hook codes, dock states, outcomes).
+When the two sides spell these apart, a renamed topic or a new code breaks one side silently —
+the client waits for a topic nobody publishes. Here each is written once and both sides import
+it, so a rename is a one-line edit and tests/test_interfaces.py checks, on a live bus, that
+every client endpoint finds its server.
+
+* :mod:`~cyborg.interfaces.contract` — the descriptors :class:`Topic`, :class:`Service` and
+  :class:`Action` (name, type, QoS; they create either side's endpoint on a node), name
+  resolution, and :func:`message_constants`, the constants of a .msg/.srv/.action file;
+* :mod:`~cyborg.interfaces.robot` — the robot's ARNL-like interface (simulator ↔ BusRobot);
+* :mod:`~cyborg.interfaces.tree_runner` — the tree runner's topics and services (runner ↔
+  monitor, command line);
+* :mod:`~cyborg.interfaces.detector` — the camera's and the detector's topics.
+
+**Adding to a contract.** Declare the endpoint in the module of the program that serves it,
+e.g. ``BUMPERS = Topic("bumper_state", "cyborg_msgs/msg/BumperState", latched=True)``, use the
+descriptor on both sides (``BUMPERS.publisher(node)`` / ``BUMPERS.subscription(node, on_bumpers,
+namespace)``), add it to the module's ``TOPICS`` or ``SERVICES`` tuple, and extend the test
+that starts both sides. A constant the message carries belongs in the message definition
+(``uint8 FORCE=2`` in the .srv; constants do not change the type hash or the wire format):
+declare it there and take it with :func:`~cyborg.interfaces.contract.constant`, never retype
+it. Only values no message defines (ARNL's path states sent as a string) are written here.
+
+This package imports only itself and :mod:`cyborg.bus`; every layer above may import it.
+"""
+
+from cyborg.interfaces.contract import Action, Service, Topic, message_constants, resolve
+
+__all__ = ["Action", "Service", "Topic", "message_constants", "resolve"]

@@ -1,0 +1,58 @@
+"""The camera's and the detector's interfaces: what :class:`~cyborg.vision.CameraNode` (or a
+ZED driver on the robot) publishes, what :class:`~cyborg.vision.DetectorNode` reads and
+publishes, and what their consumers subscribe to.
+
+Camera, under its namespace (:data:`CAMERA_NAMESPACE`, ``/cyborg/camera`` by default):
+
+============================  ==========================  ========================================
+topic                         type                        content
+============================  ==========================  ========================================
+``left/image_raw``            sensor_msgs/Image           the colour image (``bgr8``)
+``right/image_raw``           sensor_msgs/Image           the right image of a stereo camera
+``depth/depth_registered``    sensor_msgs/Image           depth in metres (``32FC1``)
+============================  ==========================  ========================================
+
+all stamped alike, so that a detector pairs them by exact stamp (:data:`CAMERA_STREAMS`).
+
+Detector, under its namespace (:data:`DETECTOR_NAMESPACE`, ``/cyborg/detector`` by default):
+
+============================  ==========================  ========================================
+``predictions``               cyborg_msgs/Predictions     latched: the 2018 message
+``detections``                vision_msgs/Detection2DArray  ROS 2's standard message
+``detection_image``           sensor_msgs/Image           the image with boxes and labels
+============================  ==========================  ========================================
+
+The detector reads the camera topics named by its parameters, by default
+:data:`DEFAULT_IMAGE_TOPIC` and :data:`DEFAULT_DEPTH_TOPIC`.
+"""
+
+from __future__ import annotations
+
+from cyborg.interfaces.contract import Topic
+
+CAMERA_NAMESPACE = "/cyborg/camera"
+DETECTOR_NAMESPACE = "/cyborg/detector"
+
+# ---------------------------------------------------------------------- the camera
+IMAGE = Topic("left/image_raw", "sensor_msgs/msg/Image", depth=2)
+RIGHT_IMAGE = Topic("right/image_raw", "sensor_msgs/msg/Image", depth=2)
+DEPTH = Topic("depth/depth_registered", "sensor_msgs/msg/Image", depth=2)
+CAMERA_STREAMS = {"image": IMAGE, "depth": DEPTH, "right": RIGHT_IMAGE}
+"""The camera's topics by the stream name a detector pairs them under."""
+
+DEFAULT_IMAGE_TOPIC = IMAGE.full_name(CAMERA_NAMESPACE)
+DEFAULT_DEPTH_TOPIC = DEPTH.full_name(CAMERA_NAMESPACE)
+
+# ---------------------------------------------------------------------- the detector
+PREDICTIONS = Topic("predictions", "cyborg_msgs/msg/Predictions", latched=True)
+DETECTIONS = Topic("detections", "vision_msgs/msg/Detection2DArray", depth=5)
+DETECTION_IMAGE = Topic("detection_image", "sensor_msgs/msg/Image", depth=1)
+DETECTOR_TOPICS = (PREDICTIONS, DETECTIONS, DETECTION_IMAGE)
+
+# ---------------------------------------------------------------------- the detector's parameters
+CONFIDENCE_THRESHOLD = "confidence_threshold"
+"""Detections below this confidence (0..1) are dropped; settable at runtime."""
+IOU_THRESHOLD = "iou_threshold"
+"""Overlap above which boxes of one class merge (0..1); settable at runtime."""
+CLASSES = "classes"
+"""Labels to keep (empty: every class); settable at runtime."""

@@ -1,0 +1,123 @@
+"""The robot's ARNL-like interface: what the simulator (or a bridge to the real robot) serves
+and :class:`~cyborg.nodes.bus_robot.BusRobot` uses.
+
+Under the robot's namespace (:data:`NAMESPACE`, ``/cyborg`` by default), from a node named
+``arnl`` (the simulator's; rosarnl's in 2018):
+
+==========================  ==================================  ==================================
+name                        type                                what
+==========================  ==================================  ==================================
+``/clock``                  rosgraph_msgs/Clock                 simulated time (for use_sim_time)
+``pose``                    geometry_msgs/Pose2D                the robot's pose in the map frame
+``odom``                    nav_msgs/Odometry                   pose and velocity
+``scan``                    sensor_msgs/LaserScan               the laser's beams
+``bumper_state``            cyborg_msgs/BumperState             latched, on change
+``battery_status``          cyborg_msgs/BatteryStatus           latched: :class:`ChargingState`,
+                                                                charge, :class:`DockState`
+``arnl_path_state``         std_msgs/String                     latched: a :class:`PathState`
+``path``                    nav_msgs/Path                       latched: the path being followed
+``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose;
+                                                                ends with a :class:`MoveOutcome`
+``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
+``stop``
+``nav/get_available_goals`` cyborg_msgs/srv/AvailableGoals      the map's named goals
+``nav/get_distance_to_goal`` cyborg_msgs/srv/DistanceToGoal     planned path length to a pose
+``nav/get_closest_goal``    cyborg_msgs/srv/ClosestGoal         nearest goal by path length
+``make_plan``               cyborg_msgs/srv/MakePlan            a path on the static map
+``load_map_file``           cyborg_msgs/srv/LoadMapFile         switch maps at runtime
+==========================  ==================================  ==================================
+
+The enums' values come from the message definitions where those declare them
+(BatteryStatus.msg, MoveToGoal.action); ARNL's path states exist only here.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum, StrEnum
+
+from cyborg.bus.clock import CLOCK_TOPIC, CLOCK_TYPE
+from cyborg.interfaces.contract import Action, Service, Topic, constant
+
+NAMESPACE = "/cyborg"
+"""The robot's namespace unless told otherwise."""
+
+# ---------------------------------------------------------------------- topics
+CLOCK = Topic(CLOCK_TOPIC, CLOCK_TYPE)
+POSE = Topic("pose", "geometry_msgs/msg/Pose2D")
+ODOM = Topic("odom", "nav_msgs/msg/Odometry")
+SCAN = Topic("scan", "sensor_msgs/msg/LaserScan")
+BUMPER_STATE = Topic("bumper_state", "cyborg_msgs/msg/BumperState", latched=True)
+BATTERY_STATUS = Topic("battery_status", "cyborg_msgs/msg/BatteryStatus", latched=True)
+PATH_STATE = Topic("arnl_path_state", "std_msgs/msg/String", latched=True)
+PATH = Topic("path", "nav_msgs/msg/Path", latched=True)
+TOPICS = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE, PATH)
+
+# ---------------------------------------------------------------------- services and the action
+DOCK = Service("dock", "std_srvs/srv/Trigger")
+UNDOCK = Service("undock", "std_srvs/srv/Trigger")
+STOP = Service("stop", "std_srvs/srv/Trigger")
+AVAILABLE_GOALS = Service("nav/get_available_goals", "cyborg_msgs/srv/AvailableGoals")
+DISTANCE_TO_GOAL = Service("nav/get_distance_to_goal", "cyborg_msgs/srv/DistanceToGoal")
+CLOSEST_GOAL = Service("nav/get_closest_goal", "cyborg_msgs/srv/ClosestGoal")
+MAKE_PLAN = Service("make_plan", "cyborg_msgs/srv/MakePlan")
+LOAD_MAP_FILE = Service("load_map_file", "cyborg_msgs/srv/LoadMapFile")
+SERVICES = (DOCK, UNDOCK, STOP, AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL, MAKE_PLAN,
+            LOAD_MAP_FILE)
+NAVIGATION_SERVICES = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL, MAKE_PLAN, LOAD_MAP_FILE)
+"""The services of :mod:`cyborg.nav.services`, answered on the map in use."""
+
+MOVE_TO_GOAL = Action("move_to_goal", "cyborg_msgs/action/MoveToGoal")
+
+# ---------------------------------------------------------------------- values in the messages
+_BATTERY = BATTERY_STATUS.type_name
+_RESULT = MOVE_TO_GOAL.result_type
+
+
+class MoveOutcome(IntEnum):
+    """How a move ended: MoveToGoal's result ``outcome``."""
+
+    SUCCEEDED = constant(_RESULT, "SUCCEEDED")
+    FAILED = constant(_RESULT, "FAILED")
+    """Gave up on the way (stalled, blocked, preempted): trying again may help."""
+    CANCELED = constant(_RESULT, "CANCELED")
+    NO_PATH = constant(_RESULT, "NO_PATH")
+    """No such goal or no path to it: trying again will not help."""
+
+
+class DockState(StrEnum):
+    """BatteryStatus ``dock_state``: where docking stands (ARNL's states)."""
+
+    UNDOCKED = constant(_BATTERY, "DOCK_UNDOCKED")
+    DOCKING = constant(_BATTERY, "DOCK_DOCKING")
+    DOCKED = constant(_BATTERY, "DOCK_DOCKED")
+    UNDOCKING = constant(_BATTERY, "DOCK_UNDOCKING")
+    UNKNOWN = ""
+    """Not one of the states (a client's reading of a value it does not know)."""
+
+
+class ChargingState(IntEnum):
+    """BatteryStatus ``charging_state`` (rosarnl's numbers)."""
+
+    UNKNOWN = constant(_BATTERY, "CHARGING_UNKNOWN")
+    NOT = constant(_BATTERY, "CHARGING_NOT")
+    BULK = constant(_BATTERY, "CHARGING_BULK")
+    OVERCHARGE = constant(_BATTERY, "CHARGING_OVERCHARGE")
+    FLOAT = constant(_BATTERY, "CHARGING_FLOAT")
+    BALANCE = constant(_BATTERY, "CHARGING_BALANCE")
+
+
+class PathState(StrEnum):
+    """What ``arnl_path_state`` says (ARNL's path planning states)."""
+
+    NOT_INITIALIZED = "NOT_INITIALIZED"
+    PLANNING_PATH = "PLANNING_PATH"
+    MOVING_TO_GOAL = "MOVING_TO_GOAL"
+    REACHED_GOAL = "REACHED_GOAL"
+    FAILED_PLAN = "FAILED_PLAN"
+    FAILED_MOVE = "FAILED_MOVE"
+    ABORTED_PATHPLAN = "ABORTED_PATHPLAN"
+    INVALID = "INVALID"
+
+    @property
+    def finished(self) -> bool:
+        return self not in (PathState.PLANNING_PATH, PathState.MOVING_TO_GOAL)

@@ -1,0 +1,85 @@
+"""The tree runner's interface: what :mod:`cyborg.nodes.tree_runner` (with
+:mod:`cyborg.nodes.tree_control`) serves and the monitor (:mod:`cyborg.monitor.source`) uses.
+
+Under the runner's namespace (:data:`NAMESPACE`, ``/cyborg/bt`` by default, as in 2018):
+
+==========================  ==================================  ==================================
+name                        type                                what
+==========================  ==================================  ==================================
+``behavior_tree``           cyborg_msgs/BehaviorTree            latched: the structure as JSON
+``behavior_tree_updates``   cyborg_msgs/BehaviorTreeNodes       latched: ids of the active path
+``enabled``                 std_msgs/Bool                       latched: whether the tree ticks
+``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: what ran, how it ended
+``hooks``                   cyborg_msgs/BehaviorTreeHooks       latched: hooks set, where a tick
+                                                                waits (:class:`HookAction`)
+``enable``                  std_srvs/SetBool                    run or pause the tree
+``reload``                  cyborg_msgs/ReloadTree              load the file again
+``control``                 cyborg_msgs/ControlNode             set or clear a hook on one node
+``resume``, ``step``        std_srvs/Trigger                    go on from a breakpoint
+``get_blackboard``          cyborg_msgs/GetBlackboard           the blackboard as JSON
+==========================  ==================================  ==================================
+
+A runner is recognised on the bus by its :data:`STRUCTURE` topic (:func:`runner_namespace`).
+Hook codes and statuses come from ControlNode.srv; the statuses equal the engine's
+(:class:`cyborg.bt.Status`), which the tests check.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+from cyborg.interfaces.contract import Service, Topic, constant
+
+NAMESPACE = "/cyborg/bt"
+"""The tree runner's namespace unless told otherwise."""
+
+# ---------------------------------------------------------------------- topics
+STRUCTURE = Topic("behavior_tree", "cyborg_msgs/msg/BehaviorTree", latched=True)
+ACTIVE_PATH = Topic("behavior_tree_updates", "cyborg_msgs/msg/BehaviorTreeNodes", latched=True)
+ENABLED = Topic("enabled", "std_msgs/msg/Bool", latched=True)
+STATUS = Topic("status", "cyborg_msgs/msg/BehaviorTreeStatus")
+HOOKS = Topic("hooks", "cyborg_msgs/msg/BehaviorTreeHooks", latched=True)
+TOPICS = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS)
+
+# ---------------------------------------------------------------------- services
+ENABLE = Service("enable", "std_srvs/srv/SetBool")
+RELOAD = Service("reload", "cyborg_msgs/srv/ReloadTree")
+CONTROL = Service("control", "cyborg_msgs/srv/ControlNode")
+RESUME = Service("resume", "std_srvs/srv/Trigger")
+STEP = Service("step", "std_srvs/srv/Trigger")
+GET_BLACKBOARD = Service("get_blackboard", "cyborg_msgs/srv/GetBlackboard")
+SERVICES = (ENABLE, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
+
+# ---------------------------------------------------------------------- values in the messages
+_CONTROL = CONTROL.request_type
+
+
+class HookAction(IntEnum):
+    """ControlNode's ``action`` (and BehaviorTreeHooks' ``actions``, which lack CLEAR)."""
+
+    CLEAR = constant(_CONTROL, "CLEAR")
+    DISABLE = constant(_CONTROL, "DISABLE")
+    FORCE = constant(_CONTROL, "FORCE")
+    BREAKPOINT = constant(_CONTROL, "BREAKPOINT")
+
+    @property
+    def label(self) -> str:
+        """Lower-case name, as the monitor's page and the engine's hook modes say it."""
+        return self.name.lower()
+
+
+class HookStatus(IntEnum):
+    """ControlNode's ``status``: what a disabled or forced node returns."""
+
+    SUCCESS = constant(_CONTROL, "SUCCESS")
+    FAILURE = constant(_CONTROL, "FAILURE")
+    RUNNING = constant(_CONTROL, "RUNNING")
+
+
+def runner_namespace(topic: str, type_name: str) -> str | None:
+    """The namespace of the runner that publishes ``topic`` of ``type_name``, if that is a
+    runner's structure topic (``/cyborg/bt/behavior_tree`` → ``/cyborg/bt``); else None."""
+    suffix = "/" + STRUCTURE.name
+    if type_name != STRUCTURE.type_name or not topic.endswith(suffix):
+        return None
+    return topic.removesuffix(suffix) or "/"
