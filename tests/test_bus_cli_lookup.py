@@ -12,8 +12,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from cyborg.app.bt_commands import CommandError
 from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
+from cyborg.app.errors import CommandError
 from cyborg.app.rate_window import Rate, RateWindow, hz_line
 from cyborg.bus import Durability, MessageTypes, Qos, new_message, to_plain
 from cyborg.bus.graph import Graph

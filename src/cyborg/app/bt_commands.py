@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
+from cyborg.app.errors import CommandError
 from cyborg.app.status_line import StatusLine
 from cyborg.bt import (
     Clock,
@@ -28,7 +29,9 @@ from cyborg.bt.registry import NodeModuleError
 from cyborg.nodes.robot import ROBOT
 
 
-def add_parser(commands: Any) -> None:
+def add_parser(commands: Any) -> Any:
+    """``cyborg bt`` and its offline subcommands; returns the group, to which
+    :mod:`cyborg.app.cli` adds the tree runner's (:mod:`cyborg.app.runner_commands`)."""
     bt = commands.add_parser("bt", help="behaviour trees: validate, run, export",
                              description="Work with behavior3editor exports.")
     sub = bt.add_subparsers(dest="bt_command", metavar="SUBCOMMAND", required=True)
@@ -59,9 +62,7 @@ def add_parser(commands: Any) -> None:
     nodes.add_argument("--nodes", action="append", default=[], metavar="MODULE",
                        help="also import this module of node classes (repeatable)")
     nodes.set_defaults(handler=nodes_command)
-
-    from cyborg.app import runner_commands
-    runner_commands.add_parsers(sub)
+    return sub
 
 
 def _file_options(parser: argparse.ArgumentParser) -> None:
@@ -74,10 +75,6 @@ def _file_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--stub-missing", type=Status.parse, metavar="STATUS",
                         help="stand a stub returning STATUS (success, failure, running) in for "
                              "every node without a Python class")
-
-
-class CommandError(Exception):
-    """A problem with the command's input, reported as one line without a traceback."""
 
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:

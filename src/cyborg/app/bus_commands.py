@@ -1,4 +1,4 @@
-"""``cyborg router|node|topic|service|param``: the bus from the shell, in the ros2 style.
+"""``cyborg router|node|topic|service``: the bus from the shell, in the ros2 style.
 
     cyborg router                          run a Zenoh router (the local meeting point)
     cyborg node list                       nodes alive now (ours and ROS 2 peers)
@@ -7,9 +7,9 @@
     cyborg topic pub /chatter std_msgs/msg/String "{data: hi}" --once
     cyborg topic hz /camera/image
     cyborg service call /add example_interfaces/srv/AddTwoInts "{a: 2, b: 40}"
-    cyborg param set /detector confidence_threshold 0.6
 
-Every command takes ``--connect ENDPOINT`` to reach another machine's router. Types and QoS
+Every command takes ``--connect ENDPOINT`` to reach another machine's router
+(:mod:`cyborg.app.bus_options`; ``cyborg param`` is :mod:`cyborg.app.param_commands`). Types and QoS
 come from the graph (:mod:`cyborg.app.bus_lookup`): ``echo`` and ``hz`` wait for a publisher of
 a topic not seen yet, ``service call`` for a server.
 """
@@ -20,16 +20,24 @@ import argparse
 import sys
 import threading
 import time
-from collections.abc import Callable
 from typing import Any
 
 import yaml
 
-from cyborg.app.bt_commands import CommandError
 from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
-from cyborg.app.param_commands import add_param_parser
+from cyborg.app.bus_options import add_join_command, open_context
+from cyborg.app.errors import CommandError
 from cyborg.app.rate_window import RateWindow, hz_line
-from cyborg.bus import BusConfig, Context, MessageValueError, Node, Qos, new_message, to_plain
+from cyborg.bus import (
+    BusConfig,
+    Context,
+    MessageValueError,
+    Node,
+    Qos,
+    ServiceError,
+    new_message,
+    to_plain,
+)
 from cyborg.bus.config import BusConfigError
 from cyborg.bus.wire import EntityKind
 
@@ -46,14 +54,14 @@ def add_parser(commands: Any) -> None:
     router.set_defaults(handler=router_command)
 
     node = _group(commands, "node", "nodes on the bus")
-    _command(node, "list", "list live nodes", node_list)
-    _command(node, "info", "a node's publishers, subscriptions and services",
-             node_info).add_argument("name")
+    add_join_command(node, "list", "list live nodes", node_list)
+    add_join_command(node, "info", "a node's publishers, subscriptions and services",
+                     node_info).add_argument("name")
 
     topic = _group(commands, "topic", "topics on the bus")
-    _command(topic, "list", "list topics", topic_list).add_argument(
+    add_join_command(topic, "list", "list topics", topic_list).add_argument(
         "-t", "--show-types", action="store_true")
-    echo = _command(topic, "echo", "print messages of a topic as YAML", topic_echo)
+    echo = add_join_command(topic, "echo", "print messages of a topic as YAML", topic_echo)
     echo.add_argument("topic")
     echo.add_argument("type", nargs="?", help="message type (default: from the graph, waiting "
                                               "for a publisher if need be)")
@@ -64,7 +72,7 @@ def add_parser(commands: Any) -> None:
                       help="ask for latched messages even if no publisher says it keeps them "
                            "(automatic when one does)")
     echo.add_argument("--full", action="store_true", help="print long arrays in full")
-    pub = _command(topic, "pub", "publish a message given as YAML", topic_pub)
+    pub = add_join_command(topic, "pub", "publish a message given as YAML", topic_pub)
     pub.add_argument("topic")
     pub.add_argument("type")
     pub.add_argument("values", nargs="?", default="{}", help="fields as YAML, e.g. '{data: hi}'")
@@ -72,61 +80,26 @@ def add_parser(commands: Any) -> None:
     pub.add_argument("--once", action="store_true", help="publish once, then exit")
     pub.add_argument("--times", type=int, default=0, help="publish this many times, then exit")
     pub.add_argument("--latched", action="store_true", help="latched (transient local)")
-    hz = _command(topic, "hz", "print the rate of a topic", topic_hz)
+    hz = add_join_command(topic, "hz", "print the rate of a topic", topic_hz)
     hz.add_argument("topic")
     hz.add_argument("type", nargs="?", help="message type (default: from the graph)")
     hz.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
 
     service = _group(commands, "service", "services on the bus")
-    _command(service, "list", "list services", service_list).add_argument(
+    add_join_command(service, "list", "list services", service_list).add_argument(
         "-t", "--show-types", action="store_true")
-    call = _command(service, "call", "call a service with a request given as YAML",
-                    service_call)
+    call = add_join_command(service, "call", "call a service with a request given as YAML",
+                            service_call)
     call.add_argument("name")
     call.add_argument("type", nargs="?", help="service type (default: from the graph)")
     call.add_argument("values", nargs="?", default="{}")
     call.add_argument("--timeout", type=float, default=5.0,
                       help="seconds to wait for a server, then for the reply (default 5)")
 
-    add_param_parser(_group(commands, "param", "parameters of a node"), _command)
-
 
 def _group(commands: Any, name: str, text: str) -> Any:
     parser = commands.add_parser(name, help=text)
     return parser.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND", required=True)
-
-
-def _command(group: Any, name: str, text: str,
-             handler: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
-    """A subcommand that joins the bus: ``--connect`` and ``--wait`` come with it."""
-    parser: argparse.ArgumentParser = group.add_parser(name, help=text)
-    parser.set_defaults(handler=handler)
-    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                        help="router to join (default $CYBORG_CONNECT or tcp/127.0.0.1:7447)")
-    parser.add_argument("--wait", type=float, default=1.0, metavar="S",
-                        help="seconds to wait for the graph to fill (default 1)")
-    return parser
-
-
-def open_context(args: argparse.Namespace) -> Context:
-    """A context for a command; waits until the router is reached and the graph settles."""
-    try:
-        context = Context(BusConfig.from_environment(args.connect))
-    except BusConfigError as exc:
-        raise CommandError(str(exc)) from exc
-    deadline = time.monotonic() + max(args.wait, 0.1) + 1.0
-    while time.monotonic() < deadline:
-        info = context.session.info
-        if info.routers_zid() or info.peers_zid():
-            break
-        time.sleep(0.05)
-    else:
-        endpoints = ", ".join(context.config.connect) or "(none)"
-        context.close()
-        raise CommandError(f"no router reachable at {endpoints}; start one with "
-                           "`cyborg router` (or `cyborg up`), or pass --connect")
-    time.sleep(args.wait)
-    return context
 
 
 def router_command(args: argparse.Namespace) -> int:
@@ -287,7 +260,6 @@ def topic_hz(args: argparse.Namespace) -> int:
 
 
 def service_call(args: argparse.Namespace) -> int:
-    from cyborg.bus import ServiceError
     if args.type and args.type.lstrip().startswith("{"):  # NAME VALUES, type from the graph
         args.type, args.values = None, args.type
     with open_context(args) as context:

@@ -19,7 +19,7 @@ import sys
 import time
 from collections.abc import Callable
 
-from cyborg.app.bt_commands import CommandError
+from cyborg.app.errors import CommandError
 from cyborg.bus import Durability, MessageTypes, Qos
 from cyborg.bus.graph import Graph
 from cyborg.bus.wire import EntityKind

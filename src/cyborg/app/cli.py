@@ -36,9 +36,12 @@ from cyborg.app import (
     bus_commands,
     detect_commands,
     monitor_commands,
+    param_commands,
+    runner_commands,
     sim_commands,
     up,
 )
+from cyborg.app.errors import CommandError
 from cyborg.app.memory import limit_malloc_arenas
 
 
@@ -51,8 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     up.add_parser(commands)
     monitor_commands.add_parser(commands)
-    bt_commands.add_parser(commands)
+    runner_commands.add_parsers(bt_commands.add_parser(commands))
     bus_commands.add_parser(commands)
+    param_commands.add_parser(commands)
     sim_commands.add_parser(commands)
     detect_commands.add_parser(commands)
     return parser
@@ -66,7 +70,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         result: int = args.handler(args)
-    except bt_commands.CommandError as exc:
+    except CommandError as exc:
         print(f"cyborg: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

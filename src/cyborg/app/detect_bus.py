@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
+from cyborg.app.bus_options import DEFAULT_ROUTER, bus_context
 from cyborg.bus import Context, Node
 from cyborg.vision import CameraTopics
 from cyborg.vision.bus_source import BusSource

@@ -23,8 +23,8 @@ from collections import Counter
 from pathlib import Path
 from typing import Any, TextIO
 
-from cyborg.app.bt_commands import CommandError
 from cyborg.app.detect_output import FrameWriter
+from cyborg.app.errors import CommandError
 from cyborg.app.progress import ProgressBar
 from cyborg.vision import (
     DetectionPipeline,

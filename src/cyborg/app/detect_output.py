@@ -8,7 +8,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from cyborg.app.bt_commands import CommandError
+from cyborg.app.errors import CommandError
 from cyborg.vision.image_files import IMAGE_SUFFIXES, VIDEO_SUFFIXES
 from cyborg.vision.pipeline import Result
 

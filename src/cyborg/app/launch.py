@@ -53,18 +53,18 @@ import yaml
 
 from cyborg.app.launchables import LaunchError, NodeSpec, Running, RunningTree, starter_for
 from cyborg.bus import Context
+from cyborg.bus.config import DEFAULT_ROUTER
 
 log = logging.getLogger("cyborg.app")
 
 NODE_KEYS = {"kind", "name", "namespace", "process", "parameters"}
-DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
 
 
 @dataclass
 class LaunchDescription:
     nodes: list[NodeSpec]
     connect: list[str] = field(default_factory=list)
-    listen: str = DEFAULT_LISTEN
+    listen: str = DEFAULT_ROUTER
     source: str = "<built in>"
 
     def processes(self) -> list[str]:
@@ -139,7 +139,7 @@ def parse_launch(data: Any, path: Path) -> LaunchDescription:
         seen.add(full_name)
         starter_for(spec)  # unknown kinds fail now, before anything starts
         nodes.append(spec)
-    return LaunchDescription(nodes, list(connect), str(bus.get("listen", DEFAULT_LISTEN)),
+    return LaunchDescription(nodes, list(connect), str(bus.get("listen", DEFAULT_ROUTER)),
                              str(path))
 
 

@@ -22,10 +22,11 @@ import argparse
 import sys
 from typing import Any
 
+from cyborg.app.access_options import access_parameters, add_access_options
+from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.launch import LaunchDescription
-from cyborg.app.launchables import NodeSpec
-from cyborg.app.sim_commands import DEFAULT_ROUTER
-from cyborg.app.up import access_parameters, add_access_options, add_bus_options, run
+from cyborg.app.node_spec import NodeSpec
+from cyborg.app.system import run_system
 from cyborg.monitor import DEFAULT_HOST, DEFAULT_PORT
 
 TOKEN_IN_PS = ("cyborg: warning: --token shows in `ps` to every user of this machine; prefer "
@@ -68,4 +69,4 @@ def monitor_description(args: argparse.Namespace) -> LaunchDescription:
 
 
 def monitor_command(args: argparse.Namespace) -> int:
-    return run(monitor_description(args), args, title="cyborg monitor")
+    return run_system(monitor_description(args), args, title="cyborg monitor")

@@ -8,25 +8,28 @@ from typing import Any
 
 import yaml
 
-from cyborg.app.bt_commands import CommandError
+from cyborg.app.bus_options import add_join_command, open_context
+from cyborg.app.errors import CommandError
 from cyborg.bus import Node, ServiceError
 from cyborg.bus.parameter_client import ParameterClient, ParameterError
 
 
-def add_param_parser(param: Any, command: Callable[..., argparse.ArgumentParser]) -> None:
-    """The ``param`` subcommands; ``command`` makes a subcommand that joins the bus."""
-    command(param, "list", "a node's parameters", param_list).add_argument("node")
-    get = command(param, "get", "a parameter's value", param_get)
+def add_parser(commands: Any) -> None:
+    """``cyborg param``: its subcommands join the bus (:func:`add_join_command`)."""
+    param = commands.add_parser("param", help="parameters of a node")
+    group = param.add_subparsers(dest="param_command", metavar="SUBCOMMAND", required=True)
+    add_join_command(group, "list", "a node's parameters", param_list).add_argument("node")
+    get = add_join_command(group, "get", "a parameter's value", param_get)
     get.add_argument("node")
     get.add_argument("name")
-    set_ = command(param, "set", "set a parameter (the value is read as YAML)", param_set)
+    set_ = add_join_command(group, "set", "set a parameter (the value is read as YAML)",
+                            param_set)
     set_.add_argument("node")
     set_.add_argument("name")
     set_.add_argument("value")
 
 
 def _client(args: argparse.Namespace, run: Callable[[ParameterClient], None]) -> int:
-    from cyborg.app.bus_commands import open_context
     with open_context(args) as context:
         target = args.node if args.node.startswith("/") else "/" + args.node
         if target not in context.graph.nodes():

@@ -13,12 +13,11 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from cyborg.app.bt_commands import CommandError
-from cyborg.app.bus_commands import open_context
+from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options, open_context
+from cyborg.app.errors import CommandError
 from cyborg.app.launch import LaunchDescription
-from cyborg.app.launchables import NodeSpec
-from cyborg.app.sim_commands import DEFAULT_ROUTER
-from cyborg.app.up import add_bus_options, run
+from cyborg.app.node_spec import NodeSpec
+from cyborg.app.system import run_system
 from cyborg.bus import Node, ServiceError, new_message
 
 RUNNER_NAMESPACE = "/cyborg/bt"
@@ -71,7 +70,7 @@ def serve_command(args: argparse.Namespace) -> int:
     description = LaunchDescription(
         [NodeSpec("tree_runner", "tree_runner", args.namespace, parameters, where=str(args.file))],
         list(args.connect), args.listen or DEFAULT_ROUTER)
-    return run(description, args, title="cyborg bt serve")
+    return run_system(description, args, title="cyborg bt serve")
 
 
 def control_command(args: argparse.Namespace) -> int:

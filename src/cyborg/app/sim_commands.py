@@ -15,16 +15,15 @@ import time
 from pathlib import Path
 from typing import Any
 
-from cyborg.app.bt_commands import CommandError
-from cyborg.bus import BusConfig, BusConfigError, Context, Node
+from cyborg.app.bus_options import DEFAULT_ROUTER, bus_context
+from cyborg.app.errors import CommandError
+from cyborg.bus import Node
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
-
-DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
 
 
 def add_parser(commands: Any) -> None:
@@ -108,21 +107,6 @@ def plan_command(args: argparse.Namespace) -> int:
         for x, y in result.path.points:
             print(f"  {x:9.3f} {y:9.3f}")
     return 0
-
-
-def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
-    """Join the given router, or be the router at ``listen`` (or join the one already there)."""
-    try:
-        if connect:
-            return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"
-        try:
-            return Context(BusConfig.router([listen])), f"router at {listen}"
-        except BusConfigError:
-            raise
-        except Exception:  # the address is taken: a router already runs there
-            return Context(BusConfig.from_environment([listen])), f"connected to {listen}"
-    except BusConfigError as exc:
-        raise CommandError(str(exc)) from exc
 
 
 def sim_command(args: argparse.Namespace) -> int:

@@ -24,17 +24,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
-from collections.abc import Sequence
 from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
-from cyborg.app.bt_commands import CommandError
-from cyborg.app.launch import Launch, LaunchDescription, as_child, end_if_stuck, read_launch
-from cyborg.app.launchables import LaunchError, NodeSpec, RunningTree
-from cyborg.app.sim_commands import DEFAULT_ROUTER, bus_context
-from cyborg.app.status_line import StatusLine
+from cyborg.app.access_options import access_parameters, add_access_options
+from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
+from cyborg.app.errors import CommandError
+from cyborg.app.launch import LaunchDescription, as_child, read_launch
+from cyborg.app.node_spec import LaunchError, NodeSpec
+from cyborg.app.system import run_system
 from cyborg.app.up_vision import add_vision_options, vision_nodes
 
 DATA = files("cyborg.app").joinpath("data")
@@ -87,37 +86,6 @@ def add_parser(commands: Any) -> None:
     launch.set_defaults(handler=launch_command)
 
 
-def add_bus_options(parser: argparse.ArgumentParser) -> None:
-    """``--connect``, ``--listen`` and ``--duration``, for every command that starts nodes."""
-    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                        help="join the router there instead of being one")
-    parser.add_argument("--listen", default=None, metavar="ENDPOINT",
-                        help=f"be the bus's router there (default {DEFAULT_ROUTER})")
-    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
-                        help="stop after this many wall-clock seconds")
-
-
-def add_access_options(parser: argparse.ArgumentParser) -> None:
-    """``--allow-host`` and ``--token-file``, for ``cyborg monitor`` and ``cyborg up``."""
-    parser.add_argument("--allow-host", action="append", default=[], metavar="NAME",
-                        help="a name the page may be opened as, beside this machine's names "
-                             "and addresses (repeatable; .example.org: the domain and its "
-                             "names)")
-    parser.add_argument("--token-file", default=None, metavar="PATH",
-                        help="file whose first line is the token that lets pages on other "
-                             "machines control (?token=...); default $CYBORG_MONITOR_TOKEN")
-
-
-def access_parameters(args: argparse.Namespace) -> dict[str, Any]:
-    """The monitor's launch parameters for ``--allow-host`` and ``--token-file``."""
-    parameters: dict[str, Any] = {}
-    if args.allow_host:
-        parameters["allow_hosts"] = list(args.allow_host)
-    if args.token_file:
-        parameters["token_file"] = str(args.token_file)
-    return parameters
-
-
 def up_description(args: argparse.Namespace) -> LaunchDescription:
     """The system ``cyborg up`` starts, as a launch description."""
     if args.speed < 0:
@@ -160,7 +128,7 @@ def up_notes(args: argparse.Namespace) -> list[str]:
 
 
 def up_command(args: argparse.Namespace) -> int:
-    return run(up_description(args), args, title="cyborg up", notes=up_notes(args))
+    return run_system(up_description(args), args, title="cyborg up", notes=up_notes(args))
 
 
 def launch_command(args: argparse.Namespace) -> int:
@@ -175,52 +143,9 @@ def launch_command(args: argparse.Namespace) -> int:
     if args.connect:
         description.connect = list(args.connect)
     if args.process == "main":
-        return run(description, args, title=f"cyborg launch {args.file}")
+        return run_system(description, args, title=f"cyborg launch {args.file}")
     parent = os.getppid()
     as_child()  # stopped by its parent's SIGTERM, after the parent's tree runners halted
-    return run(description, args, title=f"cyborg launch {args.file} --process {args.process}",
-               process=args.process, parent=parent)
-
-
-def run(description: LaunchDescription, args: argparse.Namespace, *, title: str,
-        process: str = "main", parent: int | None = None, notes: Sequence[str] = ()) -> int:
-    """Start ``process``'s nodes (and, for ``main``, the other processes as children), print
-    ``notes`` and what runs, follow the tree, and stop everything in order
-    (:meth:`Launch.stop`) on Ctrl-C, after ``--duration``, or when ``parent`` (a child's
-    launch) has gone."""
-    context, where = bus_context(description.connect, description.listen)
-    launch = Launch(description, context)
-    status_line: StatusLine | None = None
-    code = 0
-    try:
-        children = [name for name in description.processes() if name != "main"] \
-            if process == "main" else []
-        connect = description.connect[0] if description.connect else description.listen
-        launch.start(process, children=children, connect=connect)
-        stops = "Ctrl-C stops everything" if parent is None else "stops with its launch"
-        print(f"{title}: bus {where}; {stops}", flush=True)
-        for line in [*notes, *launch.describe()]:
-            print(f"  {line}", flush=True)
-        status_line = _follow_tree(launch)
-        code = launch.wait(args.duration, parent=parent)
-    except LaunchError as exc:
-        raise CommandError(str(exc)) from exc
-    finally:
-        end_if_stuck(launch)
-        launch.stop()
-        context.close()
-        if status_line is not None:  # ends a live line: what follows starts on its own
-            status_line.finish(interrupted=code == 130 or sys.exc_info()[0] is KeyboardInterrupt)
-    if code == 130:
-        print(f"{title}: stopped", file=sys.stderr)
-    return code
-
-
-def _follow_tree(launch: Launch) -> StatusLine | None:
-    """Print a live status line for the first tree runner of this process."""
-    for item in launch.running:
-        if isinstance(item, RunningTree):
-            line = StatusLine(item.runner.tree, sys.stdout)
-            item.runner.runner.add_listener(line.update)
-            return line
-    return None
+    return run_system(description, args,
+                      title=f"cyborg launch {args.file} --process {args.process}",
+                      process=args.process, parent=parent)

@@ -23,11 +23,9 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import hashlib
 import json
 import logging
 from collections.abc import AsyncIterator
-from pathlib import Path
 
 from starlette.applications import Starlette
 from starlette.requests import ClientDisconnect, Request
@@ -42,18 +40,20 @@ from cyborg.monitor.commands import located_error, receive
 from cyborg.monitor.export import ExportError, render, view_dot
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import BODY_LIMIT, MessageError, check_namespace, decode
+from cyborg.monitor.page_files import PageSource, page_files
 from cyborg.monitor.seat import is_loopback
 
 log = logging.getLogger("cyborg.monitor")
 
-STATIC = Path(__file__).with_name("static")
 EXPORTS_AT_ONCE = 2
 """Graphviz runs at a time; more export requests are told to try again (503)."""
 
 
-def create_app(hub: Hub, *, hosts: HostPolicy | None = None) -> ASGIApp:
+def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
+               files: PageSource | None = None) -> ASGIApp:
     """The web application for ``hub``, answering only the names ``hosts`` allows (default:
-    this machine's names and addresses)."""
+    this machine's names and addresses), with the page's ``files`` (default: from memory,
+    :func:`~cyborg.monitor.page_files.page_files`)."""
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: Starlette) -> AsyncIterator[None]:
@@ -66,14 +66,14 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None) -> ASGIApp:
             with contextlib.suppress(asyncio.CancelledError):
                 await periodic
 
-    files = StaticCache(STATIC)
+    files = files or page_files()
     exports = asyncio.Semaphore(EXPORTS_AT_ONCE)
 
     async def page(request: Request) -> Response:
-        return files.respond("index.html", request)
+        return await files.get_response("index.html", request.scope)
 
     async def static(request: Request) -> Response:
-        return files.respond(request.path_params["path"], request)
+        return await files.get_response(request.path_params["path"], request.scope)
 
     async def robots(_request: Request) -> Response:
         return JSONResponse(hub.robots())
@@ -221,34 +221,6 @@ def _reason(exc: Exception) -> str:
     if isinstance(exc, KeyError):
         return f"missing {exc}"
     return str(exc) if isinstance(exc, MessageError | ValueError) else type(exc).__name__
-
-
-class StaticCache:
-    """The page's files, read once and served from memory with an ETag (a reload costs a
-    304). The page is small and fixed, so this is quicker than reading files per request."""
-
-    TYPES = {".html": "text/html; charset=utf-8", ".css": "text/css; charset=utf-8",
-             ".js": "text/javascript; charset=utf-8", ".mjs": "text/javascript; charset=utf-8",
-             ".LICENSE": "text/plain; charset=utf-8"}
-
-    def __init__(self, folder: Path) -> None:
-        self.files: dict[str, tuple[bytes, str, str]] = {}
-        for path in sorted(folder.rglob("*")):
-            if path.is_file() and path.suffix in self.TYPES:
-                content = path.read_bytes()
-                etag = '"' + hashlib.sha1(content, usedforsecurity=False).hexdigest()[:16] + '"'
-                self.files[path.relative_to(folder).as_posix()] = (
-                    content, self.TYPES[path.suffix], etag)
-
-    def respond(self, name: str, request: Request) -> Response:
-        found = self.files.get(name)
-        if found is None:
-            return PlainTextResponse(f"no such file: {name}", 404)
-        content, media_type, etag = found
-        headers = {"ETag": etag, "Cache-Control": "no-cache"}
-        if request.headers.get("if-none-match") == etag:
-            return Response(status_code=304, headers=headers)
-        return Response(content, media_type=media_type, headers=headers)
 
 
 async def _write(hub: Hub, client: Client) -> None:

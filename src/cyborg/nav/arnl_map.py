@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from cyborg.nav.map_limits import MapLimits, check_grid, map_limits, read_capped
-from cyborg.nav.map_objects import MapObject, declared_categories
+from cyborg.nav.map_objects import MapObject, MapType, declared_categories
 from cyborg.nav.map_syntax import (
     MAX_COORDINATE_MM,
     MapError,
@@ -54,19 +54,6 @@ __all__ = ["MAP_INTROS", "ArnlMap", "MapError", "MapType", "decode_map_bytes", "
            "read_map", "split_fields"]
 
 MAP_INTROS = ("2D-Map", "2D-Map-Ex", "2D-Map-Ex2", "2D-Map-Ex3", "2D-Map-Ex4")
-
-
-@dataclass(frozen=True)
-class MapType:
-    """A ``MapInfo:`` declaration, e.g. ``GoalType`` named ``Goal`` or ``DockPioneer``."""
-
-    category: str  # GoalType, DockType, SectorType, BoundaryType, LocationType, ArgDesc, ...
-    settings: dict[str, str]
-    line: int
-
-    @property
-    def name(self) -> str:
-        return self.settings.get("Name", "")
 
 
 @dataclass

@@ -31,14 +31,12 @@ import os
 import stat
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
+from cyborg.nav.map_objects import MapObject
 from cyborg.nav.map_syntax import MapError
-
-if TYPE_CHECKING:
-    from cyborg.nav.arnl_map import ArnlMap
 
 DEFAULT_RESOLUTION = 0.05
 """Metres per cell of the grids built from a map by default (the planner's and the simulator's)."""
@@ -118,6 +116,18 @@ def _too_large(source: str, size: str, max_bytes: int) -> MapError:
 
 
 # ---------------------------------------------------------------------- the grid
+class DrawnMap(Protocol):
+    """What the grid caps look at in a map (an :class:`~cyborg.nav.arnl_map.ArnlMap`)."""
+
+    @property
+    def source(self) -> str: ...
+    @property
+    def lines(self) -> np.ndarray: ...
+    @property
+    def objects(self) -> list[MapObject]: ...
+    def bounds(self) -> tuple[float, float, float, float]: ...
+
+
 def grid_shape(bounds: tuple[float, float, float, float], resolution: float,
                margin: float = GRID_MARGIN) -> tuple[int, int]:
     """``(rows, columns)`` of a grid over ``bounds`` (metres) plus ``margin`` on every side."""
@@ -128,7 +138,7 @@ def grid_shape(bounds: tuple[float, float, float, float], resolution: float,
     return rows, columns
 
 
-def check_grid(arnl_map: ArnlMap, resolution: float = DEFAULT_RESOLUTION,
+def check_grid(arnl_map: DrawnMap, resolution: float = DEFAULT_RESOLUTION,
                margin: float = GRID_MARGIN, limits: MapLimits | None = None) -> None:
     """MapError (naming the map) unless a grid of ``arnl_map`` at ``resolution`` stays within
     the cell cap, and drawing its walls, forbidden lines and areas within the drawing cap.
@@ -165,7 +175,7 @@ def segment_samples(segments: np.ndarray, resolution: float) -> np.ndarray:
     return counts
 
 
-def drawing_work(arnl_map: ArnlMap, resolution: float) -> int:
+def drawing_work(arnl_map: DrawnMap, resolution: float) -> int:
     """Cells and samples visited drawing the map's lines and areas at ``resolution`` (an upper
     bound: every area counts its bounding box and its outline, simulator boxes included)."""
     work = int(segment_samples(arnl_map.lines, resolution).sum()) if len(arnl_map.lines) else 0

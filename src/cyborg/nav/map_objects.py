@@ -23,16 +23,25 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from cyborg.nav.arnl_map import MapType
 
 GOAL, GOAL_WITH_HEADING, DOCK, HOME = "goal", "goal_with_heading", "dock", "home"
 FORBIDDEN_LINE, FORBIDDEN_AREA, SIM_OBSTACLE, OTHER = (
     "forbidden_line", "forbidden_area", "sim_obstacle", "other")
+
+
+@dataclass(frozen=True)
+class MapType:
+    """A ``MapInfo:`` declaration, e.g. ``GoalType`` named ``Goal`` or ``DockPioneer``."""
+
+    category: str  # GoalType, DockType, SectorType, BoundaryType, LocationType, ArgDesc, ...
+    settings: dict[str, str]
+    line: int
+
+    @property
+    def name(self) -> str:
+        return self.settings.get("Name", "")
 
 
 @dataclass(frozen=True)

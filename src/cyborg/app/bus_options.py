@@ -1,0 +1,80 @@
+"""Where the bus is, from the command line: the options that say so and the contexts they open.
+
+Commands that start nodes (``cyborg up``, ``launch``, ``monitor``, ``bt serve``) take
+:func:`add_bus_options` and are the bus's router unless told to join one (:func:`bus_context`);
+commands that only look at the bus or call it (``cyborg topic``, ``service``, ``param``, ...)
+are made by :func:`add_join_command` and join a router (:func:`open_context`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from typing import Any
+
+from cyborg.app.errors import CommandError
+from cyborg.bus import BusConfig, BusConfigError, Context
+from cyborg.bus.config import DEFAULT_ROUTER
+
+__all__ = ["DEFAULT_ROUTER", "add_bus_options", "add_join_command", "bus_context",
+           "open_context"]
+
+
+def add_bus_options(parser: argparse.ArgumentParser) -> None:
+    """``--connect``, ``--listen`` and ``--duration``, for every command that starts nodes."""
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="join the router there instead of being one")
+    parser.add_argument("--listen", default=None, metavar="ENDPOINT",
+                        help=f"be the bus's router there (default {DEFAULT_ROUTER})")
+    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                        help="stop after this many wall-clock seconds")
+
+
+def add_join_command(group: Any, name: str, text: str,
+                     handler: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
+    """A subcommand of ``group`` that joins the bus to look or call: ``--connect`` and
+    ``--wait`` come with it (:func:`open_context` reads them)."""
+    parser: argparse.ArgumentParser = group.add_parser(name, help=text)
+    parser.set_defaults(handler=handler)
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="router to join (default $CYBORG_CONNECT or tcp/127.0.0.1:7447)")
+    parser.add_argument("--wait", type=float, default=1.0, metavar="S",
+                        help="seconds to wait for the graph to fill (default 1)")
+    return parser
+
+
+def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
+    """Join the given router, or be the router at ``listen`` (or join the one already there)."""
+    try:
+        if connect:
+            return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"
+        try:
+            return Context(BusConfig.router([listen])), f"router at {listen}"
+        except BusConfigError:
+            raise
+        except Exception:  # the address is taken: a router already runs there
+            return Context(BusConfig.from_environment([listen])), f"connected to {listen}"
+    except BusConfigError as exc:
+        raise CommandError(str(exc)) from exc
+
+
+def open_context(args: argparse.Namespace) -> Context:
+    """A context for a command; waits until the router is reached and the graph settles."""
+    try:
+        context = Context(BusConfig.from_environment(args.connect))
+    except BusConfigError as exc:
+        raise CommandError(str(exc)) from exc
+    deadline = time.monotonic() + max(args.wait, 0.1) + 1.0
+    while time.monotonic() < deadline:
+        info = context.session.info
+        if info.routers_zid() or info.peers_zid():
+            break
+        time.sleep(0.05)
+    else:
+        endpoints = ", ".join(context.config.connect) or "(none)"
+        context.close()
+        raise CommandError(f"no router reachable at {endpoints}; start one with "
+                           "`cyborg router` (or `cyborg up`), or pass --connect")
+    time.sleep(args.wait)
+    return context

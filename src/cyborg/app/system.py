@@ -1,0 +1,61 @@
+"""The running system: a launch description's nodes started on the bus, followed on the
+terminal and stopped in order. ``cyborg up``, ``launch``, ``monitor`` and ``bt serve`` each
+build a :class:`~cyborg.app.launch.LaunchDescription` and hand it to :func:`run_system`."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from cyborg.app.bus_options import bus_context
+from cyborg.app.errors import CommandError
+from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck
+from cyborg.app.launchables import RunningTree
+from cyborg.app.node_spec import LaunchError
+from cyborg.app.status_line import StatusLine
+
+
+def run_system(description: LaunchDescription, args: argparse.Namespace, *, title: str,
+               process: str = "main", parent: int | None = None,
+               notes: Sequence[str] = ()) -> int:
+    """Start ``process``'s nodes (and, for ``main``, the other processes as children), print
+    ``notes`` and what runs, follow the tree, and stop everything in order
+    (:meth:`Launch.stop`) on Ctrl-C, after ``--duration``, or when ``parent`` (a child's
+    launch) has gone."""
+    context, where = bus_context(description.connect, description.listen)
+    launch = Launch(description, context)
+    status_line: StatusLine | None = None
+    code = 0
+    try:
+        children = [name for name in description.processes() if name != "main"] \
+            if process == "main" else []
+        connect = description.connect[0] if description.connect else description.listen
+        launch.start(process, children=children, connect=connect)
+        stops = "Ctrl-C stops everything" if parent is None else "stops with its launch"
+        print(f"{title}: bus {where}; {stops}", flush=True)
+        for line in [*notes, *launch.describe()]:
+            print(f"  {line}", flush=True)
+        status_line = _follow_tree(launch)
+        code = launch.wait(args.duration, parent=parent)
+    except LaunchError as exc:
+        raise CommandError(str(exc)) from exc
+    finally:
+        end_if_stuck(launch)
+        launch.stop()
+        context.close()
+        if status_line is not None:  # ends a live line: what follows starts on its own
+            status_line.finish(interrupted=code == 130 or sys.exc_info()[0] is KeyboardInterrupt)
+    if code == 130:
+        print(f"{title}: stopped", file=sys.stderr)
+    return code
+
+
+def _follow_tree(launch: Launch) -> StatusLine | None:
+    """Print a live status line for the first tree runner of this process."""
+    for item in launch.running:
+        if isinstance(item, RunningTree):
+            line = StatusLine(item.runner.tree, sys.stdout)
+            item.runner.runner.add_listener(line.update)
+            return line
+    return None
