@@ -374,9 +374,11 @@ def test_bus_source_pairs_camera_topics_into_frames(bus: Context) -> None:
     left[1, 2] = (1, 2, 3)
     depth = np.full((4, 6), 1.25, np.float32)
     image_pub.publish(bgr_to_image(bus.types, left, 10, "cam"))  # its depth never comes
+    assert reader.callbacks.flush()  # keep-last 2: a burst of three could drop one
     for stamp in (20, 30):
         depth_pub.publish(depth_to_image(bus.types, depth * stamp, stamp, "cam"))
         image_pub.publish(bgr_to_image(bus.types, left, stamp, "cam"))
+        assert reader.callbacks.flush()
     frames = list(source)  # ends after 0.5 s without a frame
     assert [frame.stamp_ns for frame in frames] == [20, 30]
     assert frames[1].left[1, 2].tolist() == [1, 2, 3] and frames[1].frame_id == "cam"

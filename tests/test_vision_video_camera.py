@@ -168,6 +168,7 @@ def test_a_silent_depth_publisher_is_waited_for_5_s_then_named_and_detection_goe
         if with_depth:
             depth.publish(depth_to_image(bus.types, three_metres, stamp, "cam"))
         image.publish(bgr_to_image(bus.types, person, stamp, "cam"))
+        assert detector_node.node.callbacks.flush()  # handled at this clock time
 
     depth.publish(depth_to_image(bus.types, three_metres, 999, "cam"))  # matches no image
     publish(1, 100.0)

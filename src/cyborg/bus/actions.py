@@ -9,11 +9,18 @@ reports progress with ``goal.publish_feedback(...)`` and should watch ``goal.can
 (then stop and call ``goal.canceled()``). Returning ends the goal as SUCCEEDED, unless it called
 ``goal.abort()`` or ``goal.canceled()``; raising ends it as ABORTED.
 
-Client side::
+Client side (:mod:`cyborg.bus.action_client`)::
 
-    goal = client.send_goal(Goal(goal_name="kitchen"), feedback=print)
+    from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal
+
+    client = node.create_action_client("move_to_goal", MoveToGoal)
+    goal = client.send_goal(MoveToGoal.Goal(goal_name="kitchen", ...), feedback=print)
     goal.cancel()                      # later, e.g. when a behaviour is halted
     status, result = goal.result(timeout=60)
+
+Made from an :class:`~cyborg.bus.typed.ActionType`, servers, clients and goals are generic in
+its goal, result and feedback classes, so mypy checks what ``execute`` reads and returns, the
+feedback, and the result a client gets.
 """
 
 from __future__ import annotations
@@ -21,16 +28,19 @@ from __future__ import annotations
 import logging
 import threading
 import time
-import uuid
 from collections.abc import Callable
-from concurrent.futures import Future
 from enum import IntEnum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic
 
 import numpy as np
 
 from cyborg.bus.conversion import new_message
-from cyborg.bus.services import Responder, ServiceError
+from cyborg.bus.msgs.action_msgs.msg import GoalInfo, GoalStatusArray
+from cyborg.bus.msgs.action_msgs.msg import GoalStatus as GoalStatusMessage
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.unique_identifier_msgs.msg import UUID
+from cyborg.bus.services import Responder
+from cyborg.bus.typed import FeedbackT, GoalT, ResultT
 from cyborg.bus.wire import Qos
 
 if TYPE_CHECKING:
@@ -67,22 +77,22 @@ class ActionError(RuntimeError):
     """A goal was rejected, or the action server could not be reached."""
 
 
-def _stamp(types: Any, seconds: float | None = None) -> Any:
+def stamp(seconds: float | None = None) -> Time:
+    """A ``builtin_interfaces/msg/Time`` of ``seconds`` since the epoch (now if None)."""
     now = time.time() if seconds is None else seconds
-    return types.message_class("builtin_interfaces/msg/Time")(
-        sec=int(now), nanosec=int((now % 1) * 1e9))
+    return Time(sec=int(now), nanosec=int((now % 1) * 1e9))
 
 
-def _uuid(types: Any, raw: bytes) -> Any:
-    return types.message_class("unique_identifier_msgs/msg/UUID")(
-        uuid=np.frombuffer(raw, dtype=np.uint8).copy())
+def goal_uuid(raw: bytes) -> UUID:
+    """A goal id (16 bytes) as a ``unique_identifier_msgs/msg/UUID``."""
+    return UUID(uuid=np.frombuffer(raw, dtype=np.uint8).copy())
 
 
-class ServerGoal:
+class ServerGoal(Generic[GoalT, FeedbackT]):
     """One goal on the server: the request, its status, feedback and cancel flag."""
 
-    def __init__(self, server: ActionServer, goal_id: bytes, request: Any,
-                 sequence: int = 0) -> None:
+    def __init__(self, server: ActionServer[GoalT, Any, FeedbackT], goal_id: bytes,
+                 request: GoalT, sequence: int = 0) -> None:
         self.server, self.id, self.request = server, goal_id, request
         self.sequence = sequence
         """Order of acceptance on this server, from 1: a goal with a higher number came later
@@ -96,7 +106,7 @@ class ServerGoal:
     def cancel_requested(self) -> bool:
         return self._cancel.is_set()
 
-    def publish_feedback(self, feedback: Any) -> None:
+    def publish_feedback(self, feedback: FeedbackT) -> None:
         self.server._feedback(self, feedback)
 
     def abort(self) -> None:
@@ -109,7 +119,7 @@ class ServerGoal:
         self._ending = GoalStatus.SUCCEEDED
 
 
-class ActionServer:
+class ActionServer(Generic[GoalT, ResultT, FeedbackT]):
     """Accepts goals, runs ``execute(goal) -> result`` for each, answers result requests.
 
     ``accept(request) -> bool`` may reject goals; ``cancel(goal) -> bool`` may refuse a cancel.
@@ -120,9 +130,9 @@ class ActionServer:
     """
 
     def __init__(self, node: Node, name: str, action_type: str,
-                 execute: Callable[[ServerGoal], Any], *,
-                 accept: Callable[[Any], bool] | None = None,
-                 cancel: Callable[[ServerGoal], bool] | None = None,
+                 execute: Callable[[ServerGoal[GoalT, FeedbackT]], ResultT | None], *,
+                 accept: Callable[[GoalT], bool] | None = None,
+                 cancel: Callable[[ServerGoal[GoalT, FeedbackT]], bool] | None = None,
                  max_goals: int = MAX_GOALS) -> None:
         types = node.types
         if action_type not in types.actions:
@@ -130,13 +140,18 @@ class ActionServer:
         self.node, self.types, self.action_type = node, types, action_type
         self.execute, self.accept, self.allow_cancel = execute, accept, cancel
         self.name, self.max_goals = name, max_goals
-        self._goals: dict[bytes, ServerGoal] = {}
+        self._goals: dict[bytes, ServerGoal[GoalT, FeedbackT]] = {}
         self._results: dict[bytes, tuple[GoalStatus, Any]] = {}
         self._waiting: dict[bytes, list[Responder]] = {}
         self._lock = threading.Lock()
         self._accepted = 0
         self._closed = False
         base = f"{name}/_action/"
+        self._send_goal_response = types.message_class(f"{action_type}_SendGoal_Response")
+        self._result_class = types.message_class(f"{action_type}_Result")
+        self._get_result_response = types.message_class(f"{action_type}_GetResult_Response")
+        self._feedback_message = types.message_class(f"{action_type}_FeedbackMessage")
+        self._cancel_response = types.message_class("action_msgs/srv/CancelGoal_Response")
         self._entities: list[Any] = [
             node.create_service(base + "send_goal", f"{action_type}_SendGoal", self._on_goal),
             node.create_service(base + "cancel_goal", "action_msgs/srv/CancelGoal",
@@ -157,8 +172,7 @@ class ActionServer:
             accepted = False
         else:
             accepted = self.accept(request.goal) if self.accept is not None else True
-        response = self.types.message_class(f"{self.action_type}_SendGoal_Response")(
-            accepted=bool(accepted), stamp=_stamp(self.types))
+        response = self._send_goal_response(accepted=bool(accepted), stamp=stamp())
         if accepted:
             with self._lock:
                 self._accepted += 1
@@ -179,9 +193,9 @@ class ActionServer:
             return f"{running} goals are running, the most this server takes ({self.max_goals})"
         return ""
 
-    def _run(self, goal: ServerGoal) -> None:
+    def _run(self, goal: ServerGoal[GoalT, FeedbackT]) -> None:
         self._set_status(goal, GoalStatus.EXECUTING)
-        result_class = self.types.message_class(f"{self.action_type}_Result")
+        result: Any
         try:
             result = self.execute(goal)
             status = goal._ending or GoalStatus.SUCCEEDED
@@ -189,7 +203,7 @@ class ActionServer:
             log.error("action %s: execute raised %s: %s", self.name, type(exc).__name__, exc,
                       exc_info=True)
             result, status = None, GoalStatus.ABORTED
-        if not isinstance(result, result_class):
+        if not isinstance(result, self._result_class):
             if result is not None:
                 log.error("action %s: execute returned %s, not %s_Result", self.name,
                           type(result).__name__, self.action_type)
@@ -197,7 +211,8 @@ class ActionServer:
             result = new_message(self.types, f"{self.action_type}_Result")
         self._finish(goal, status, result)
 
-    def _finish(self, goal: ServerGoal, status: GoalStatus, result: Any) -> None:
+    def _finish(self, goal: ServerGoal[GoalT, FeedbackT], status: GoalStatus,
+                result: Any) -> None:
         with self._lock:
             self._results[goal.id] = (status, result)
             while len(self._results) > KEEP_FINISHED:
@@ -210,8 +225,7 @@ class ActionServer:
             responder.reply(self._result_response(status, result))
 
     def _result_response(self, status: GoalStatus, result: Any) -> Any:
-        return self.types.message_class(f"{self.action_type}_GetResult_Response")(
-            status=int(status), result=result)
+        return self._get_result_response(status=int(status), result=result)
 
     def _on_get_result(self, request: Any, responder: Responder) -> None:
         goal_id = bytes(request.goal_id.uuid)
@@ -253,20 +267,16 @@ class ActionServer:
         code = 0 if canceling or not candidates else 1
         if any(wanted) and not candidates:
             code = 3 if wanted in self._goals else 2
-        info = self.types.message_class("action_msgs/msg/GoalInfo")
-        return self.types.message_class("action_msgs/srv/CancelGoal_Response")(
-            return_code=code, goals_canceling=[
-                info(goal_id=_uuid(self.types, g.id), stamp=_stamp(self.types, g.accepted_at))
-                for g in canceling])
+        return self._cancel_response(return_code=code, goals_canceling=[
+            GoalInfo(goal_id=goal_uuid(g.id), stamp=stamp(g.accepted_at)) for g in canceling])
 
-    def _feedback(self, goal: ServerGoal, feedback: Any) -> None:
+    def _feedback(self, goal: ServerGoal[GoalT, FeedbackT], feedback: FeedbackT) -> None:
         if self._closed:
             return
-        message = self.types.message_class(f"{self.action_type}_FeedbackMessage")(
-            goal_id=_uuid(self.types, goal.id), feedback=feedback)
-        self._feedback_pub.publish(message)
+        self._feedback_pub.publish(self._feedback_message(goal_id=goal_uuid(goal.id),
+                                                          feedback=feedback))
 
-    def _set_status(self, goal: ServerGoal, status: GoalStatus) -> None:
+    def _set_status(self, goal: ServerGoal[GoalT, FeedbackT], status: GoalStatus) -> None:
         if goal.status.terminal:
             return
         goal.status = status
@@ -275,15 +285,12 @@ class ActionServer:
     def _publish_status(self) -> None:
         if self._closed:
             return  # a goal thread finishing after the node was destroyed
-        types = self.types
-        status_class = types.message_class("action_msgs/msg/GoalStatus")
-        info = types.message_class("action_msgs/msg/GoalInfo")
         with self._lock:
             goals = list(self._goals.values())
-        message = types.message_class("action_msgs/msg/GoalStatusArray")(
-            status_list=[status_class(goal_info=info(goal_id=_uuid(types, g.id),
-                                                     stamp=_stamp(types, g.accepted_at)),
-                                      status=int(g.status)) for g in goals])
+        message = GoalStatusArray(status_list=[
+            GoalStatusMessage(goal_info=GoalInfo(goal_id=goal_uuid(g.id),
+                                                 stamp=stamp(g.accepted_at)),
+                              status=int(g.status)) for g in goals])
         try:
             self._status_pub.publish(message)
         except RuntimeError:
@@ -297,121 +304,4 @@ class ActionServer:
         for goal in goals:
             goal._cancel.set()
         for entity in (*self._entities, self._feedback_pub, self._status_pub):
-            entity.destroy()
-
-
-class ClientGoal:
-    """A goal sent by an :class:`ActionClient`: status, last feedback, result, cancel."""
-
-    def __init__(self, client: ActionClient, goal_id: bytes, accepted: bool,
-                 on_feedback: Callable[[Any], object] | None = None) -> None:
-        self.client, self.id, self.accepted = client, goal_id, accepted
-        self.on_feedback = on_feedback
-        self.status = GoalStatus.ACCEPTED if accepted else GoalStatus.UNKNOWN
-        self.feedback: Any = None
-        self._result: Future[tuple[GoalStatus, Any]] = Future()
-        if accepted:
-            client.node.context.calls.submit(self._fetch_result)
-
-    def _fetch_result(self) -> None:
-        request = self.client.types.message_class(
-            f"{self.client.action_type}_GetResult_Request")(
-            goal_id=_uuid(self.client.types, self.id))
-        while not self._result.done():
-            try:
-                response = self.client._get_result.call(request, timeout=3600.0)
-            except ServiceError as exc:
-                if self.client._closed:
-                    self._result.set_exception(ActionError(f"{self.client.name}: client closed"))
-                    return
-                log.debug("get_result of %s: %s; retrying", self.client.name, exc)
-                time.sleep(0.5)
-                continue
-            self.status = GoalStatus(response.status)
-            self._result.set_result((self.status, response.result))
-
-    @property
-    def done(self) -> bool:
-        return self._result.done()
-
-    def result(self, timeout: float | None = None) -> tuple[GoalStatus, Any]:
-        """Block until the goal ends; returns ``(status, result)``."""
-        return self._result.result(timeout)
-
-    def add_done_callback(self, callback: Callable[[ClientGoal], object]) -> None:
-        self._result.add_done_callback(lambda _future: callback(self))
-
-    def cancel(self, timeout: float = 5.0) -> bool:
-        """Ask the server to cancel; True if it agreed (the result then says CANCELED)."""
-        return self.client._cancel(self, timeout)
-
-
-class ActionClient:
-    """Sends goals to an action server and follows them."""
-
-    def __init__(self, node: Node, name: str, action_type: str) -> None:
-        types = node.types
-        if action_type not in types.actions:
-            raise KeyError(f"{name}: unknown action type {action_type!r}")
-        self.node, self.types, self.name, self.action_type = node, types, name, action_type
-        self._goals: dict[bytes, ClientGoal] = {}
-        self._statuses: dict[bytes, GoalStatus] = {}
-        self._closed = False
-        base = f"{name}/_action/"
-        self._send = node.create_client(base + "send_goal", f"{action_type}_SendGoal")
-        self._cancel_client = node.create_client(base + "cancel_goal",
-                                                 "action_msgs/srv/CancelGoal")
-        self._get_result = node.create_client(base + "get_result", f"{action_type}_GetResult")
-        self._feedback_sub = node.create_subscription(
-            base + "feedback", f"{action_type}_FeedbackMessage", self._on_feedback)
-        self._status_sub = node.create_subscription(
-            base + "status", "action_msgs/msg/GoalStatusArray", self._on_status, STATUS_QOS)
-
-    def wait_for_server(self, timeout: float = 5.0) -> bool:
-        return self._send.wait_for_service(timeout)
-
-    def send_goal(self, goal: Any, feedback: Callable[[Any], object] | None = None,
-                  timeout: float = 5.0) -> ClientGoal:
-        """Send a goal; raises :class:`ActionError` if the server rejects it or is absent."""
-        goal_id = uuid.uuid4().bytes
-        request = self.types.message_class(f"{self.action_type}_SendGoal_Request")(
-            goal_id=_uuid(self.types, goal_id), goal=goal)
-        try:
-            response = self._send.call(request, timeout)
-        except ServiceError as exc:
-            raise ActionError(f"action {self.name}: {exc}") from exc
-        if not response.accepted:
-            raise ActionError(f"action {self.name}: the server rejected the goal")
-        handle = ClientGoal(self, goal_id, True, feedback)
-        handle.status = self._statuses.get(goal_id, handle.status)  # status may come first
-        self._goals[goal_id] = handle
-        return handle
-
-    def _cancel(self, goal: ClientGoal, timeout: float) -> bool:
-        info = self.types.message_class("action_msgs/msg/GoalInfo")(
-            goal_id=_uuid(self.types, goal.id), stamp=_stamp(self.types, 0.0))
-        request = self.types.message_class("action_msgs/srv/CancelGoal_Request")(goal_info=info)
-        response = self._cancel_client.call(request, timeout)
-        return int(response.return_code) == 0 and bool(response.goals_canceling)
-
-    def _on_feedback(self, message: Any) -> None:
-        goal = self._goals.get(bytes(message.goal_id.uuid))
-        if goal is None:
-            return
-        goal.feedback = message.feedback
-        if goal.on_feedback is not None:
-            goal.on_feedback(message.feedback)
-
-    def _on_status(self, message: Any) -> None:
-        self._statuses = {bytes(entry.goal_info.goal_id.uuid): GoalStatus(entry.status)
-                          for entry in message.status_list}
-        for goal_id, status in self._statuses.items():
-            goal = self._goals.get(goal_id)
-            if goal is not None and not goal.done:
-                goal.status = status
-
-    def destroy(self) -> None:
-        self._closed = True
-        for entity in (self._send, self._cancel_client, self._get_result, self._feedback_sub,
-                       self._status_sub):
             entity.destroy()

@@ -100,8 +100,8 @@ class SimClock:
         source = info.gid if info is not None else b""
         with self._changed:
             report = self._follow(source, seconds, time.monotonic())
-        if report is not None:
-            log.log(report[0], report[1], *report[2])
+            if report is not None:  # said before a woken sleeper (who may log too) goes on
+                log.log(report[0], report[1], *report[2])
 
     def _follow(self, source: bytes, seconds: float, wall: float) -> Report | None:
         """Decide about one message (under the lock); what to log, if anything."""

@@ -1,9 +1,12 @@
 """Where a node's callbacks run: one thread per node, one callback at a time.
 
-Messages arrive on Zenoh's threads; they are queued here so that a node's code never runs two
-callbacks at once and a slow callback never stalls the network. A message from a node of the same
-process is handed over directly on the publisher's thread when the receiving node is idle (see
-:meth:`CallbackThread.try_inline`), as nodelets did; otherwise it is queued too.
+Messages arrive on Zenoh's threads, or on a publisher's thread for a node of the same process;
+either way they are queued here, so that a node's code never runs two callbacks at once, runs
+them on its own thread (never on a publisher's), and a slow callback never stalls the network
+or a publisher. The one exception is opted in per subscription
+(``create_subscription(..., inline=True)``): an in-process message may then be handed over
+directly on the publisher's thread while the node is idle, as nodelets did (see
+:meth:`CallbackThread.try_inline`).
 
 An exception in a callback is logged with its traceback — once per callback, then counted — and
 the node keeps running.
@@ -70,11 +73,27 @@ class CallbackThread:
             with self._busy:
                 self.call(function, *args)
 
+    def flush(self, timeout: float = 5.0) -> bool:
+        """Wait until every callback queued here before this call has run; False if that
+        takes more than ``timeout`` seconds.
+
+        A message published in this process is queued to the subscribing node's thread, so
+        once ``subscriber_node.callbacks.flush()`` returns True its callback has seen it (a
+        test that moves a fake clock between messages waits like this). Callbacks routed to
+        another thread are that thread's to flush.
+        """
+        if self.in_thread():
+            raise RuntimeError(f"node {self.name}: flush on its own thread would wait forever")
+        done = threading.Event()
+        self._queue.put((done.set, ()))
+        return done.wait(timeout)
+
     def try_inline(self, function: Callable[..., object], *args: Any) -> bool:
         """Run ``function`` now on the caller's thread if this node is idle with nothing queued.
 
-        In-process delivery uses this to skip a thread switch (tens of microseconds); the
-        node still runs one callback at a time, and queued callbacks keep their order.
+        Only for subscriptions made with ``inline=True``: in-process delivery then skips a
+        thread switch (tens of microseconds); the node still runs one callback at a time, and
+        queued callbacks keep their order. Returns False, having run nothing, otherwise.
         """
         thread = self._routed(function) if self._routes else None
         if thread is not None:

@@ -13,11 +13,19 @@ goal, result and feedback messages plus the ``SendGoal`` and ``GetResult`` servi
     raw = types.serialize(message, "std_msgs/msg/String")     # CDR, little endian
     message = types.deserialize(raw, "std_msgs/msg/String")   # numpy arrays are views on raw
     types.hash("std_srvs/srv/SetBool")                         # "RIHS01_abe9e4bb..."
+
+Every message class is a static dataclass that mypy knows: rosbags' own for its standard types,
+and for the bundled interfaces the classes generated into :mod:`cyborg.bus.msgs`
+(``python3 -m cyborg.bus.codegen``), which replace the ones rosbags would make at run time.
+Import them from there (:mod:`cyborg.bus.typed`); :meth:`MessageTypes.message_class` returns
+those very classes, so decoded messages are instances of them.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
+import logging
 import struct
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -40,6 +48,15 @@ from cyborg.bus.type_hash import (
     rihs01,
     service_fields,
 )
+from cyborg.bus.typed import (
+    ActionType,
+    ServiceType,
+    action_type_name,
+    message_type_name,
+    service_type_name,
+)
+
+log = logging.getLogger("cyborg.bus")
 
 BUNDLED_INTERFACES = Path(__file__).with_name("interfaces")
 """The interface files shipped with cyborg (cyborg_msgs and standard services)."""
@@ -120,6 +137,29 @@ class MessageTypes:
             except Exception as exc:
                 raise InterfaceError(f"{interface.source}: {exc}") from exc
         self.store.register(definitions)
+        for name in definitions:
+            self._use_static_class(name)
+
+    def _use_static_class(self, type_name: str) -> None:
+        """Put the class generated into :mod:`cyborg.bus.msgs` for ``type_name`` in place of
+        the one rosbags just made, if there is one and it matches field for field."""
+        package, kind, short = type_name.split("/")
+        try:
+            module = importlib.import_module(f"cyborg.bus.msgs.{package}.{kind}")
+        except ModuleNotFoundError:
+            return
+        static = getattr(module, f"{package}__{kind}__{short}", None)
+        if static is None or getattr(static, "__msgtype__", None) != type_name:
+            return
+        made = self.store.types[type_name]
+        if made is static:
+            return
+        if _shape(static) != _shape(made):
+            log.warning("%s in cyborg.bus.msgs differs from its interface file; using the "
+                        "file's (run `python3 -m cyborg.bus.codegen` to regenerate)", type_name)
+            return
+        self.store.types[type_name] = static
+        self.store.cache.pop(type_name, None)
 
     def _definitions(self, interface: Interface) -> dict[str, Any]:
         name, parts = interface.name, interface.parts
@@ -199,6 +239,33 @@ class MessageTypes:
             raise KeyError(f"unknown message type {type_name!r}") from None
         return cls
 
+    def type_name(self, message_type: type[Any] | str) -> str:
+        """The type name of ``message_type``, given by name or as a class; a class must be
+        this store's own (from :mod:`cyborg.bus.msgs`), or TypeError."""
+        name = message_type_name(message_type)
+        if not isinstance(message_type, str) and self.store.types.get(name) is not message_type:
+            raise TypeError(f"{message_type!r} is not the class of {name} here; import message "
+                            "classes from cyborg.bus.msgs")
+        return name
+
+    def service_name(self, service_type: ServiceType[Any, Any] | str) -> str:
+        """The name of a service type, given by name or as a checked
+        :class:`~cyborg.bus.typed.ServiceType`."""
+        name = service_type_name(service_type)
+        if isinstance(service_type, ServiceType):
+            self.type_name(service_type.Request)
+            self.type_name(service_type.Response)
+        return name
+
+    def action_name(self, action_type: ActionType[Any, Any, Any] | str) -> str:
+        """The name of an action type, given by name or as a checked
+        :class:`~cyborg.bus.typed.ActionType`."""
+        name = action_type_name(action_type)
+        if isinstance(action_type, ActionType):
+            for part in (action_type.Goal, action_type.Result, action_type.Feedback):
+                self.type_name(part)
+        return name
+
     def serialize(self, message: Any, type_name: str) -> memoryview:
         """CDR bytes (little endian, with the 4-byte encapsulation header)."""
         data: memoryview = self.store.serialize_cdr(message, type_name, little_endian=True)
@@ -264,6 +331,12 @@ class MessageTypes:
         cannot change what another receiver of the same buffer sees.
         """
         return self.store.deserialize_cdr(memoryview(data).toreadonly(), type_name)
+
+
+def _shape(message_class: type) -> list[tuple[str, object, object]]:
+    """A message class's dataclass fields (constants included): name, annotation, default."""
+    return [(field.name, field.type, field.default)
+            for field in dataclasses.fields(message_class)]
 
 
 def _base(type_name: str) -> tuple[Nodetype, tuple[str, int]]:

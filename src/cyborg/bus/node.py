@@ -2,15 +2,22 @@
 
     from cyborg.bus import Context, Node, Qos
 
+    from cyborg.bus.msgs.std_msgs.msg import String
+
     with Context() as context:
         node = Node("talker", namespace="/robot1", context=context)
-        String = node.types.message_class("std_msgs/msg/String")
-        chatter = node.create_publisher("chatter", "std_msgs/msg/String")
+        chatter = node.create_publisher("chatter", String)   # Publisher[String]
         chatter.publish(String(data="hello"))
 
+Message, service and action types are given as classes (and :class:`~cyborg.bus.typed.
+ServiceType`, :class:`~cyborg.bus.typed.ActionType`) imported from :mod:`cyborg.bus.msgs`, which
+makes what is created generic in them for mypy; or by name (``"std_msgs/msg/String"``), typed
+``Any``.
+
 Each node runs its callbacks (subscriptions, services, timers) one at a time on its own thread;
-a service that must never wait behind them gets a thread of its own with
-``create_service(..., callbacks=node.callback_thread("name"))``.
+a subscription's callback runs there even for a message published in this process, unless the
+subscription opted in with ``inline=True``. A service that must never wait behind them gets a
+thread of its own with ``create_service(..., callbacks=node.callback_thread("name"))``.
 Nodes of one process normally share one :class:`~cyborg.bus.context.Context`; without one, a
 node uses the process's default context (see :func:`default_context`).
 """
@@ -20,20 +27,31 @@ from __future__ import annotations
 import re
 import threading
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar, overload
 
 from cyborg.bus.context import Context
 from cyborg.bus.executor import CallbackThread
 from cyborg.bus.message_types import MessageTypes
 from cyborg.bus.parameters import Parameters
-from cyborg.bus.services import ServiceClient, ServiceServer
+from cyborg.bus.services import Responder, ServiceClient, ServiceServer
 from cyborg.bus.topics import Publisher, Subscription
-from cyborg.bus.wire import Qos, node_token
+from cyborg.bus.typed import ActionType, ServiceType
+from cyborg.bus.wire import Attachment, Qos, node_token
+
+if TYPE_CHECKING:
+    from cyborg.bus.action_client import ActionClient
+    from cyborg.bus.actions import ActionServer, ServerGoal
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _NAMESPACE = re.compile(r"^(/[A-Za-z][A-Za-z0-9_]*)*/?$")
 
 _E = TypeVar("_E")
+_M = TypeVar("_M")
+_Req = TypeVar("_Req")
+_Resp = TypeVar("_Resp")
+_G = TypeVar("_G")
+_R = TypeVar("_R")
+_F = TypeVar("_F")
 
 _default: Context | None = None
 _default_lock = threading.Lock()
@@ -85,30 +103,75 @@ class Node:
         return self.context.types
 
     # ------------------------------------------------------------------ topics
-    def create_publisher(self, topic: str, type_name: str, qos: Qos | None = None) -> Publisher:
-        """A publisher; ``Qos.latched()`` keeps the last message for late subscribers."""
-        return self._keep(Publisher, topic, type_name, qos or Qos(depth=10))
+    @overload
+    def create_publisher(self, topic: str, message_type: type[_M],
+                         qos: Qos | None = None) -> Publisher[_M]: ...
+    @overload
+    def create_publisher(self, topic: str, message_type: str,
+                         qos: Qos | None = None) -> Publisher[Any]: ...
 
-    def create_subscription(self, topic: str, type_name: str, callback: Callable[..., object],
-                            qos: Qos | None = None, *, with_info: bool = False) -> Subscription:
+    def create_publisher(self, topic: str, message_type: type[Any] | str,
+                         qos: Qos | None = None) -> Publisher[Any]:
+        """A publisher of ``message_type`` (a class from :mod:`cyborg.bus.msgs`, or a type
+        name); ``Qos.latched()`` keeps the last message for late subscribers."""
+        return self._keep(Publisher, topic, self.types.type_name(message_type),
+                          qos or Qos(depth=10))
+
+    @overload
+    def create_subscription(self, topic: str, message_type: type[_M],
+                            callback: Callable[[_M], object], qos: Qos | None = None, *,
+                            with_info: Literal[False] = False,
+                            inline: bool = False) -> Subscription[_M]: ...
+    @overload
+    def create_subscription(self, topic: str, message_type: type[_M],
+                            callback: Callable[[_M, Attachment | None], object],
+                            qos: Qos | None = None, *, with_info: Literal[True],
+                            inline: bool = False) -> Subscription[_M]: ...
+    @overload
+    def create_subscription(self, topic: str, message_type: str,
+                            callback: Callable[..., object], qos: Qos | None = None, *,
+                            with_info: bool = False, inline: bool = False) -> Subscription[Any]: ...
+
+    def create_subscription(self, topic: str, message_type: type[Any] | str,
+                            callback: Callable[..., object], qos: Qos | None = None, *,
+                            with_info: bool = False, inline: bool = False) -> Subscription[Any]:
         """Call ``callback(message)`` for each message; use ``Qos.latched()`` for latched topics.
 
+        The callback runs on this node's thread, also for messages published in this process.
         ``with_info=True``: ``callback(message, info)``, ``info`` being the sample's
         :class:`~cyborg.bus.wire.Attachment` (claimed publisher GID, sequence, timestamp) or None.
+        ``inline=True`` lets an in-process message be handed to the callback on the publisher's
+        thread when this node is idle (see :class:`~cyborg.bus.topics.Subscription`).
         """
-        return self._keep(Subscription, topic, type_name, callback, qos or Qos(depth=10),
-                          with_info=with_info)
+        return self._keep(Subscription, topic, self.types.type_name(message_type), callback,
+                          qos or Qos(depth=10), with_info=with_info, inline=inline)
 
     # ------------------------------------------------------------------ services
+    @overload
+    def create_service(self, name: str, service_type: ServiceType[_Req, _Resp],
+                       handler: Callable[[_Req], _Resp], *, deferred: Literal[False] = False,
+                       callbacks: CallbackThread | None = None) -> ServiceServer[_Req, _Resp]: ...
+    @overload
+    def create_service(self, name: str, service_type: ServiceType[_Req, _Resp],
+                       handler: Callable[[_Req, Responder[_Resp]], object], *,
+                       deferred: Literal[True],
+                       callbacks: CallbackThread | None = None) -> ServiceServer[_Req, _Resp]: ...
+    @overload
     def create_service(self, name: str, service_type: str, handler: Callable[..., Any], *,
                        deferred: bool = False,
-                       callbacks: CallbackThread | None = None) -> ServiceServer:
+                       callbacks: CallbackThread | None = None) -> ServiceServer[Any, Any]: ...
+
+    def create_service(self, name: str, service_type: ServiceType[Any, Any] | str,
+                       handler: Callable[..., Any], *, deferred: bool = False,
+                       callbacks: CallbackThread | None = None) -> ServiceServer[Any, Any]:
         """Serve ``handler(request) -> response`` (see :class:`ServiceServer`).
 
         ``callbacks`` (from :meth:`callback_thread`): run the handler there instead of on the
         node's thread, so that the node's other callbacks never delay it.
         """
-        server = self._keep(ServiceServer, name, service_type, handler, deferred=deferred)
+        server: ServiceServer[Any, Any] = self._keep(
+            ServiceServer, name, self.types.service_name(service_type), handler,
+            deferred=deferred)
         if callbacks is not None:
             self.callbacks.route(server, callbacks)
         return server
@@ -122,19 +185,55 @@ class Node:
         self._callback_threads.append(thread)
         return thread
 
-    def create_client(self, name: str, service_type: str) -> ServiceClient:
-        return self._keep(ServiceClient, name, service_type)
+    @overload
+    def create_client(self, name: str,
+                      service_type: ServiceType[_Req, _Resp]) -> ServiceClient[_Req, _Resp]: ...
+    @overload
+    def create_client(self, name: str, service_type: str) -> ServiceClient[Any, Any]: ...
+
+    def create_client(self, name: str,
+                      service_type: ServiceType[Any, Any] | str) -> ServiceClient[Any, Any]:
+        """A client of a service (a :class:`~cyborg.bus.typed.ServiceType` or a type name)."""
+        return self._keep(ServiceClient, name, self.types.service_name(service_type))
 
     # ------------------------------------------------------------------ actions
-    def create_action_server(self, name: str, action_type: str,
-                             execute: Callable[[Any], Any], **options: Any) -> Any:
-        """Serve an action (see :class:`cyborg.bus.actions.ActionServer`)."""
-        from cyborg.bus.actions import ActionServer
-        return self._keep(ActionServer, name, action_type, execute, **options)
+    @overload
+    def create_action_server(
+            self, name: str, action_type: ActionType[_G, _R, _F],
+            execute: Callable[[ServerGoal[_G, _F]], _R | None], *,
+            accept: Callable[[_G], bool] | None = None,
+            cancel: Callable[[ServerGoal[_G, _F]], bool] | None = None,
+            max_goals: int | None = None) -> ActionServer[_G, _R, _F]: ...
+    @overload
+    def create_action_server(
+            self, name: str, action_type: str, execute: Callable[[ServerGoal[Any, Any]], Any], *,
+            accept: Callable[[Any], bool] | None = None,
+            cancel: Callable[[ServerGoal[Any, Any]], bool] | None = None,
+            max_goals: int | None = None) -> ActionServer[Any, Any, Any]: ...
 
-    def create_action_client(self, name: str, action_type: str) -> Any:
-        from cyborg.bus.actions import ActionClient
-        return self._keep(ActionClient, name, action_type)
+    def create_action_server(
+            self, name: str, action_type: ActionType[Any, Any, Any] | str,
+            execute: Callable[[ServerGoal[Any, Any]], Any], *,
+            accept: Callable[[Any], bool] | None = None,
+            cancel: Callable[[ServerGoal[Any, Any]], bool] | None = None,
+            max_goals: int | None = None) -> ActionServer[Any, Any, Any]:
+        """Serve an action (see :class:`cyborg.bus.actions.ActionServer`)."""
+        from cyborg.bus.actions import MAX_GOALS, ActionServer
+        return self._keep(ActionServer, name, self.types.action_name(action_type), execute,
+                          accept=accept, cancel=cancel,
+                          max_goals=MAX_GOALS if max_goals is None else max_goals)
+
+    @overload
+    def create_action_client(self, name: str, action_type: ActionType[_G, _R, _F]
+                             ) -> ActionClient[_G, _R, _F]: ...
+    @overload
+    def create_action_client(self, name: str, action_type: str) -> ActionClient[Any, Any, Any]: ...
+
+    def create_action_client(self, name: str, action_type: ActionType[Any, Any, Any] | str
+                             ) -> ActionClient[Any, Any, Any]:
+        """A client of an action (see :class:`cyborg.bus.action_client.ActionClient`)."""
+        from cyborg.bus.action_client import ActionClient
+        return self._keep(ActionClient, name, self.types.action_name(action_type))
 
     # ------------------------------------------------------------------ timers
     def create_timer(self, period: float, callback: Callable[[], object]) -> Timer:

@@ -18,11 +18,17 @@ logs where it happened:
 * a response that does not fit the response type is an error reply naming the field, at once,
   not a timeout.
 
-    def add(request):
-        return AddTwoInts_Response(sum=request.a + request.b)
-    node.create_service("add_two_ints", "example_interfaces/srv/AddTwoInts", add)
-    client = node.create_client("add_two_ints", "example_interfaces/srv/AddTwoInts")
-    client.call(AddTwoInts_Request(a=2, b=40), timeout=2.0).sum   # 42
+    from cyborg.bus.msgs.example_interfaces.srv import AddTwoInts
+
+    def add(request: AddTwoInts_Request) -> AddTwoInts_Response:
+        return AddTwoInts.Response(sum=request.a + request.b)
+    node.create_service("add_two_ints", AddTwoInts, add)
+    client = node.create_client("add_two_ints", AddTwoInts)
+    client.call(AddTwoInts.Request(a=2, b=40), timeout=2.0).sum   # 42
+
+Made from a :class:`~cyborg.bus.typed.ServiceType`, servers and clients are generic in its
+request and response classes (``ServiceClient[AddTwoInts_Request, AddTwoInts_Response]``), so
+mypy checks the handler and what :meth:`ServiceClient.call` is given and returns.
 """
 
 from __future__ import annotations
@@ -33,12 +39,13 @@ import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic
 
 import numpy as np
 import zenoh
 from rosbags.interfaces import Nodetype
 
+from cyborg.bus.typed import RequestT, ResponseT
 from cyborg.bus.wire import (
     Attachment,
     EntityKind,
@@ -186,10 +193,11 @@ class _ServiceEndpoint:
         return True
 
 
-class Responder:
+class Responder(Generic[ResponseT]):
     """Answers one request, now or later (from any thread), exactly once."""
 
-    def __init__(self, server: ServiceServer, query: zenoh.Query, attachment: Attachment) -> None:
+    def __init__(self, server: ServiceServer[Any, ResponseT], query: zenoh.Query,
+                 attachment: Attachment) -> None:
         self._server, self._query, self._attachment = server, query, attachment
         self._done = threading.Lock()
 
@@ -199,7 +207,7 @@ class Responder:
         asked, e.g. to release what it set up once its liveliness token is gone."""
         return self._attachment.gid
 
-    def reply(self, response: Any) -> None:
+    def reply(self, response: ResponseT) -> None:
         """Send ``response``; one that does not fit the response type becomes an error reply
         naming the field (and an error in the server's log), sent at once."""
         server = self._server
@@ -240,7 +248,7 @@ class Responder:
         self._query.drop()
 
 
-class ServiceServer(_ServiceEndpoint):
+class ServiceServer(_ServiceEndpoint, Generic[RequestT, ResponseT]):
     """Serves requests with ``handler(request) -> response`` on the node's thread.
 
     With ``deferred=True`` the handler is ``handler(request, responder)`` and answers through
@@ -255,7 +263,7 @@ class ServiceServer(_ServiceEndpoint):
         super().__init__(node, name, service_type, EntityKind.SERVICE_SERVER)
         self.handler, self.deferred = handler, deferred
         self.handled = 0
-        self.checks: list[Callable[[Any], object]] = []
+        self.checks: list[Callable[[RequestT], object]] = []
         self._traced: set[type] = set()  # exception types whose traceback was logged
         self.max_pending = MAX_PENDING_REQUESTS
         self._pending = 0  # requests queued for the handler, not yet started
@@ -287,7 +295,7 @@ class ServiceServer(_ServiceEndpoint):
             return
         self.node.callbacks.submit(self._handle, Responder(self, query, attachment), request)
 
-    def _handle(self, responder: Responder, request: Any) -> None:
+    def _handle(self, responder: Responder[ResponseT], request: RequestT) -> None:
         with self._pending_lock:
             self._pending -= 1
         self.handled += 1
@@ -315,7 +323,7 @@ class ServiceServer(_ServiceEndpoint):
             self._queryable.undeclare()
 
 
-class ServiceClient(_ServiceEndpoint):
+class ServiceClient(_ServiceEndpoint, Generic[RequestT, ResponseT]):
     """Calls a service: :meth:`call` blocks, :meth:`call_async` returns a Future."""
 
     def __init__(self, node: Node, name: str, service_type: str) -> None:
@@ -329,7 +337,7 @@ class ServiceClient(_ServiceEndpoint):
         """Wait until a server for this service is in the graph."""
         return self.context.graph.wait_for(lambda graph: self.service_is_ready(), timeout)
 
-    def call(self, request: Any, timeout: float = 5.0) -> Any:
+    def call(self, request: RequestT, timeout: float = 5.0) -> ResponseT:
         """Send ``request`` and return the response; raise :class:`ServiceError` on failure:
         :class:`RequestError` for a request that does not fit the request type (nothing is
         sent) or that the server refused, :class:`ServiceTimeoutError` without a reply."""
@@ -355,8 +363,9 @@ class ServiceClient(_ServiceEndpoint):
         for reply in replies:
             if reply.ok is not None:
                 try:
-                    return self.context.types.deserialize(reply.ok.payload.to_bytes(),
-                                                          f"{self.service_type}_Response")
+                    response: ResponseT = self.context.types.deserialize(
+                        reply.ok.payload.to_bytes(), f"{self.service_type}_Response")
+                    return response
                 except Exception as exc:
                     raise ServiceError(f"service {self.name}: cannot decode the response: "
                                        f"{_one_line(str(exc))}") from exc
@@ -372,7 +381,7 @@ class ServiceClient(_ServiceEndpoint):
         raise ServiceError(f"service {self.name} ({self.service_type}) is not available; "
                            "is its server running? (`cyborg service list`)")
 
-    def call_async(self, request: Any, timeout: float = 5.0) -> Future[Any]:
+    def call_async(self, request: RequestT, timeout: float = 5.0) -> Future[ResponseT]:
         """Like :meth:`call`, on a worker thread; the Future holds the response or the error."""
         return self.context.calls.submit(self.call, request, timeout)
 

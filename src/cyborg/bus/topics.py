@@ -13,6 +13,13 @@ How a message travels depends on where its subscribers are:
 A latched publisher (``Qos.latched()``, transient-local) keeps its last ``depth`` messages for
 subscribers that join later, in-process and remote.
 
+Whichever way a message came, its subscription's callback runs on the subscribing node's
+callback thread (:mod:`cyborg.bus.executor`), never on the publisher's: a camera's thread does
+not run a detector's inference, a tree's tick thread does not run a monitor's handling. Only a
+subscription made with ``inline=True`` may be called on the publisher's thread, for an
+in-process message arriving while its node is idle (see :class:`Subscription`). Both are
+generic in their message class (``Publisher[String]``, :mod:`cyborg.bus.typed`).
+
 Ownership: once published, a message belongs to the bus. In-process subscribers share its numpy
 arrays read-only; write new arrays for the next message instead of filling the old ones.
 """
@@ -23,13 +30,14 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic
 
 import zenoh
 import zenoh.ext
 
 from cyborg.bus.sequences import MAX_PUBLISHERS, SequenceTable
 from cyborg.bus.shm import SlotReader, SlotRef, SlotRejectedError, SlotWriter
+from cyborg.bus.typed import MessageT
 from cyborg.bus.wire import (
     Attachment,
     Durability,
@@ -86,8 +94,10 @@ class _Endpoint:
         return True
 
 
-class Publisher(_Endpoint):
-    """Publishes messages of one type on one topic. Create with :meth:`Node.create_publisher`."""
+class Publisher(_Endpoint, Generic[MessageT]):
+    """Publishes messages of one type on one topic. Create with :meth:`Node.create_publisher`.
+
+    ``Publisher[String]`` takes ``String`` messages only: mypy checks it, :meth:`publish` too."""
 
     def __init__(self, node: Node, topic: str, type_name: str, qos: Qos) -> None:
         super().__init__(node, topic, type_name, qos, EntityKind.PUBLISHER)
@@ -118,14 +128,15 @@ class Publisher(_Endpoint):
         self._slots: SlotWriter | None = None
         self._announce()
 
-    def publish(self, message: Any) -> None:
-        """Send ``message`` to every subscriber, choosing the cheapest path for each."""
+    def publish(self, message: MessageT) -> None:
+        """Send ``message`` to every subscriber, choosing the cheapest path for each; those
+        of this process get it queued to their nodes' threads (see :class:`Subscription`)."""
         if not isinstance(message, self._class):
             raise TypeError(f"publish on {self.topic}: expected {self.type_name}, "
                             f"got {type(message).__name__}")
-        if self._closed:
-            raise RuntimeError(f"publish on {self.topic}: the publisher was destroyed")
         with self._lock:
+            if self._closed:
+                raise RuntimeError(f"publish on {self.topic}: the publisher was destroyed")
             self._sequence += 1
             attachment = Attachment(self._sequence, time.time_ns(), self.gid)
             if self.latched:
@@ -180,17 +191,31 @@ class Publisher(_Endpoint):
         return local + remote
 
     def destroy(self) -> None:
-        if not self._withdraw():
-            return
-        self.context.unlatch(self.topic, self)
-        self._zenoh.undeclare()  # type: ignore[no-untyped-call]
-        self._shm_publisher.undeclare()
-        if self._slots is not None:
-            self._slots.close()
+        # under the lock: a publish on another thread (a node's callback, while the node is
+        # being destroyed) may be using the Zenoh publishers, which cannot be undeclared then
+        with self._lock:
+            if not self._withdraw():
+                return
+            self.context.unlatch(self.topic, self)
+            self._zenoh.undeclare()  # type: ignore[no-untyped-call]
+            self._shm_publisher.undeclare()
+            if self._slots is not None:
+                self._slots.close()
 
 
-class Subscription(_Endpoint):
+class Subscription(_Endpoint, Generic[MessageT]):
     """Calls ``callback(message)`` on the node's thread for each message on a topic.
+
+    It runs on the node's callback thread (or the one it was routed to:
+    :meth:`~cyborg.bus.executor.CallbackThread.route`) wherever the message came from: never
+    on the publisher's thread, never on Zenoh's.
+
+    ``inline=True`` opts in to an optimisation for in-process messages: when the node is idle
+    with nothing queued, the callback is called at once on the *publisher's* thread, saving
+    the hand-over to the node's thread (a wake-up, and under load a wait for the interpreter
+    lock). The node still runs one callback at a time and this subscription's messages keep
+    their order, but the callback must not care which thread runs it and should be quick:
+    the publisher waits for it.
 
     With ``with_info=True`` the callback is ``callback(message, info)``: ``info`` is the
     sample's :class:`~cyborg.bus.wire.Attachment` (publisher GID, sequence number, source
@@ -205,10 +230,12 @@ class Subscription(_Endpoint):
     """
 
     def __init__(self, node: Node, topic: str, type_name: str,
-                 callback: Callable[..., object], qos: Qos, *, with_info: bool = False) -> None:
+                 callback: Callable[..., object], qos: Qos, *, with_info: bool = False,
+                 inline: bool = False) -> None:
         super().__init__(node, topic, type_name, qos, EntityKind.SUBSCRIPTION)
         self.callback = callback
         self.with_info = with_info
+        self.inline = inline
         self.received = 0
         depth = None if qos.history is History.KEEP_ALL else max(qos.depth, 1)
         self._queue: deque[tuple[Any, Attachment | None]] = deque(maxlen=depth)
@@ -240,17 +267,19 @@ class Subscription(_Endpoint):
 
     # ------------------------------------------------------------------ arrivals
     def deliver_local(self, message: Any, type_name: str, attachment: Attachment) -> None:
+        """A message of this process (the publisher's thread): queue a read-only copy."""
         if type_name != self.type_name:
             self.context.drop(f"{self.topic}: type {type_name} instead of {self.type_name}")
             return
         if not self._last_sequence.record(attachment.gid, attachment.sequence):
             return
         copy = self.context.copier.copy(message, type_name)
-        # Handed over directly only when nothing of this subscription is queued or about to
-        # run: a dispatch taken off the node's queue but not yet running would come second.
-        if self._scheduled or not self.node.callbacks.try_inline(self._deliver_now, copy,
-                                                                 attachment):
-            self._enqueue(copy, attachment)
+        # Inline (opted in) only when nothing of this subscription is queued or about to run:
+        # a dispatch taken off the node's queue but not yet running would come second.
+        if self.inline and not self._scheduled and self.node.callbacks.try_inline(
+                self._deliver_now, copy, attachment):
+            return
+        self._enqueue(copy, attachment)
 
     def _deliver_now(self, message: Any, info: Attachment | None) -> None:
         if not self._closed:
