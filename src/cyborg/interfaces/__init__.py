@@ -10,7 +10,7 @@ every client endpoint finds its server.
 
 * :mod:`~cyborg.interfaces.contract` — the descriptors :class:`Topic`, :class:`Service` and
   :class:`Action` (name, type, QoS; they create either side's endpoint on a node), name
-  resolution, and :func:`message_constants`, the constants of a .msg/.srv/.action file;
+  and name resolution;
 * :mod:`~cyborg.interfaces.robot` — the robot's ARNL-like interface (simulator ↔ BusRobot);
 * :mod:`~cyborg.interfaces.tree_runner` — the tree runner's topics and services (runner ↔
   monitor, command line);
@@ -22,12 +22,13 @@ descriptor on both sides (``BUMPERS.publisher(node)`` / ``BUMPERS.subscription(n
 namespace)``), add it to the module's ``TOPICS`` or ``SERVICES`` tuple, and extend the test
 that starts both sides. A constant the message carries belongs in the message definition
 (``uint8 FORCE=2`` in the .srv; constants do not change the type hash or the wire format):
-declare it there and take it with :func:`~cyborg.interfaces.contract.constant`, never retype
-it. Only values no message defines (ARNL's path states sent as a string) are written here.
+declare it there, regenerate :mod:`cyborg.bus.msgs` (``python3 -m cyborg.bus.codegen``) and
+take it from the class (``ControlNode_Request.FORCE``), never retype it. Only values no
+message defines (ARNL's path states sent as a string) are written here.
 
 This package imports only itself and :mod:`cyborg.bus`; every layer above may import it.
 """
 
-from cyborg.interfaces.contract import Action, Service, Topic, message_constants, resolve
+from cyborg.interfaces.contract import Action, Service, Topic, resolve
 
-__all__ = ["Action", "Service", "Topic", "message_constants", "resolve"]
+__all__ = ["Action", "Service", "Topic", "resolve"]

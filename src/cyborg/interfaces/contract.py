@@ -12,9 +12,10 @@ Names are relative, as in ROS: without ``namespace`` they resolve in the node's 
 with it they resolve under that one (:func:`resolve`). A name that starts with ``/`` (such as
 ``/clock``) is absolute and stays as it is.
 
-Constants the message definitions declare (``uint8 DISABLE=1`` in ControlNode.srv) are read from
-the bundled interface files by :func:`message_constants`, so an enum in a contract takes its
-values from the .msg, .srv or .action file and never retypes them.
+Constants the message definitions declare (``uint8 DISABLE=1`` in ControlNode.srv) are taken
+from the generated message classes (``ControlNode_Request.DISABLE`` from
+:mod:`cyborg.bus.msgs`, which ``python3 -m cyborg.bus.codegen --check`` keeps equal to the
+.msg, .srv and .action files), so an enum in a contract never retypes them.
 
 The bus names types by string today (``type_name``); when it takes message classes, each
 descriptor gains its class here and the call sites stay as they are.
@@ -24,12 +25,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from functools import cache
 from typing import TYPE_CHECKING, Any
 
-from rosbags.typesys import get_types_from_msg
-
-from cyborg.bus.message_types import BUNDLED_INTERFACES, read_interfaces
 from cyborg.bus.wire import Qos, fully_qualified
 
 if TYPE_CHECKING:
@@ -40,8 +37,6 @@ if TYPE_CHECKING:
 DEFAULT_DEPTH = 10
 """History depth of a topic that names none (the bus's default for publishers and
 subscriptions); a latched topic keeps 1 unless told otherwise."""
-
-Constant = bool | int | float | str
 
 
 def resolve(namespace: str, name: str) -> str:
@@ -153,39 +148,3 @@ class Action:
 
     def client(self, node: Node, namespace: str | None = None) -> Any:
         return node.create_action_client(_at(self.name, namespace), self.type_name)
-
-
-_PARTS = {"msg": ("",), "srv": ("_Request", "_Response"),
-          "action": ("_Goal", "_Result", "_Feedback")}
-
-
-@cache
-def _bundled() -> dict[str, tuple[str, ...]]:
-    return {interface.name: interface.parts for interface in read_interfaces(BUNDLED_INTERFACES)}
-
-
-@cache
-def message_constants(type_name: str) -> dict[str, Constant]:
-    """The constants a bundled message definition declares, by name: for
-    ``cyborg_msgs/srv/ControlNode_Request`` ``{"CLEAR": 0, "DISABLE": 1, ...}``.
-
-    ``type_name`` is a message (``pkg/msg/X``), a service's request or response
-    (``pkg/srv/X_Request``) or an action's goal, result or feedback (``pkg/action/X_Result``).
-    The file is parsed as the bus parses it (rosbags), so these equal the class attributes of
-    ``MessageTypes().message_class(type_name)``; a few milliseconds, without building a type
-    store. ``KeyError`` for a type that is not bundled."""
-    package, kind, name = type_name.split("/")
-    for index, suffix in enumerate(_PARTS.get(kind, ())):
-        if suffix and not name.endswith(suffix):
-            continue
-        parts = _bundled().get(f"{package}/{kind}/{name.removesuffix(suffix)}")
-        if parts is not None:
-            as_message = f"{package}/msg/{name}"
-            constants, _fields = get_types_from_msg(parts[index], as_message)[as_message]
-            return {constant: value for constant, _type, value in constants}
-    raise KeyError(f"{type_name!r} is not a bundled message type")
-
-
-def constant(type_name: str, name: str) -> Any:
-    """One constant of a bundled message definition (see :func:`message_constants`)."""
-    return message_constants(type_name)[name]

@@ -36,7 +36,9 @@ from __future__ import annotations
 from enum import IntEnum, StrEnum
 
 from cyborg.bus.clock import CLOCK_TOPIC, CLOCK_TYPE
-from cyborg.interfaces.contract import Action, Service, Topic, constant
+from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal_Result
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus
+from cyborg.interfaces.contract import Action, Service, Topic
 
 NAMESPACE = "/cyborg"
 """The robot's namespace unless told otherwise."""
@@ -69,28 +71,26 @@ NAVIGATION_SERVICES = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL, MAKE_PLA
 MOVE_TO_GOAL = Action("move_to_goal", "cyborg_msgs/action/MoveToGoal")
 
 # ---------------------------------------------------------------------- values in the messages
-_BATTERY = BATTERY_STATUS.type_name
-_RESULT = MOVE_TO_GOAL.result_type
 
 
 class MoveOutcome(IntEnum):
     """How a move ended: MoveToGoal's result ``outcome``."""
 
-    SUCCEEDED = constant(_RESULT, "SUCCEEDED")
-    FAILED = constant(_RESULT, "FAILED")
+    SUCCEEDED = MoveToGoal_Result.SUCCEEDED
+    FAILED = MoveToGoal_Result.FAILED
     """Gave up on the way (stalled, blocked, preempted): trying again may help."""
-    CANCELED = constant(_RESULT, "CANCELED")
-    NO_PATH = constant(_RESULT, "NO_PATH")
+    CANCELED = MoveToGoal_Result.CANCELED
+    NO_PATH = MoveToGoal_Result.NO_PATH
     """No such goal or no path to it: trying again will not help."""
 
 
 class DockState(StrEnum):
     """BatteryStatus ``dock_state``: where docking stands (ARNL's states)."""
 
-    UNDOCKED = constant(_BATTERY, "DOCK_UNDOCKED")
-    DOCKING = constant(_BATTERY, "DOCK_DOCKING")
-    DOCKED = constant(_BATTERY, "DOCK_DOCKED")
-    UNDOCKING = constant(_BATTERY, "DOCK_UNDOCKING")
+    UNDOCKED = BatteryStatus.DOCK_UNDOCKED
+    DOCKING = BatteryStatus.DOCK_DOCKING
+    DOCKED = BatteryStatus.DOCK_DOCKED
+    UNDOCKING = BatteryStatus.DOCK_UNDOCKING
     UNKNOWN = ""
     """Not one of the states (a client's reading of a value it does not know)."""
 
@@ -98,12 +98,12 @@ class DockState(StrEnum):
 class ChargingState(IntEnum):
     """BatteryStatus ``charging_state`` (rosarnl's numbers)."""
 
-    UNKNOWN = constant(_BATTERY, "CHARGING_UNKNOWN")
-    NOT = constant(_BATTERY, "CHARGING_NOT")
-    BULK = constant(_BATTERY, "CHARGING_BULK")
-    OVERCHARGE = constant(_BATTERY, "CHARGING_OVERCHARGE")
-    FLOAT = constant(_BATTERY, "CHARGING_FLOAT")
-    BALANCE = constant(_BATTERY, "CHARGING_BALANCE")
+    UNKNOWN = BatteryStatus.CHARGING_UNKNOWN
+    NOT = BatteryStatus.CHARGING_NOT
+    BULK = BatteryStatus.CHARGING_BULK
+    OVERCHARGE = BatteryStatus.CHARGING_OVERCHARGE
+    FLOAT = BatteryStatus.CHARGING_FLOAT
+    BALANCE = BatteryStatus.CHARGING_BALANCE
 
 
 class PathState(StrEnum):

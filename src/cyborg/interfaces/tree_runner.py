@@ -28,7 +28,8 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-from cyborg.interfaces.contract import Service, Topic, constant
+from cyborg.bus.msgs.cyborg_msgs.srv import ControlNode_Request
+from cyborg.interfaces.contract import Service, Topic
 
 NAMESPACE = "/cyborg/bt"
 """The tree runner's namespace unless told otherwise."""
@@ -51,16 +52,15 @@ GET_BLACKBOARD = Service("get_blackboard", "cyborg_msgs/srv/GetBlackboard")
 SERVICES = (ENABLE, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
 
 # ---------------------------------------------------------------------- values in the messages
-_CONTROL = CONTROL.request_type
 
 
 class HookAction(IntEnum):
     """ControlNode's ``action`` (and BehaviorTreeHooks' ``actions``, which lack CLEAR)."""
 
-    CLEAR = constant(_CONTROL, "CLEAR")
-    DISABLE = constant(_CONTROL, "DISABLE")
-    FORCE = constant(_CONTROL, "FORCE")
-    BREAKPOINT = constant(_CONTROL, "BREAKPOINT")
+    CLEAR = ControlNode_Request.CLEAR
+    DISABLE = ControlNode_Request.DISABLE
+    FORCE = ControlNode_Request.FORCE
+    BREAKPOINT = ControlNode_Request.BREAKPOINT
 
     @property
     def label(self) -> str:
@@ -71,9 +71,9 @@ class HookAction(IntEnum):
 class HookStatus(IntEnum):
     """ControlNode's ``status``: what a disabled or forced node returns."""
 
-    SUCCESS = constant(_CONTROL, "SUCCESS")
-    FAILURE = constant(_CONTROL, "FAILURE")
-    RUNNING = constant(_CONTROL, "RUNNING")
+    SUCCESS = ControlNode_Request.SUCCESS
+    FAILURE = ControlNode_Request.FAILURE
+    RUNNING = ControlNode_Request.RUNNING
 
 
 def runner_namespace(topic: str, type_name: str) -> str | None:
