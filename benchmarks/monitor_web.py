@@ -38,7 +38,7 @@ from websockets.sync.client import connect
 from cyborg.bt.dot import structure_to_dot
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.monitor import Monitor
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode
 
 NODES = 1000
 RATE_HZ = 20.0

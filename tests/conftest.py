@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-import cyborg.nodes  # noqa: F401  (the robot's nodes are part of every test's baseline)
+import cyborg.robot  # noqa: F401  (the robot's nodes are part of every test's baseline)
 from cyborg.bt import registry
 
 

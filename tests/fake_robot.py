@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 from cyborg.bt import Blackboard, ManualClock, Tree, loads_tree
 from cyborg.nav.geometry import Pose2D
-from cyborg.nodes.robot import ROBOT, BatteryReading, DockState, Goal, MoveOutcome, RobotError
+from cyborg.robot.interface import ROBOT, BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from tests.builders import N, registry, tree_json
 
 

@@ -14,7 +14,7 @@ from typing import Any
 from cyborg.app.launch import Launch, LaunchDescription
 from cyborg.app.launchables import NodeSpec, RunningSimulator, RunningTree
 from cyborg.bus import BusConfig, Context, Node, new_message
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode
 from cyborg.sim.simulator import Simulator
 
 

@@ -21,7 +21,7 @@ from cyborg.bt import (
     loads_tree,
 )
 from cyborg.nav.geometry import Pose2D
-from cyborg.nodes.robot import DockState, MoveOutcome
+from cyborg.robot.interface import DockState, MoveOutcome
 from tests.builders import N, registry, tree_json
 from tests.fake_robot import FakeRobot, robot_tree
 
@@ -160,7 +160,7 @@ def test_move_to_backs_off_while_the_action_server_is_gone(
         caplog: pytest.LogCaptureFixture) -> None:
     """The simulator was killed: move_to fails at once. The patrol must not retry every tick
     and log a warning each time (727 warnings in 75 s)."""
-    caplog.set_level(logging.INFO, "cyborg.nodes")
+    caplog.set_level(logging.INFO, "cyborg.robot")
     robot, clock = FakeRobot(reachable=False), ManualClock()
     tree = robot_tree(N("Repeater", N("MemSequence", N("MoveTo", location="home"),
                                       N("Wait", milliseconds=2000),

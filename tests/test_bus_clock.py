@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from cyborg.bt import TickSnapshot, TreeRunner, loads_tree
+from cyborg.bt import TickLoop, TickSnapshot, loads_tree
 from cyborg.bus import BusConfig, Context, Node, Qos
 from cyborg.bus.clock import CLOCK_TYPE, SimClock
 from tests.builders import N, registry, tree_json
@@ -67,13 +67,13 @@ class Simulator:
 
 
 class Ticking:
-    """A TreeRunner on ``clock`` at 50 Hz of simulated time, counting its ticks."""
+    """A TickLoop on ``clock`` at 50 Hz of simulated time, counting its ticks."""
 
     def __init__(self, clock: SimClock) -> None:
         reg = registry()
         tree = loads_tree(json.dumps(tree_json(N("Runner"), reg=reg)), registry=reg,
                           clock=clock)
-        self.runner = TreeRunner(tree, rate_hz=50, clock=clock)
+        self.runner = TickLoop(tree, rate_hz=50, clock=clock)
         self.ticks: list[float] = []
         self.runner.add_listener(self._on_tick)
         self.runner.start()

@@ -66,7 +66,7 @@ def test_the_robot_nodes_are_known(capsys: pytest.CaptureFixture[str]) -> None:
     for name in ("MoveTo", "CheckBattery", "Charge", "Dock", "Undock", "ClosestGoal",
                  "DistanceToGoal", "BlackboardCompare"):
         assert f"\n{name} " in out or f"{name}  " in out, name
-    assert "entry point cyborg" in out or "cyborg.nodes" in out
+    assert "entry point cyborg" in out or "cyborg.robot" in out
 
 
 def test_validate_unknown_custom_nodes_and_stubs(tmp_path: Path,

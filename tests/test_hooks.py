@@ -20,8 +20,8 @@ from cyborg.bt import (
     Node,
     Sequence,
     Status,
+    TickLoop,
     Tree,
-    TreeRunner,
 )
 from cyborg.bt.node import TickRecord
 from tests.builders import N, events, tree_from
@@ -146,7 +146,7 @@ def test_owner_hooks_are_released_together() -> None:
 def test_pausing_the_runner_releases_a_waiting_breakpoint() -> None:
     tree = tree_from(N("Sequence", N("Scripted", script="R", tag="job", id="job")))
     tree.hooks.breakpoint("job")
-    runner = TreeRunner(tree)
+    runner = TickLoop(tree)
     runner.start()
     _wait_for(lambda: tree.hooks.paused_at == "job")
     runner.pause(halt=True)  # must not deadlock on the waiting tick
@@ -162,7 +162,7 @@ def test_replace_tree_halts_the_old_one_and_carries_hooks_over() -> None:
     old.hooks.clear("root")
     old.tick()
     old.hooks.force("root", FAILURE)
-    runner = TreeRunner(old)
+    runner = TickLoop(old)
     assert runner.replace_tree(new) is old
     assert events(old)[-1] == ("halt", "old")
     assert runner.tree is new and new.hooks.get("root") is not None

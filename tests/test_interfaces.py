@@ -20,10 +20,10 @@ from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
 from cyborg.monitor.source import TreeSource
 from cyborg.nav.arnl_map import read_map
-from cyborg.nodes.bus_robot import BusRobot
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.robot.bus_robot import BusRobot
+from cyborg.runner.tree_runner import TreeRunnerNode
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
-from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 from cyborg.vision import CameraNode, CameraTopics, DetectionPipeline, Detector, DetectorNode
 from cyborg.vision.samples import SampleSource

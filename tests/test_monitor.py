@@ -25,7 +25,7 @@ from cyborg.monitor.export import (
     view_dot,
 )
 from cyborg.monitor.tree_state import FRESH, StructureError, TreeState
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.builders import N, tree_from
 from tests.monitor_protocol import (
     CAMPUS_TREE,

@@ -19,7 +19,7 @@ from cyborg.bt.status import FAILURE, RUNNING, Status
 from cyborg.bus import Node
 from cyborg.monitor import Monitor
 from cyborg.monitor.monitor import _lan_address
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.browser import (
     CAMPUS_TREE,
     Live,

@@ -30,7 +30,7 @@ from cyborg.monitor.limits import (
     decode,
 )
 from cyborg.monitor.server import create_app
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.monitor_protocol import (
     FakeSource,
     bare_hub,

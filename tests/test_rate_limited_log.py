@@ -6,7 +6,7 @@ import logging
 
 import pytest
 
-from cyborg.nodes.rate_limited_log import RateLimitedLog
+from cyborg.robot.rate_limited_log import RateLimitedLog
 
 
 class Clock:

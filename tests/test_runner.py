@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from cyborg.bt import ManualClock, MonotonicClock, Status, TickSnapshot, TreeRunner
+from cyborg.bt import ManualClock, MonotonicClock, Status, TickLoop, TickSnapshot
 from tests.builders import N, events, tree_from
 
 
@@ -15,7 +15,7 @@ def test_ticks_at_the_rate_on_a_manual_clock() -> None:
     clock = ManualClock()
     tree = tree_from(N("Wait", milliseconds=1000), clock=clock)
     seen: list[TickSnapshot] = []
-    runner = TreeRunner(tree, rate_hz=10)
+    runner = TickLoop(tree, rate_hz=10)
     runner.add_listener(seen.append)
     runner.run(until_done=True)
     # Ticks at t = 0.0, 0.1, ..., 1.0: the Wait succeeds in the 11th tick.
@@ -26,7 +26,7 @@ def test_ticks_at_the_rate_on_a_manual_clock() -> None:
 
 def test_default_rate_is_10_hz_and_max_ticks() -> None:
     clock = ManualClock()
-    runner = TreeRunner(tree_from(N("Runner"), clock=clock))
+    runner = TickLoop(tree_from(N("Runner"), clock=clock))
     assert runner.rate_hz == 10
     runner.run(max_ticks=5)
     assert clock.now() == pytest.approx(0.4)
@@ -35,7 +35,7 @@ def test_default_rate_is_10_hz_and_max_ticks() -> None:
 
 def test_stop_halts_running_nodes() -> None:
     tree = tree_from(N("Sequence", N("Scripted", script="R", tag="job")))
-    runner = TreeRunner(tree)
+    runner = TickLoop(tree)
     runner.run(max_ticks=3)
     assert events(tree)[-1] == ("halt", "job")
     assert tree.running == []
@@ -44,7 +44,7 @@ def test_stop_halts_running_nodes() -> None:
 def test_pause_resume_step_and_stop_in_background() -> None:
     tree = tree_from(N("Scripted", script="R", tag="job"), clock=None)
     tree.clock = MonotonicClock()
-    runner = TreeRunner(tree, rate_hz=200, clock=tree.clock)
+    runner = TickLoop(tree, rate_hz=200, clock=tree.clock)
     ticked = threading.Event()
     runner.add_listener(lambda snapshot: ticked.set())
     runner.start()
@@ -70,7 +70,7 @@ def test_pause_resume_step_and_stop_in_background() -> None:
 
 def test_pause_with_halt_stops_running_actions() -> None:
     tree = tree_from(N("Scripted", script="R", tag="job"))
-    runner = TreeRunner(tree)
+    runner = TickLoop(tree)
     runner.step()
     runner.pause(halt=True)
     assert events(tree)[-1] == ("halt", "job")
@@ -80,7 +80,7 @@ def test_pause_with_halt_stops_running_actions() -> None:
 
 def test_a_raising_listener_does_not_stop_the_tree(caplog: pytest.LogCaptureFixture) -> None:
     tree = tree_from(N("Runner"))
-    runner = TreeRunner(tree)
+    runner = TickLoop(tree)
 
     def broken(snapshot: TickSnapshot) -> None:
         raise RuntimeError("listener bug")
@@ -92,7 +92,7 @@ def test_a_raising_listener_does_not_stop_the_tree(caplog: pytest.LogCaptureFixt
 
 
 def test_remove_listener() -> None:
-    runner = TreeRunner(tree_from(N("Runner")))
+    runner = TickLoop(tree_from(N("Runner")))
     seen: list[int] = []
     remove = runner.add_listener(lambda s: seen.append(s.tick))
     runner.step()
@@ -104,7 +104,7 @@ def test_remove_listener() -> None:
 @pytest.mark.parametrize("rate", [0, -1])
 def test_bad_rate(rate: float) -> None:
     with pytest.raises(ValueError, match="tick rate must be more than 0"):
-        TreeRunner(tree_from(N("Runner")), rate_hz=rate)
+        TickLoop(tree_from(N("Runner")), rate_hz=rate)
 
 
 def test_overrun_does_not_burst() -> None:
@@ -115,7 +115,7 @@ def test_overrun_does_not_burst() -> None:
         pass
 
     tree = tree_from(N("Runner"), clock=clock)
-    runner = TreeRunner(tree, rate_hz=10)
+    runner = TickLoop(tree, rate_hz=10)
     times: list[float] = []
 
     def slow(snapshot: TickSnapshot) -> None:

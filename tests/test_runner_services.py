@@ -19,8 +19,8 @@ import pytest
 from cyborg.bt import Action, NodeRegistry, Status, default_registry
 from cyborg.bus import BusConfig, Context, Node, new_message
 from cyborg.bus.executor import CallbackThread
-from cyborg.nodes.robot import DockState
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.robot.interface import DockState
+from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.fake_robot import FakeRobot
 from tests.system import wait_until, write_tree
 

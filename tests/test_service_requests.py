@@ -26,8 +26,8 @@ from hypothesis import strategies as st
 from cyborg.bus import BusConfig, Context, Node, ServiceError, ServiceTimeoutError, new_message
 from cyborg.bus.services import RequestError
 from cyborg.nav.arnl_map import parse_map
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import NO_PATH, SimulatorNode
-from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 from tests.small_maps import room_map, write
 

@@ -144,7 +144,7 @@ def test_dock_needs_a_dock() -> None:
 def test_loop_paces_simulated_time_by_the_speed_factor() -> None:
     import time
 
-    from cyborg.sim.runner import SimulationLoop
+    from cyborg.sim.loop import SimulationLoop
     sim = Simulator(parse_map(room_map([])), start=Pose2D(2.0, 3.0))
     with pytest.raises(ValueError, match="speed must be positive"):
         SimulationLoop(sim, speed=-1)

@@ -14,8 +14,8 @@ import pytest
 from cyborg.bus import BusConfig, Context, GoalStatus, Node, new_message
 from cyborg.bus.clock import SimClock
 from cyborg.nav.arnl_map import read_map
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import CANCELED, FEEDBACK_PERIOD, NO_PATH, SUCCEEDED, SimulatorNode
-from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
 

@@ -17,16 +17,16 @@ from cyborg.bt import (
     MonotonicClock,
     NodeRegistry,
     Status,
+    TickLoop,
     Tree,
     TreeLoadError,
-    TreeRunner,
     check_file,
     default_registry,
     load_tree,
 )
 from cyborg.bt.problems import Problem
 from cyborg.bt.registry import NodeModuleError
-from cyborg.nodes.robot import ROBOT
+from cyborg.robot.interface import ROBOT
 
 
 def add_parser(commands: Any) -> Any:
@@ -190,7 +190,7 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
 
     The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0."""
     stream = stream or sys.stdout
-    runner = TreeRunner(tree, rate_hz=rate_hz)
+    runner = TickLoop(tree, rate_hz=rate_hz)
     line = StatusLine(tree, stream)
     runner.add_listener(line.update)
     print(f"running {tree.title!r} from {tree.source} ({len(tree)} nodes) at {rate_hz:g} Hz; "

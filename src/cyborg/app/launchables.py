@@ -51,11 +51,11 @@ from cyborg.monitor import (
     read_token,
 )
 from cyborg.nav.arnl_map import MapError, read_map
-from cyborg.nodes.bus_robot import BusMove, BusRobot
-from cyborg.nodes.tree_runner import TreeRunnerNode
+from cyborg.robot.bus_robot import BusMove, BusRobot
+from cyborg.runner.tree_runner import TreeRunnerNode
 from cyborg.sim.battery import Battery
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
-from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
 

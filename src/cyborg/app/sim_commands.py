@@ -21,8 +21,8 @@ from cyborg.bus import Node
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
-from cyborg.sim.runner import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
 

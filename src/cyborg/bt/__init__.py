@@ -10,7 +10,7 @@ Load a tree exported by behavior3editor and tick it::
 
 Write your own nodes by subclassing :class:`Action`, :class:`Condition`, :class:`Decorator` or
 :class:`Composite` and registering them with :func:`register`. Run a tree at a fixed rate with
-:class:`TreeRunner`. This package does no I/O beyond reading tree files and imports nothing
+:class:`TickLoop`. This package does no I/O beyond reading tree files and imports nothing
 else of cyborg.
 """
 
@@ -39,21 +39,70 @@ from cyborg.bt.loader import check_file, load_tree, loads_tree
 from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, NodeType, default_registry, register
-from cyborg.bt.runner import TreeRunner
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+from cyborg.bt.tick_loop import TickLoop
 from cyborg.bt.tree import Tree
 
 __all__ = [
-    "ERROR", "FAILURE", "RUNNING", "SUCCESS",
-    "Action", "Blackboard", "Category", "Clock", "Composite", "Condition", "Decorator",
-    "Delay", "Error", "Failer", "ForceFailure", "ForceSuccess", "Hook", "HookError",
-    "HookMode", "Inverter", "Limiter",
-    "ManualClock", "MaxTime", "MemPriority", "MemSequence", "MonotonicClock", "Node",
-    "NodeRegistry", "NodeType", "Parallel", "Priority", "Problem", "ProjectSpec",
-    "RepeatUntilFailure", "RepeatUntilSuccess", "Repeater", "Retry", "RunOnce", "Runner",
-    "Sequence", "Severity", "Status", "Subtree", "Succeeder", "TickSnapshot", "Timeout", "Tree",
-    "TreeHooks", "TreeLoadError", "TreeRunner", "TreeStructure", "Wait", "check_file",
-    "default_registry", "load_tree", "loads_tree", "parse_project", "read_project", "register",
+    "ERROR",
+    "FAILURE",
+    "RUNNING",
+    "SUCCESS",
+    "Action",
+    "Blackboard",
+    "Category",
+    "Clock",
+    "Composite",
+    "Condition",
+    "Decorator",
+    "Delay",
+    "Error",
+    "Failer",
+    "ForceFailure",
+    "ForceSuccess",
+    "Hook",
+    "HookError",
+    "HookMode",
+    "Inverter",
+    "Limiter",
+    "ManualClock",
+    "MaxTime",
+    "MemPriority",
+    "MemSequence",
+    "MonotonicClock",
+    "Node",
+    "NodeRegistry",
+    "NodeType",
+    "Parallel",
+    "Priority",
+    "Problem",
+    "ProjectSpec",
+    "RepeatUntilFailure",
+    "RepeatUntilSuccess",
+    "Repeater",
+    "Retry",
+    "RunOnce",
+    "Runner",
+    "Sequence",
+    "Severity",
+    "Status",
+    "Subtree",
+    "Succeeder",
+    "TickLoop",
+    "TickSnapshot",
+    "Timeout",
+    "Tree",
+    "TreeHooks",
+    "TreeLoadError",
+    "TreeStructure",
+    "Wait",
+    "check_file",
+    "default_registry",
+    "load_tree",
+    "loads_tree",
+    "parse_project",
+    "read_project",
+    "register",
     "render_title",
 ]

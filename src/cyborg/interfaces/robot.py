@@ -1,5 +1,5 @@
 """The robot's ARNL-like interface: what the simulator (or a bridge to the real robot) serves
-and :class:`~cyborg.nodes.bus_robot.BusRobot` uses.
+and :class:`~cyborg.robot.bus_robot.BusRobot` uses.
 
 Under the robot's namespace (:data:`NAMESPACE`, ``/cyborg`` by default), from a node named
 ``arnl`` (the simulator's; rosarnl's in 2018):

@@ -1,5 +1,5 @@
-"""The tree runner's interface: what :mod:`cyborg.nodes.tree_runner` (with
-:mod:`cyborg.nodes.tree_control`) serves and the monitor (:mod:`cyborg.monitor.source`) uses.
+"""The tree runner's interface: what :mod:`cyborg.runner.tree_runner` (with
+:mod:`cyborg.runner.tree_control`) serves and the monitor (:mod:`cyborg.monitor.source`) uses.
 
 Under the runner's namespace (:data:`NAMESPACE`, ``/cyborg/bt`` by default, as in 2018):
 

@@ -41,7 +41,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.nav.services import NavigationMap, NavigationServices
-from cyborg.sim.runner import SimulationLoop
+from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.simulator import Simulator
 
 SUCCEEDED, FAILED, CANCELED, NO_PATH = (int(MoveOutcome.SUCCEEDED), int(MoveOutcome.FAILED),

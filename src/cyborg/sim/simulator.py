@@ -3,7 +3,7 @@
 The simulator owns simulated time. :meth:`Simulator.step` advances one physics step
 (``physics_rate``, 50 Hz by default); every ``1 / sensor_rate`` seconds it also takes a laser
 scan and lets the navigator and the docking sequence choose the next command. Nothing here waits
-for the wall clock: :class:`cyborg.sim.runner.SimulationLoop` paces it (real time, ``--speed``
+for the wall clock: :class:`cyborg.sim.loop.SimulationLoop` paces it (real time, ``--speed``
 times faster, or as fast as possible)::
 
     sim = Simulator(read_map("AMROffice.map"), start="Dock")

@@ -26,7 +26,7 @@ the move_to_goal action (the robot turns to the goal's heading when the map give
 * cancels its goal when it is halted (a higher-priority branch took over, the tree was
   disabled), so an abandoned MoveTo never leaves the robot driving.
 
-Failures and retries are logged rate-limited (:class:`~cyborg.nodes.rate_limited_log.
+Failures and retries are logged rate-limited (:class:`~cyborg.robot.rate_limited_log.
 RateLimitedLog`): one line per kind per 10 s of wall time, with the count of those left out.
 
 All times are in the tree's clock: simulated seconds when the tree runs on ``/clock``; the
@@ -42,8 +42,7 @@ import math
 from collections.abc import Hashable
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
-from cyborg.nodes.rate_limited_log import RateLimitedLog
-from cyborg.nodes.robot import (
+from cyborg.robot.interface import (
     ROBOT,
     DockState,
     Goal,
@@ -53,8 +52,9 @@ from cyborg.nodes.robot import (
     heading_error,
     robot_of,
 )
+from cyborg.robot.rate_limited_log import RateLimitedLog
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.robot")
 limited = RateLimitedLog(log)
 
 UNREACHABLE = "MoveTo: robot not reachable"

@@ -11,7 +11,7 @@ A patrol-and-recharge tree puts them together as
 * :class:`Charge` docks if the robot is not docked, and stays RUNNING until the charge reaches
   ``target`` percent; it fails when docking fails. It does not undock: the next move does.
   A refusal repeats every tick under the latching guard (the map has no dock): its warning is
-  logged once per 10 s with a count (:mod:`cyborg.nodes.rate_limited_log`).
+  logged once per 10 s with a count (:mod:`cyborg.robot.rate_limited_log`).
 """
 
 from __future__ import annotations
@@ -19,10 +19,10 @@ from __future__ import annotations
 import logging
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Decorator, Status, register
-from cyborg.nodes.rate_limited_log import RateLimitedLog
-from cyborg.nodes.robot import ROBOT, DockState, robot_of
+from cyborg.robot.interface import ROBOT, DockState, robot_of
+from cyborg.robot.rate_limited_log import RateLimitedLog
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.robot")
 limited = RateLimitedLog(log)
 
 DOCK_START_TIMEOUT = 10.0

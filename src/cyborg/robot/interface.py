@@ -2,7 +2,7 @@
 
 Behaviour nodes never talk to the bus themselves. They act through a :class:`Robot`, which the
 tree runner puts in the blackboard's resources (``blackboard.resources["robot"]``) and which
-:func:`robot_of` fetches. :class:`~cyborg.nodes.bus_robot.BusRobot` is the real one (the robot's
+:func:`robot_of` fetches. :class:`~cyborg.robot.bus_robot.BusRobot` is the real one (the robot's
 ARNL-like interface on the bus, simulated or not); tests may pass anything with the same
 methods.
 

@@ -1,6 +1,6 @@
 """Ticking a tree at a fixed rate, with pause, resume, single steps and stop.
 
-    runner = TreeRunner(tree, rate_hz=10)
+    runner = TickLoop(tree, rate_hz=10)
     runner.add_listener(lambda snapshot: print(snapshot.status))
     runner.start()          # ticks in a background thread; or runner.run() to block
     runner.pause()          # ticks stop; RUNNING nodes stay RUNNING (pause(halt=True) halts them)
@@ -30,7 +30,7 @@ log = logging.getLogger("cyborg.bt")
 Listener = Callable[[TickSnapshot], None]
 
 
-class TreeRunner:
+class TickLoop:
     """Ticks a :class:`~cyborg.bt.tree.Tree` at ``rate_hz`` (default 10 Hz, as in 2018)."""
 
     def __init__(self, tree: Tree, *, rate_hz: float = 10.0, clock: Clock | None = None) -> None:

@@ -22,10 +22,10 @@ from typing import Any
 from cyborg.bus import ActionError, ClientGoal, Node, ServiceError, new_message
 from cyborg.interfaces import robot
 from cyborg.nav.geometry import Pose2D
-from cyborg.nodes.rate_limited_log import RateLimitedLog
-from cyborg.nodes.robot import BatteryReading, DockState, Goal, MoveOutcome, RobotError
+from cyborg.robot.interface import BatteryReading, DockState, Goal, MoveOutcome, RobotError
+from cyborg.robot.rate_limited_log import RateLimitedLog
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.robot")
 limited = RateLimitedLog(log)
 
 GOAL = robot.MOVE_TO_GOAL.goal_type
@@ -93,7 +93,7 @@ class BusMove:
 
 
 class BusRobot:
-    """:class:`~cyborg.nodes.robot.Robot` on the bus, for the robot under ``namespace``."""
+    """:class:`~cyborg.robot.interface.Robot` on the bus, for the robot under ``namespace``."""
 
     def __init__(self, node: Node, namespace: str = robot.NAMESPACE, *,
                  timeout: float = 5.0) -> None:

@@ -5,7 +5,7 @@ robot is gone fails ten times a second, and a warning per failure buries everyth
 log (727 warnings in 75 s). :class:`RateLimitedLog` shows the first of a kind at once, counts
 the ones that follow, and shows the next one after ``interval`` seconds with the count::
 
-    limited = RateLimitedLog(logging.getLogger("cyborg.nodes"))
+    limited = RateLimitedLog(logging.getLogger("cyborg.robot"))
     limited.warning(("MoveTo failed", node.uid), "MoveTo %s failed: %s", location, reason)
     # MoveTo room1 failed: no action server
     # ... 10 s later:

@@ -43,7 +43,7 @@ from cyborg.bus.wire import EntityKind, gid
 from cyborg.interfaces import tree_runner
 from cyborg.interfaces.tree_runner import HookAction, HookStatus
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.runner")
 
 ACTIONS = {int(HookAction.DISABLE): HookMode.DISABLE, int(HookAction.FORCE): HookMode.FORCE,
            int(HookAction.BREAKPOINT): HookMode.BREAKPOINT}

@@ -19,7 +19,7 @@ from concurrent.futures import Future
 from typing import Any
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Condition, Status, register
-from cyborg.nodes.robot import ROBOT, robot_of
+from cyborg.robot.interface import ROBOT, robot_of
 
 
 class _Query:

@@ -14,15 +14,15 @@ BlackboardCompare{key,    decorator   tick the child when a blackboard entry mat
 value,equal}
 ========================  ==========  =====================================================
 
-They act on the robot through :class:`~cyborg.nodes.robot.Robot` (see that module); the tree
-runner (:mod:`cyborg.nodes.tree_runner`) provides one on the bus. This package is an entry
+They act on the robot through :class:`~cyborg.robot.interface.Robot` (see that module); the tree
+runner (:mod:`cyborg.runner.tree_runner`) provides one on the bus. This package is an entry
 point of the group ``cyborg.nodes``, so every registry built with
 :func:`cyborg.bt.default_registry` knows these nodes — a user's own package adds nodes the same
 way (see the README).
 """
 
-from cyborg.nodes import battery, blackboard_compare, docking, goals, move_to
-from cyborg.nodes.robot import ROBOT, Robot, RobotError, robot_of
+from cyborg.robot import battery, blackboard_compare, docking, goals, move_to
+from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
 
 __all__ = ["ROBOT", "Robot", "RobotError", "battery", "blackboard_compare", "docking", "goals",
            "move_to", "robot_of"]

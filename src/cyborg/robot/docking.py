@@ -9,7 +9,7 @@ drive to the dock.
 from __future__ import annotations
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
-from cyborg.nodes.robot import ROBOT, DockState, robot_of
+from cyborg.robot.interface import ROBOT, DockState, robot_of
 
 
 class _DockAction(Action):

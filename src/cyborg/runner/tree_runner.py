@@ -20,7 +20,7 @@ name                        type                                what
 ``reload``                  cyborg_msgs/ReloadTree              service: load the file again
 ==========================  ==================================  ==================================
 
-plus the per-node controls of :mod:`cyborg.nodes.tree_control` (hooks, breakpoints, blackboard),
+plus the per-node controls of :mod:`cyborg.runner.tree_control` (hooks, breakpoints, blackboard),
 and the node parameter ``reload_timeout`` (seconds, wall time; default 30).
 
 **Services never wait on each other.** ``enable`` — the stop button — is answered on a thread
@@ -44,7 +44,7 @@ that has not finished after ``reload_timeout`` seconds is answered with ``reload
 ...`` and the running tree keeps running; the load itself cannot be stopped (a thread cannot
 be killed), so it goes on in the background and whatever it ends with is discarded. One reload
 runs at a time, and hanging loads cannot pile up (see
-:mod:`cyborg.nodes.background_reload`). The loader itself refuses files that are not regular
+:mod:`cyborg.runner.background_reload`). The loader itself refuses files that are not regular
 and caps size, nesting and node instances.
 
 **Time.** The tree ticks on the clock it is given: the wall clock, or simulated time from
@@ -65,8 +65,8 @@ from cyborg.bt import (
     Blackboard,
     Clock,
     NodeRegistry,
+    TickLoop,
     Tree,
-    TreeRunner,
     default_registry,
     load_tree,
 )
@@ -74,11 +74,11 @@ from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import Node, SimClock
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
-from cyborg.nodes.background_reload import BackgroundReloads
-from cyborg.nodes.robot import ROBOT, Robot
-from cyborg.nodes.tree_control import TreeControl
+from cyborg.robot.interface import ROBOT, Robot
+from cyborg.runner.background_reload import BackgroundReloads
+from cyborg.runner.tree_control import TreeControl
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.runner")
 
 RELOAD_TIMEOUT = 30.0
 """Seconds (wall time) a reload may take before it is answered with an error."""
@@ -101,7 +101,7 @@ class TreeRunnerNode:
         self.clock = clock
         self.resources: dict[str, Any] = {ROBOT: robot} if robot is not None else {}
         self.tree = self._load(self.path, Blackboard(resources=self.resources))
-        self.runner = TreeRunner(self.tree, rate_hz=rate_hz)
+        self.runner = TickLoop(self.tree, rate_hz=rate_hz)
         self._enabled = enabled
         self._active: tuple[str, ...] | None = None
         self._lock = threading.Lock()

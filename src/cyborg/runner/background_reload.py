@@ -32,7 +32,7 @@ from pathlib import Path
 from cyborg.bt import Tree, TreeLoadError
 from cyborg.bus.services import Responder
 
-log = logging.getLogger("cyborg.nodes")
+log = logging.getLogger("cyborg.runner")
 
 STUCK_RELOADS = 2
 """Timed-out loads that may still be running before further reloads are refused."""
