@@ -5,7 +5,7 @@ actions under a namespace, the message type of each, whether a topic is latched,
 namespace, and the constants that travel in the messages (hook codes, dock states, outcomes).
 When the two sides spell these apart, a renamed topic or a new code breaks one side silently —
 the client waits for a topic nobody publishes. Here each is written once and both sides import
-it, so a rename is a one-line edit and tests/test_interfaces.py checks, on a live bus, that
+it, so a rename is a one-line edit and tests/interfaces/test_contracts.py checks, on a live bus, that
 every client endpoint finds its server.
 
 * :mod:`~cyborg.interfaces.contract` — the descriptors :class:`Topic`, :class:`Service` and

@@ -2,7 +2,7 @@
 :class:`~starlette.staticfiles.StaticFiles` as the documented fallback.
 
 :func:`page_files` gives one or the other; both answer ``get_response(path, scope)`` with the
-same bytes and media types (``tests/test_monitor_static.py`` checks it), an ETag that a reload
+same bytes and media types (``tests/monitor/test_static.py`` checks it), an ETag that a reload
 revalidates (``304``), ``Cache-Control: no-cache`` (a page from an older monitor is never run
 from the browser's cache) and ``404`` for anything else, paths outside the folder included.
 

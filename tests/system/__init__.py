@@ -1,0 +1,1 @@
+"""Whole-system tests: the simulator, tree runner and monitor together."""

@@ -1,0 +1,165 @@
+"""End to end: the shared patrol-and-recharge tree drives the simulated LX for a full battery cycle.
+
+The tree (../shared/trees/patrol_recharge.b3.json) patrols room1, room2, Outside and room4 on
+AMROffice.map; CheckBattery(25) takes over below 25 %: the robot abandons (and cancels) the move
+in progress, drives to the Dock, charges to 95 % and patrols again. Everything runs in one
+process on simulated time, as fast as the machine allows: 13 simulated hours.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+from cyborg.app.cli import build_parser
+from cyborg.app.launch import Launch
+from cyborg.app.launchables import RunningSimulator, RunningTree
+from cyborg.app.up import CAMPUS_TREE, DATA, up_description, up_notes
+from cyborg.bt import SUCCESS, load_tree
+from cyborg.bt.snapshot import TickSnapshot
+from cyborg.bus import BusConfig, Context
+from cyborg.bus.actions import ActionServer, GoalStatus
+from cyborg.sim.simulator import Simulator
+from tests.running_system import running_system, wait_until
+
+HOURS = 13.0
+PATROL = ["room1", "room2", "Outside", "room4"]
+
+
+@dataclass
+class Log:
+    arrivals: list[tuple[float, str]] = field(default_factory=list)
+    abandoned: list[tuple[float, str]] = field(default_factory=list)
+    low_at: float | None = None
+    min_charge: float = 100.0
+    charged_at: float | None = None
+
+    def tick(self, snapshot: TickSnapshot, labels: dict[str, str]) -> None:
+        for uid, status in snapshot.visited:
+            label = labels.get(uid, "")
+            if status is SUCCESS and label.startswith("MoveTo "):
+                self.arrivals.append((snapshot.time, label.removeprefix("MoveTo ")))
+        for uid in snapshot.halted:
+            label = labels.get(uid, "")
+            if label.startswith(("MoveTo ", "Wait ")):
+                self.abandoned.append((snapshot.time, label))
+
+    def sensor(self, sim: Simulator) -> None:
+        charge = sim.battery.charge_percent
+        self.min_charge = min(self.min_charge, charge)
+        if self.low_at is None and charge < 25.0:
+            self.low_at = sim.time
+        if self.low_at is not None and self.charged_at is None and charge >= 95.0:
+            self.charged_at = sim.time
+
+
+@pytest.mark.heavy
+def test_patrol_and_recharge_over_a_full_battery_cycle(shared: Path) -> None:
+    tree = shared / "trees" / "patrol_recharge.b3.json"
+    amroffice = shared / "maps" / "AMROffice.map"
+    log = Log()
+    with running_system(amroffice, tree, speed=0, start="Dock") as system:
+        sim, runner = system.sim, system.runner
+        labels = {node.uid: node.label for node in runner.tree}
+        simulator = system._simulator()
+        simulator.loop.on_sensor.append(log.sensor)
+        runner.runner.add_listener(lambda snapshot: log.tick(snapshot, labels))
+        started = time.monotonic()
+        while sim.time < HOURS * 3600:
+            assert simulator.loop.running, f"the simulation stopped: {simulator.loop.error}"
+            assert time.monotonic() - started < 1200, f"too slow: {sim.time / 3600:.1f} h"
+            time.sleep(0.5)
+        wall = time.monotonic() - started
+        with simulator.loop.lock:
+            bumps, docks, odometer = sim.base.bumps, sim.docking.docks, sim.base.odometer
+            server = next(entity for entity in simulator.node._entities
+                          if isinstance(entity, ActionServer))
+            goals = list(server._goals.values())
+    print(f"\n{HOURS:g} h simulated in {wall:.0f} s ({HOURS * 3600 / wall:.0f}x real time): "
+          f"{len(log.arrivals)} arrivals, {odometer / 1000:.1f} km, {docks} docking(s), "
+          f"lowest charge {log.min_charge:.1f} %")
+
+    # no collision, a real battery cycle: below the threshold, docked, charged, patrolling again
+    assert bumps == 0
+    assert log.low_at is not None and log.charged_at is not None, "no full battery cycle"
+    assert docks >= 1 and log.min_charge > 20.0
+    before = [name for at, name in log.arrivals if at < log.low_at]
+    recharge = [name for at, name in log.arrivals if log.low_at <= at <= log.charged_at]
+    after = [name for at, name in log.arrivals if at > log.charged_at]
+    # patrols the goals in order (each arrival is the next goal of the round)
+    for arrivals in (before, after):
+        rounds = [name for name in arrivals if name != "Dock"]
+        assert rounds == [PATROL[i % len(PATROL)] for i in range(len(rounds))], rounds[:12]
+    assert len(before) >= 4 * len(PATROL), "several full rounds before the battery ran low"
+    assert set(after) >= set(PATROL), "every goal visited again after charging"
+    # going to the dock abandoned the move in progress, and that goal was cancelled
+    assert recharge[:1] == ["Dock"]
+    # (or the Wait between two moves, if the battery ran low just then)
+    abandoned = [label for at, label in log.abandoned if log.low_at <= at <= log.low_at + 5.0]
+    assert abandoned, log.abandoned[:5]
+    if abandoned[0].startswith("MoveTo"):
+        assert abandoned[0].removeprefix("MoveTo ") in PATROL
+    assert any(goal.status is GoalStatus.CANCELED for goal in goals)
+    # no goal left behind: every goal ended except the one being driven now
+    assert sum(not goal.status.terminal for goal in goals) <= 1
+
+
+# ---------------------------------------------------------------------------------- cyborg up
+RECHARGE_WITHIN = 120.0
+"""Wall-clock seconds in which `cyborg up`, on its defaults, shows the recharge (README)."""
+
+
+def _bundled_threshold() -> float:
+    tree = load_tree(Path(str(DATA.joinpath(CAMPUS_TREE))))
+    (guard,) = [node for node in tree if node.name == "CheckBattery"]
+    return float(guard.threshold)  # type: ignore[attr-defined]
+
+
+def test_cyborg_up_starts_just_above_the_recharge_threshold_and_says_so() -> None:
+    args = build_parser().parse_args(["up", "--no-detector"])
+    sim = next(spec for spec in up_description(args).nodes if spec.kind == "simulator")
+    threshold = _bundled_threshold()
+    assert threshold < sim.parameters["battery"] <= threshold + 5, "a recharge soon"
+    assert sim.parameters["speed"] > 1, "faster than real time"
+    notes = "\n".join(up_notes(args))
+    assert f"{sim.parameters['speed']:g}x real time (--speed)" in notes
+    assert f"battery at {sim.parameters['battery']:g} % (--battery)" in notes
+    assert f"below {threshold:g} %" in notes
+    assert all(len(f"  {line}") < 80 for line in notes.splitlines()), "as printed"
+    own = build_parser().parse_args(["up", "--speed", "1", "--battery", "100"])
+    assert "recharge" not in "\n".join(up_notes(own)), "no promise the user's choice breaks"
+
+
+@pytest.mark.heavy
+def test_cyborg_up_on_its_defaults_shows_a_recharge_within_two_minutes() -> None:
+    """What `cyborg up` starts, at its default pace and charge (the monitor and camera left
+    out): the patrol runs, the battery falls below the threshold, the robot docks and charges,
+    all within the wall-clock time the README promises."""
+    args = build_parser().parse_args(["up", "--no-monitor", "--no-detector"])
+    seen: list[str] = []
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(up_description(args), context)
+        started = time.monotonic()
+        launch.start()
+        try:
+            sim = next(item for item in launch.running
+                       if isinstance(item, RunningSimulator)).loop.simulator
+            runner = next(item for item in launch.running if isinstance(item, RunningTree))
+            labels = {node.uid: node.label for node in runner.runner.tree}
+            runner.runner.runner.add_listener(lambda snapshot: seen.extend(
+                labels[uid] for uid in snapshot.active[-1:]))
+            wait_until(lambda: "Charge to 90%" in seen,
+                       timeout=RECHARGE_WITHIN - (time.monotonic() - started),
+                       what="the recharge to start")
+            low = sim.battery.charge_percent
+            wait_until(lambda: sim.battery.charging and sim.battery.charge_percent > low + 0.1,
+                       timeout=max(RECHARGE_WITHIN - (time.monotonic() - started), 1.0),
+                       what="the battery to charge")
+        finally:
+            launch.stop()
+    assert low < _bundled_threshold()
+    patrol = seen[:seen.index("MoveTo Charger")]
+    assert {"MoveTo Lecture hall", "MoveTo Library"} <= set(patrol), "the patrol came first"
