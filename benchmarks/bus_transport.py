@@ -132,8 +132,8 @@ def frames_over_bus(node: Node, frames: int) -> tuple[list[int], list[int]]:
         done.clear()
         stamp = time.monotonic_ns()
         # built as the camera node builds them, sharing the arrays' memory
-        image_pub.publish(bgr_to_image(node.types, image, stamp, "zed_left"))
-        depth_pub.publish(depth_to_image(node.types, depth, stamp, "zed_left"))
+        image_pub.publish(bgr_to_image(image, stamp, "zed_left"))
+        depth_pub.publish(depth_to_image(depth, stamp, "zed_left"))
         if not done.wait(5):
             raise RuntimeError("no frame latency reported within 5 s")
         time.sleep(FRAME_PERIOD)
@@ -171,7 +171,7 @@ def in_process(frames: int, *, inline: bool = False) -> tuple[list[int], list[in
             got.wait(1)
         for _ in range(frames * 10):
             got.clear()
-            image_pub.publish(bgr_to_image(context.types, image, time.monotonic_ns(),
+            image_pub.publish(bgr_to_image(image, time.monotonic_ns(),
                                            "zed_left"))
             got.wait(1)
         return small, big

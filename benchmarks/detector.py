@@ -24,7 +24,9 @@ Measured in one run, on this machine:
   detector takes them, none dropped). The camera sends as soon as the window allows: a
   streaming run starts with two frames published back to back.
 * **ours, one process**: the same camera and detector nodes on one bus context, as
-  ``cyborg up`` runs them (in-process delivery: the frame is handed over, not copied).
+  ``cyborg up`` runs them (in-process delivery: the frame is handed over, not copied, and the
+  detector's callback runs on the detector node's own thread, not the camera's). One frame in
+  flight and streaming.
 * **drawn or not**: the node draws (and publishes) the annotated image only while someone
   subscribes to ``detection_image``. By default a viewer in the detector's process does; the
   "nothing drawn" configurations (streaming, and one process) run without it.
@@ -96,8 +98,9 @@ CONFIGURATIONS = {
     "streaming": "ours, 2 processes, streaming",
     "streaming_plain": "ours, 2 processes, streaming, nothing drawn",
     "lockstep": "ours, 2 processes, 1 frame in flight",
-    "in_process": "ours, 1 process",
-    "in_process_plain": "ours, 1 process, nothing drawn",
+    "in_process": "ours, 1 process, 1 frame in flight",
+    "in_process_streaming": "ours, 1 process, streaming",
+    "in_process_plain": "ours, 1 process, streaming, nothing drawn",
     "old_streaming": "2018, 2 processes, streaming",
     "old_lockstep": "2018, 2 processes, 1 frame in flight"}
 
@@ -174,7 +177,8 @@ def measure(model: Path, threads: int, quick: bool) -> Results:
             runs["bare_2018"].add(old.bare(40 // scale))
             runs["pipeline"].add(pipeline.paired(200 // scale, draw=True))
             runs["pipeline_plain"].add(pipeline.paired(200 // scale, draw=False))
-            runs["in_process"].add(in_process.run(200 // scale, 2))
+            runs["in_process"].add(in_process.run(100 // scale, 1))
+            runs["in_process_streaming"].add(in_process.run(200 // scale, 2))
             runs["in_process_plain"].add(in_process.run(200 // scale, 2, draw=False))
             runs["lockstep"].add(two.run(100 // scale, 1))
             runs["streaming"].add(two.run(250 // scale, 2))
@@ -274,7 +278,7 @@ def report(results: Results, markdown: bool) -> None:
     keys = ("lockstep", "streaming", "in_process", "in_process_plain", "old_lockstep")
     header: tuple[str, ...] = (
         "stage", "ours, 2 processes", "ours, 2 processes, streaming (a)", "ours, 1 process",
-        "ours, 1 process, nothing drawn", "2018, 2 processes", "2018 / ours")
+        "ours, 1 process, streaming, nothing drawn (a)", "2018, 2 processes", "2018 / ours")
     rows = []
     for stage in STAGES:
         ours, old = runs["lockstep"].stage(stage)[0], runs["old_lockstep"].stage(stage)[0]
@@ -288,9 +292,10 @@ def report(results: Results, markdown: bool) -> None:
                  *(f"{quantiles(runs[key].detections)[0]:.0f}" for key in keys), ""))
     _table(header, rows, markdown)
     print("\n(a) two frames in flight: transport includes the wait in the detector's queue while "
-          "the frame before is processed. Other columns: one frame in flight (ours, 1 process: "
-          "two, but delivery is synchronous). Nothing drawn: no subscriber to detection_image. "
-          "2018: message → frame is part of transport (unpickling).")
+          "the frame before is processed (in one process too: the frame is handed to the "
+          "detector node's own thread and waits there). Other columns: one frame in flight. "
+          "Nothing drawn: no subscriber to detection_image. 2018: message → frame is part of "
+          "transport (unpickling).")
 
     limit = full_speed_limit(runs)
     print("\nThroughput and latency (FPS: median over rounds, lowest and highest in brackets; "
@@ -302,7 +307,8 @@ def report(results: Results, markdown: bool) -> None:
             (CONFIGURATIONS["bare_2018"], f"{1000 / bare_2018:.1f}", "", f"{bare_2018:.2f}", "",
              "1.00x", "")]
     for key in ("pipeline", "pipeline_plain", "streaming", "streaming_plain", "lockstep",
-                "in_process", "in_process_plain", "old_streaming", "old_lockstep"):
+                "in_process", "in_process_streaming", "in_process_plain", "old_streaming",
+                "old_lockstep"):
         run = runs[key]
         own_bare = bare_2018 if key.startswith("old") else bare
         spread = f" ({min(run.fps_rounds):.0f} to {max(run.fps_rounds):.0f})"
@@ -322,7 +328,7 @@ def report(results: Results, markdown: bool) -> None:
               f"{FULL_SPEED:.2f}x the run's fastest tenth); from the table's medians "
               f"{(run.per_frame_ms / bare - 1) * 100:.0f} % "
               f"(goal <= {GOAL_OVERHEAD * 100:.0f} %: {_goal(overhead <= GOAL_OVERHEAD)})")
-    for key in ("streaming", "streaming_plain", "in_process", "in_process_plain"):
+    for key in ("streaming", "streaming_plain", "in_process_streaming", "in_process_plain"):
         run = runs[key]
         overhead = run.per_frame_ms / bare - 1
         fps, count = run.fps_at_full_speed(limit)
@@ -335,7 +341,7 @@ def report(results: Results, markdown: bool) -> None:
     latency = (quantiles(runs["old_lockstep"].latency)[0]
                / quantiles(runs["lockstep"].latency)[0])
     print(f"ours / 2018: {runs['streaming'].fps / old:.1f}x the frames per second (two "
-          f"processes, streaming), {runs['in_process'].fps / old:.1f}x in one process; "
+          f"processes, streaming), {runs['in_process_streaming'].fps / old:.1f}x in one process; "
           f"{latency:.1f}x lower latency (two processes, one frame in flight)")
     lost = ", ".join(f"{run.lost} of {run.frames + run.lost} ({run.name})"
                      for run in runs.values() if run.lost)

@@ -144,9 +144,8 @@ class Camera:
 
     def send(self, stamp: int, index: int) -> None:
         image, depth = self.frames[index % len(self.frames)]
-        types = self.node.types
-        self.image.publish(bgr_to_image(types, image, stamp, "camera_left"))
-        self.depth.publish(depth_to_image(types, depth, stamp, "camera_left"))
+        self.image.publish(bgr_to_image(image, stamp, "camera_left"))
+        self.depth.publish(depth_to_image(depth, stamp, "camera_left"))
 
     def run(self, count: int, window: int) -> Run:
         self.offer = Offer(window)

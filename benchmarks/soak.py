@@ -27,12 +27,13 @@ from pathlib import Path
 
 from cyborg.app.cli import build_parser
 from cyborg.app.launch import Launch
-from cyborg.app.launchables import RunningSimulator, RunningTree
 from cyborg.app.memory import limit_malloc_arenas
 from cyborg.app.up import up_description
 from cyborg.bt import SUCCESS
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import BusConfig, Context
+from cyborg.runner.component import RunningTree
+from cyborg.sim.component import RunningSimulator
 
 
 def rss_mib() -> float:

@@ -12,9 +12,11 @@ from pathlib import Path
 from typing import Any
 
 from cyborg.app.launch import Launch, LaunchDescription
-from cyborg.app.launchables import NodeSpec, RunningSimulator, RunningTree
 from cyborg.bus import BusConfig, Context, Node, new_message
+from cyborg.bus.component import NodeSpec
+from cyborg.runner.component import RunningTree
 from cyborg.runner.tree_runner import TreeRunnerNode
+from cyborg.sim.component import RunningSimulator
 from cyborg.sim.simulator import Simulator
 
 

@@ -17,8 +17,10 @@ import pytest
 
 from cyborg.app.cli import main
 from cyborg.app.launch import Launch, read_launch
-from cyborg.app.launchables import LaunchError, RunningSimulator, RunningTree
 from cyborg.bus import BusConfig, Context, SimClock
+from cyborg.bus.component import LaunchError
+from cyborg.runner.component import RunningTree
+from cyborg.sim.component import RunningSimulator
 from tests.running_system import interruptible
 
 

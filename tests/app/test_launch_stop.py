@@ -14,8 +14,8 @@ from typing import Any, cast
 import pytest
 
 from cyborg.app.launch import Launch, LaunchDescription
-from cyborg.app.launchables import RunningTree
 from cyborg.bus import BusConfig, Context, GoalStatus, Node, Qos
+from cyborg.runner.component import RunningTree
 from tests.app.test_launch import _free_port, _launch_file
 from tests.running_system import interruptible, wait_until
 

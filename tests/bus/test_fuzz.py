@@ -31,6 +31,7 @@ from rosbags.interfaces import Nodetype
 from cyborg.bus import Context, Node, SimClock, doorbell, new_message
 from cyborg.bus.clock import CLOCK_TYPE
 from cyborg.bus.shm import PREFIX, SHM_DIR, SlotRef
+from cyborg.bus.topics import Subscription
 from cyborg.bus.wire import Attachment, EntityKind
 from tests.bus.bus_peer import linked_contexts, raw_call, raw_put, ring, until_subscribed, wait_for
 
@@ -268,7 +269,8 @@ def references() -> st.SearchStrategy[bytes]:
 @given(data=st.data())
 def test_garbage_slot_references_through_zenoh(target: Target, data: st.DataObject) -> None:
     topic = data.draw(st.sampled_from(sorted(TOPICS)))
-    subscription = next(e for e in target.node._entities if getattr(e, "topic", "") == topic)
+    subscription = next(e for e in target.node._entities
+                        if isinstance(e, Subscription) and e.topic == topic)
     target.attacker.session.put(target.victim.shm_key(subscription.key),
                                 data.draw(references()), attachment=data.draw(attachments()))
 

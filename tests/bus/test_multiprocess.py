@@ -181,7 +181,7 @@ def test_parameters_list_get_set_with_callbacks(bus: Context, spawn: Any) -> Non
     changes, changed = collect(node, "/robot/changes", "std_msgs/msg/String", Qos.latched())
     assert wait_until(lambda: "/robot/peer_params" in bus.graph.nodes(), 10)
     client = ParameterClient(node, "/robot/peer_params")
-    assert client._clients["get_parameters"].wait_for_service(10)
+    assert client.wait_for_service(10)
     assert client.names() == ["classes", "confidence_threshold"]
     assert client.get(["confidence_threshold", "classes"]) == {
         "confidence_threshold": 0.5, "classes": ["person"]}

@@ -23,6 +23,7 @@ from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.msgs.std_srvs.srv import SetBool
+from cyborg.interfaces import robot
 
 
 def typed(node: Node) -> None:
@@ -36,6 +37,9 @@ def typed(node: Node) -> None:
     goal = action.send_goal(MoveToGoal.Goal(goal_name="x", pose=Pose2D(x=0.0, y=0.0, theta=0.0),
                                             use_heading=False))
     print(goal.result()[1].outcom)  # action
+    robot.POSE.publisher(node).publish(String(data="x"))  # contract publishing
+    robot.POSE.subscription(node, lambda message: message.thta)  # contract receiving
+    print(robot.DOCK.client(node).call(robot.DOCK.service_type.Request()).mesage)  # contract call
 
 
 def fine(node: Node) -> None:
@@ -43,6 +47,9 @@ def fine(node: Node) -> None:
     chatter.publish(String(data="hello"))
     node.create_subscription("chatter", String, lambda message: print(message.data))
     print(node.create_client("enable", SetBool).call(SetBool.Request(data=True)).success)
+    robot.POSE.publisher(node).publish(Pose2D(x=1.0, y=2.0, theta=0.0))
+    robot.POSE.subscription(node, lambda message: print(message.theta))
+    print(robot.DOCK.client(node).call(robot.DOCK.service_type.Request()).message)
 
 
 def by_name(node: Node) -> None:  # type names give Any: nothing is checked here
@@ -60,9 +67,16 @@ EXPECTED = {
                  'maybe "success"?',
     "# action": '"cyborg_msgs__action__MoveToGoal_Result" has no attribute "outcom"; '
                 'maybe "outcome"?',
+    "# contract publishing": 'Argument 1 to "publish" of "Publisher" has incompatible type '
+                             '"std_msgs__msg__String"; expected "geometry_msgs__msg__Pose2D"',
+    "# contract receiving": '"geometry_msgs__msg__Pose2D" has no attribute "thta"; '
+                            'maybe "theta"?',
+    "# contract call": '"std_srvs__srv__Trigger_Response" has no attribute "mesage"; '
+                       'maybe "message"?',
 }
 """The error strict mypy reports on each marked line of the snippet, and no other: a typo at
-each boundary and the wrong message class for a publisher; none in ``fine`` (no false alarm)
+each boundary and the wrong message class for a publisher, also through a contract's
+descriptor (:mod:`cyborg.interfaces`); none in ``fine`` (no false alarm)
 nor in ``by_name`` (typed Any)."""
 
 

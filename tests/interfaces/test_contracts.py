@@ -216,13 +216,20 @@ def test_qos_follows_the_contract() -> None:
 
 
 def test_every_type_in_the_contracts_is_known() -> None:
+    """The classes the descriptors carry are the bus's own, under the names the graph shows."""
     types = MessageTypes()
     for topic in (*robot.TOPICS, *tree_runner.TOPICS, *detector.CAMERA_STREAMS.values(),
                   *detector.DETECTOR_TOPICS):
-        types.message_class(topic.type_name)
+        assert types.message_class(topic.type_name) is topic.message_type, topic
     for service in (*robot.SERVICES, *tree_runner.SERVICES):
         assert service.type_name in types.services, service
-    assert robot.MOVE_TO_GOAL.type_name in types.actions
+        assert types.message_class(service.request_type) is service.service_type.Request
+        assert types.message_class(service.response_type) is service.service_type.Response
+    move = robot.MOVE_TO_GOAL
+    assert move.type_name in types.actions
+    assert [types.message_class(name) for name in (
+        move.goal_type, move.result_type, move.feedback_type)] == [
+        move.action_type.Goal, move.action_type.Result, move.action_type.Feedback]
 
 
 # ---------------------------------------------------------------------- constants

@@ -13,12 +13,14 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, Page, sync_playwright
 
-from cyborg.app.launchables import NodeSpec, RunningTree, start_tree_runner
+from cyborg.app.launchables import KINDS
 from cyborg.bt.node import Node as BtNode
 from cyborg.bt.status import FAILURE, RUNNING, Status
 from cyborg.bus import Node
+from cyborg.bus.component import NodeSpec
 from cyborg.monitor import Monitor
 from cyborg.monitor.monitor import _lan_address
+from cyborg.runner.component import RunningTree
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.monitor.browser import (
     CAMPUS_TREE,
@@ -345,7 +347,7 @@ def test_the_page_follows_a_restarted_runner_a_reload_and_a_dropped_connection(
     system.launch.running.remove(running)
     _wait_page(page, "document.getElementById('banner').textContent.includes('not running')")
     screenshot(page, "runner_gone")
-    restarted = start_tree_runner(system.context, NodeSpec(
+    restarted = KINDS["tree_runner"](system.context, NodeSpec(
         "tree_runner", "tree_runner", "/cyborg/bt",
         {"tree_file": str(CAMPUS_TREE), "use_sim_time": True, "robot_namespace": "/cyborg"}))
     system.launch.running.append(restarted)

@@ -17,10 +17,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from starlette.websockets import WebSocketDisconnect
 
-from cyborg.app.launchables import LaunchError, NodeSpec, start_monitor
 from cyborg.bus import BusConfig, Context, Node
+from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.bus.wire import EntityKind
 from cyborg.monitor.client import QUEUE_BYTES, Client
+from cyborg.monitor.component import start as start_monitor
 from cyborg.monitor.limits import (
     DEPTH_LIMIT,
     MESSAGE_LIMIT,

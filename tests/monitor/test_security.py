@@ -16,12 +16,14 @@ from starlette.testclient import WebSocketDenialResponse
 from starlette.websockets import WebSocketDisconnect
 
 from cyborg.app.cli import build_parser
-from cyborg.app.launchables import NodeSpec, RunningMonitor, start_monitor
 from cyborg.app.monitor_commands import monitor_description
 from cyborg.app.up import up_description
 from cyborg.bus import BusConfig, Context, Node
+from cyborg.bus.component import NodeSpec
 from cyborg.monitor import Monitor
 from cyborg.monitor.access import HostPolicy, TokenError, own_origin, read_token
+from cyborg.monitor.component import RunningMonitor
+from cyborg.monitor.component import start as start_monitor
 from cyborg.monitor.monitor import _lan_address
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.server import create_app

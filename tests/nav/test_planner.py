@@ -33,11 +33,12 @@ def test_path_length_progress_and_messages() -> None:
     rest = path.advance_to(2.0, -0.1)
     assert rest.length == pytest.approx(5.0) and rest.points[0].tolist() == [2.0, 0.0]
     assert len(path.sample(0.0, 7.0, 1.0)) == 7
-    types = MessageTypes()
-    back = Path.from_message(path.to_message(types))
+    message = path.to_message()
+    assert type(message) is MessageTypes().message_class("nav_msgs/msg/Path")  # the bus's own
+    back = Path.from_message(message)
     np.testing.assert_allclose(back.points, path.points)
     assert back.final_heading == pytest.approx(1.0)
-    assert Pose2D.from_message(Pose2D(1, 2, 0.5).to_pose().to_message(types)) == pytest.approx(
+    assert Pose2D.from_message(Pose2D(1, 2, 0.5).to_pose().to_message()) == pytest.approx(
         Pose2D(1, 2, 0.5))
     with pytest.raises(ValueError, match="at least one point"):
         Path([])

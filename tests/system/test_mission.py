@@ -16,12 +16,13 @@ import pytest
 
 from cyborg.app.cli import build_parser
 from cyborg.app.launch import Launch
-from cyborg.app.launchables import RunningSimulator, RunningTree
 from cyborg.app.up import CAMPUS_TREE, DATA, up_description, up_notes
 from cyborg.bt import SUCCESS, load_tree
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import BusConfig, Context
 from cyborg.bus.actions import ActionServer, GoalStatus
+from cyborg.runner.component import RunningTree
+from cyborg.sim.component import RunningSimulator
 from cyborg.sim.simulator import Simulator
 from tests.running_system import running_system, wait_until
 

@@ -139,17 +139,17 @@ def test_distance_is_nan_without_depth_and_frames_pair_by_exact_stamp(bus: Conte
     person = photo("astronaut")
     holes = np.full(person.shape[:2], np.nan, np.float32)
     holes[::2] = np.inf
-    image_pub.publish(bgr_to_image(bus.types, person, 1_000, "cam"))  # never gets its depth
-    depth_pub.publish(depth_to_image(bus.types, holes, 2_000, "cam"))
-    image_pub.publish(bgr_to_image(bus.types, person, 2_000, "cam"))
+    image_pub.publish(bgr_to_image(person, 1_000, "cam"))  # never gets its depth
+    depth_pub.publish(depth_to_image(holes, 2_000, "cam"))
+    image_pub.publish(bgr_to_image(person, 2_000, "cam"))
     assert wait_for(lambda: predictions)
     (found,) = predictions[-1].predictions
     assert found.label == "person" and math.isnan(found.distance)
     assert predictions[-1].image_header.stamp.nanosec == 2_000
     assert detector_node.dropped == 1 and detector_node.processed == 1
-    wrong = depth_to_image(bus.types, np.ones((10, 10), np.float32), 3_000, "cam")
+    wrong = depth_to_image(np.ones((10, 10), np.float32), 3_000, "cam")
     depth_pub.publish(wrong)
-    image_pub.publish(bgr_to_image(bus.types, person, 3_000, "cam"))
+    image_pub.publish(bgr_to_image(person, 3_000, "cam"))
     assert wait_for(lambda: detector_node.failed == 1), "a wrong-size depth map is refused"
     assert detector_node.processed == 1
 
@@ -315,7 +315,8 @@ def test_cyborg_up_detects_the_motorcycle_in_the_sample_stereo_frames() -> None:
 
 def test_launch_kinds_refuse_bad_sources_and_models_naming_the_entry(bus: Context,
                                                                        tmp_path: Path) -> None:
-    from cyborg.app.launchables import LaunchError, NodeSpec, starter_for
+    from cyborg.app.launchables import starter_for
+    from cyborg.bus.component import LaunchError, NodeSpec
 
     def start(kind: str, parameters: dict[str, Any]) -> Any:
         spec = NodeSpec(kind, kind, "/cyborg", parameters, base=tmp_path,
@@ -373,11 +374,11 @@ def test_bus_source_pairs_camera_topics_into_frames(bus: Context) -> None:
     left = np.zeros((4, 6, 3), np.uint8)
     left[1, 2] = (1, 2, 3)
     depth = np.full((4, 6), 1.25, np.float32)
-    image_pub.publish(bgr_to_image(bus.types, left, 10, "cam"))  # its depth never comes
+    image_pub.publish(bgr_to_image(left, 10, "cam"))  # its depth never comes
     assert reader.callbacks.flush()  # keep-last 2: a burst of three could drop one
     for stamp in (20, 30):
-        depth_pub.publish(depth_to_image(bus.types, depth * stamp, stamp, "cam"))
-        image_pub.publish(bgr_to_image(bus.types, left, stamp, "cam"))
+        depth_pub.publish(depth_to_image(depth * stamp, stamp, "cam"))
+        image_pub.publish(bgr_to_image(left, stamp, "cam"))
         assert reader.callbacks.flush()
     frames = list(source)  # ends after 0.5 s without a frame
     assert [frame.stamp_ns for frame in frames] == [20, 30]
@@ -387,7 +388,7 @@ def test_bus_source_pairs_camera_topics_into_frames(bus: Context) -> None:
     wrong = BusSource(reader, CameraTopics("/bad/image", "/bad/depth"), idle_timeout=0.5)
     bad = camera.create_publisher("/bad/image", "sensor_msgs/msg/Image")
     bad_depth = camera.create_publisher("/bad/depth", "sensor_msgs/msg/Image")
-    bad_depth.publish(depth_to_image(bus.types, np.ones((2, 2), np.float32), 5, "cam"))
-    bad.publish(bgr_to_image(bus.types, left, 5, "cam"))
+    bad_depth.publish(depth_to_image(np.ones((2, 2), np.float32), 5, "cam"))
+    bad.publish(bgr_to_image(left, 5, "cam"))
     with pytest.raises(VisionError, match="bus /bad/image: depth map is 2x2 but the image is"):
         list(wrong)

@@ -135,7 +135,7 @@ def test_without_a_depth_publisher_the_detector_runs_image_only_and_says_so_afte
     def frame(stamp: int, at: float) -> None:
         clock.now = at
         count = detector_node.processed
-        image.publish(bgr_to_image(bus.types, person, stamp, "cam"))
+        image.publish(bgr_to_image(person, stamp, "cam"))
         assert wait_for(lambda: detector_node.processed > count and len(predictions) >= stamp)
 
     frame(1, 100.0)  # no publisher of depth: the image alone is detected, at once
@@ -166,11 +166,11 @@ def test_a_silent_depth_publisher_is_waited_for_5_s_then_named_and_detection_goe
     def publish(stamp: int, at: float, *, with_depth: bool = False) -> None:
         clock.now = at
         if with_depth:
-            depth.publish(depth_to_image(bus.types, three_metres, stamp, "cam"))
-        image.publish(bgr_to_image(bus.types, person, stamp, "cam"))
+            depth.publish(depth_to_image(three_metres, stamp, "cam"))
+        image.publish(bgr_to_image(person, stamp, "cam"))
         assert detector_node.node.callbacks.flush()  # handled at this clock time
 
-    depth.publish(depth_to_image(bus.types, three_metres, 999, "cam"))  # matches no image
+    depth.publish(depth_to_image(three_metres, 999, "cam"))  # matches no image
     publish(1, 100.0)
     publish(2, 104.0)
     assert not wait_for(lambda: predictions, timeout=0.5), \

@@ -1,6 +1,8 @@
-"""Who may open and control the web monitor, from the command line (``cyborg monitor``,
-``cyborg up``): the names the page answers to and the token that lets other machines control.
-See docs/security.md."""
+"""Who may open and control the web monitor, from the command line.
+
+For ``cyborg monitor`` and ``cyborg up``: the names the page answers to and the token that lets
+other machines control. See docs/security.md.
+"""
 
 from __future__ import annotations
 

@@ -26,12 +26,16 @@ from cyborg.bt import (
 )
 from cyborg.bt.problems import Problem
 from cyborg.bt.registry import NodeModuleError
+from cyborg.bt.tick_loop import DEFAULT_RATE
 from cyborg.robot.interface import ROBOT
 
 
 def add_parser(commands: Any) -> Any:
-    """``cyborg bt`` and its offline subcommands; returns the group, to which
-    :mod:`cyborg.app.cli` adds the tree runner's (:mod:`cyborg.app.runner_commands`)."""
+    """Adds ``cyborg bt`` and its offline subcommands; returns their group.
+
+    :mod:`cyborg.app.cli` adds the tree runner's subcommands to the group
+    (:mod:`cyborg.app.runner_commands`).
+    """
     bt = commands.add_parser("bt", help="behaviour trees: validate, run, export",
                              description="Work with behavior3editor exports.")
     sub = bt.add_subparsers(dest="bt_command", metavar="SUBCOMMAND", required=True)
@@ -79,8 +83,8 @@ def _file_options(parser: argparse.ArgumentParser) -> None:
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """``--rate``, ``--ticks`` and ``--fast``, shared by every command that runs a tree."""
-    parser.add_argument("--rate", type=float, default=10.0, metavar="HZ",
-                        help="tree ticks per second (default 10)")
+    parser.add_argument("--rate", type=float, default=DEFAULT_RATE, metavar="HZ",
+                        help=f"tree ticks per second (default {DEFAULT_RATE:g})")
     parser.add_argument("--ticks", type=int, default=None, metavar="N",
                         help="stop after N ticks (default: run until Ctrl-C)")
     parser.add_argument("--fast", action="store_true",
@@ -102,6 +106,7 @@ def run_clock(args: argparse.Namespace) -> Clock:
 
 
 def registry_for(args: argparse.Namespace) -> NodeRegistry:
+    """The node types trees may use: the installed ones and those of ``--nodes``."""
     registry = default_registry()
     try:
         registry.import_modules(args.nodes)
@@ -111,6 +116,7 @@ def registry_for(args: argparse.Namespace) -> NodeRegistry:
 
 
 def print_problems(problems: list[Problem], stream: TextIO) -> None:
+    """Prints ``problems`` to ``stream``, one a line, by file and line."""
     for problem in sorted(problems, key=lambda p: (p.source, p.line or 0)):
         print(problem, file=stream)
 
@@ -128,6 +134,7 @@ def _load(args: argparse.Namespace, **options: Any) -> Tree | None:
 
 
 def validate_command(args: argparse.Namespace) -> int:
+    """``cyborg bt validate``: every problem of a tree file; 1 if one is an error."""
     problems = check_file(args.file, tree=args.tree, registry=registry_for(args),
                           stub_missing=args.stub_missing)
     errors = sum(p.is_error for p in problems)
@@ -151,6 +158,7 @@ def _problem_json(problem: Problem) -> dict[str, Any]:
 
 
 def run_command(args: argparse.Namespace) -> int:
+    """``cyborg bt run``: ticks a tree file in the foreground with a live status line."""
     problem = run_options_problem(args)
     if problem is not None:
         print(problem, file=sys.stderr)
@@ -172,8 +180,10 @@ _HOW_TO_GIVE = {
 
 
 def missing_resources_line(tree: Tree, source: str) -> str:
-    """One line naming the nodes that need a resource the tree lacks and how to give it;
-    empty when nothing is missing."""
+    """One line naming the nodes that need a resource the tree lacks, and how to give it.
+
+    Empty when nothing is missing.
+    """
     parts = []
     for key, nodes in tree.missing_resources().items():
         names = sorted({node.name for node in nodes})
@@ -186,9 +196,10 @@ def missing_resources_line(tree: Tree, source: str) -> str:
 
 def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
              until_done: bool = False, stream: TextIO | None = None) -> int:
-    """Tick ``tree`` in the foreground with a status line until done or Ctrl-C.
+    """Ticks ``tree`` in the foreground with a status line until done or Ctrl-C.
 
-    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0."""
+    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0.
+    """
     stream = stream or sys.stdout
     runner = TickLoop(tree, rate_hz=rate_hz)
     line = StatusLine(tree, stream)
@@ -222,6 +233,7 @@ def _write(text: str, output: Path | None) -> None:
 
 
 def dot_command(args: argparse.Namespace) -> int:
+    """``cyborg bt dot``: the tree as a Graphviz DOT graph."""
     tree = _load(args)
     if tree is None:
         return 1
@@ -230,6 +242,7 @@ def dot_command(args: argparse.Namespace) -> int:
 
 
 def json_command(args: argparse.Namespace) -> int:
+    """``cyborg bt json``: the tree's structure as JSON."""
     tree = _load(args)
     if tree is None:
         return 1
@@ -238,6 +251,7 @@ def json_command(args: argparse.Namespace) -> int:
 
 
 def nodes_command(args: argparse.Namespace) -> int:
+    """``cyborg bt nodes``: the node types trees can use, with their properties."""
     registry = registry_for(args)
     for node_type in registry.types():
         params = ", ".join(

@@ -38,16 +38,18 @@ from cyborg.bus import (
     new_message,
     to_plain,
 )
-from cyborg.bus.config import BusConfigError
+from cyborg.bus.config import DEFAULT_ROUTER, BusConfigError
 from cyborg.bus.wire import EntityKind
 
 ARRAY_PREVIEW = 16
+"""Items of an array ``topic echo`` prints unless ``--full``."""
 
 
 def add_parser(commands: Any) -> None:
+    """Adds ``cyborg router``, ``node``, ``topic`` and ``service`` to the commands."""
     router = commands.add_parser("router", help="run a Zenoh router for the bus")
     router.add_argument("--listen", action="append", default=[], metavar="ENDPOINT",
-                        help="where to listen (default tcp/127.0.0.1:7447; tcp/[::]:7447 for "
+                        help=f"where to listen (default {DEFAULT_ROUTER}; tcp/[::]:7447 for "
                              "other machines)")
     router.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                         help="another router to link to (repeatable)")
@@ -103,7 +105,8 @@ def _group(commands: Any, name: str, text: str) -> Any:
 
 
 def router_command(args: argparse.Namespace) -> int:
-    listen = args.listen or ["tcp/127.0.0.1:7447"]
+    """``cyborg router``: a Zenoh router for the bus, until Ctrl-C."""
+    listen = args.listen or [DEFAULT_ROUTER]
     try:
         context = Context(BusConfig.router(listen, args.connect))
     except BusConfigError as exc:
@@ -120,6 +123,7 @@ def router_command(args: argparse.Namespace) -> int:
 
 
 def node_list(args: argparse.Namespace) -> int:
+    """``cyborg node list``: the nodes alive on the bus now."""
     with open_context(args) as context:
         for name in context.graph.nodes():
             print(name)
@@ -127,6 +131,7 @@ def node_list(args: argparse.Namespace) -> int:
 
 
 def node_info(args: argparse.Namespace) -> int:
+    """``cyborg node info``: a node's publishers, subscriptions and services."""
     with open_context(args) as context:
         if args.name not in context.graph.nodes():
             raise CommandError(f"no node {args.name!r} (see `cyborg node list`)")
@@ -143,12 +148,14 @@ def node_info(args: argparse.Namespace) -> int:
 
 
 def topic_list(args: argparse.Namespace) -> int:
+    """``cyborg topic list``: the topics on the bus, with their types if asked."""
     with open_context(args) as context:
         _print_names(context.graph.topics(), args.show_types)
     return 0
 
 
 def service_list(args: argparse.Namespace) -> int:
+    """``cyborg service list``: the services on the bus, with their types if asked."""
     with open_context(args) as context:
         _print_names(context.graph.services(), args.show_types)
     return 0
@@ -191,7 +198,10 @@ def _shorten(data: Any, full: bool) -> Any:
 
 
 def topic_echo(args: argparse.Namespace) -> int:
-    """Print a topic's messages; the type and the durability to ask for come from the graph."""
+    """``cyborg topic echo``: a topic's messages as YAML.
+
+    The type and the durability to ask for come from the graph.
+    """
     limit = 1 if args.once else args.count
     with open_context(args) as context:
         started = time.monotonic()
@@ -222,6 +232,7 @@ def topic_echo(args: argparse.Namespace) -> int:
 
 
 def topic_pub(args: argparse.Namespace) -> int:
+    """``cyborg topic pub``: publishes a message given as YAML, once, N times or on."""
     times = 1 if args.once else args.times
     if args.rate <= 0:
         raise CommandError(f"--rate must be positive, not {args.rate}")
@@ -244,6 +255,7 @@ def topic_pub(args: argparse.Namespace) -> int:
 
 
 def topic_hz(args: argparse.Namespace) -> int:
+    """``cyborg topic hz``: the rate a topic's messages arrive at, every second."""
     with open_context(args) as context:
         started = time.monotonic()
         type_name = args.type or topic_type(context.graph, context.types, args.topic,
@@ -260,6 +272,7 @@ def topic_hz(args: argparse.Namespace) -> int:
 
 
 def service_call(args: argparse.Namespace) -> int:
+    """``cyborg service call``: calls a service with a request given as YAML."""
     if args.type and args.type.lstrip().startswith("{"):  # NAME VALUES, type from the graph
         args.type, args.values = None, args.type
     with open_context(args) as context:

@@ -38,8 +38,10 @@ def absolute(name: str) -> str:
 
 def topic_type(graph: Graph, known: MessageTypes, topic: str, *, command: str,
                timeout: float | None) -> str:
-    """The type of ``topic``, waiting up to ``timeout`` seconds (``None``: for ever) for an
-    endpoint to appear; ``command`` (``cyborg topic echo``) is quoted in the hint."""
+    """The type of ``topic``, waiting up to ``timeout`` seconds for an endpoint to appear.
+
+    ``timeout`` None waits for ever; ``command`` (``cyborg topic echo``) is quoted in the hint.
+    """
     topic = absolute(topic)
     types = await_types(
         graph, lambda graph: graph.topics().get(topic, set()),

@@ -33,19 +33,24 @@ def add_bus_options(parser: argparse.ArgumentParser) -> None:
 
 def add_join_command(group: Any, name: str, text: str,
                      handler: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
-    """A subcommand of ``group`` that joins the bus to look or call: ``--connect`` and
-    ``--wait`` come with it (:func:`open_context` reads them)."""
+    """A subcommand of ``group`` that joins the bus to look or call.
+
+    ``--connect`` and ``--wait`` come with it (:func:`open_context` reads them).
+    """
     parser: argparse.ArgumentParser = group.add_parser(name, help=text)
     parser.set_defaults(handler=handler)
     parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                        help="router to join (default $CYBORG_CONNECT or tcp/127.0.0.1:7447)")
+                        help=f"router to join (default $CYBORG_CONNECT or {DEFAULT_ROUTER})")
     parser.add_argument("--wait", type=float, default=1.0, metavar="S",
                         help="seconds to wait for the graph to fill (default 1)")
     return parser
 
 
 def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
-    """Join the given router, or be the router at ``listen`` (or join the one already there)."""
+    """A context joining the given router, or being the router at ``listen``, and where it is.
+
+    If a router already runs at ``listen``, the context joins it.
+    """
     try:
         if connect:
             return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"

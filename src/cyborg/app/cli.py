@@ -46,6 +46,7 @@ from cyborg.app.memory import limit_malloc_arenas
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``cyborg`` command's parser, with every subcommand."""
     parser = argparse.ArgumentParser(
         prog="cyborg", description="Control stack for the NTNU Cyborg robot.")
     parser.add_argument("--version", action="version", version=f"cyborg {__version__}")
@@ -63,6 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Runs the ``cyborg`` command with ``argv`` and returns its exit code."""
     limit_malloc_arenas()  # before any thread starts: keeps a long run's memory flat
     parser = build_parser()
     args = parser.parse_args(argv)

@@ -38,11 +38,14 @@ from cyborg.vision import (
     open_source,
 )
 from cyborg.vision.annotate import caption
+from cyborg.vision.detector import DEFAULT_BACKEND, DEFAULT_CONFIDENCE, DEFAULT_IOU
+from cyborg.vision.file_sources import DEFAULT_RATE
 from cyborg.vision.models import CATALOGUE, DEFAULT_MODEL, cache_dir, fetch, find_model
 from cyborg.vision.pipeline import STAGES
 
 
 def add_parser(commands: Any) -> None:
+    """Adds ``cyborg detect`` (and ``cyborg detect models``) to the commands."""
     detect = commands.add_parser(
         "detect", help="detect objects (with distance) in images, videos, bags or the bus",
         description="Run the object detector on a source and report labelled boxes with "
@@ -58,15 +61,18 @@ def add_parser(commands: Any) -> None:
     model.add_argument("--family", default=None,
                        help="yolox, yolov5, yolov7, yolov8, yolo11, yolov10, darknet "
                             "(default: from the model)")
-    model.add_argument("--backend", choices=("onnxruntime", "opencv"), default="onnxruntime")
+    model.add_argument("--backend", choices=("onnxruntime", "opencv"), default=DEFAULT_BACKEND,
+                       help=f"the network's runtime (default {DEFAULT_BACKEND})")
     model.add_argument("--weights", type=Path, default=None, help="Darknet .weights file")
     model.add_argument("--labels", type=Path, default=None,
                        help="class names, one per line (default: COCO)")
     model.add_argument("--threads", type=int, default=0, help="inference threads (0: auto)")
     model.add_argument("--input-size", type=int, default=None,
                        help="input size for models with a dynamic one")
-    model.add_argument("--confidence", type=float, default=0.5, help="threshold (0.5)")
-    model.add_argument("--iou", type=float, default=0.45, help="NMS overlap threshold (0.45)")
+    model.add_argument("--confidence", type=float, default=DEFAULT_CONFIDENCE,
+                       help=f"threshold ({DEFAULT_CONFIDENCE:g})")
+    model.add_argument("--iou", type=float, default=DEFAULT_IOU,
+                       help=f"NMS overlap threshold ({DEFAULT_IOU:g})")
     model.add_argument("--classes", default="", help="labels to keep, comma-separated")
     source = detect.add_argument_group("source")
     source.add_argument("--right", type=Path, default=None, help="right image of a pair")
@@ -74,8 +80,9 @@ def add_parser(commands: Any) -> None:
                         help="depth map of an image (.npy metres, 16-bit PNG millimetres)")
     source.add_argument("--side-by-side", action="store_true",
                         help="frames hold left and right side by side (ZED)")
-    source.add_argument("--rate", type=float, default=30.0,
-                        help="frames per second of image folders (stamps; default 30)")
+    source.add_argument("--rate", type=float, default=DEFAULT_RATE,
+                        help=f"frames per second of image folders (stamps; default "
+                             f"{DEFAULT_RATE:g})")
     source.add_argument("--image-topic", default=None, help="bag topic of the image")
     source.add_argument("--depth-topic", default=None, help="bag or bus topic of depth")
     source.add_argument("--right-topic", default=None, help="bag or bus topic of the right "
@@ -107,6 +114,7 @@ def add_parser(commands: Any) -> None:
 
 
 def detect_command(args: argparse.Namespace) -> int:
+    """``cyborg detect``: the objects in a source, or ``models list|fetch``."""
     try:
         if args.source == "models":
             return models_command(args)
@@ -119,6 +127,7 @@ def detect_command(args: argparse.Namespace) -> int:
 
 
 def build_pipeline(args: argparse.Namespace) -> DetectionPipeline:
+    """The detector the options ask for, with depth from a stereo pair where one is given."""
     classes = frozenset(name.strip() for name in args.classes.split(",") if name.strip())
     if not 0 <= args.confidence <= 1 or not 0 <= args.iou <= 1:
         raise CommandError("--confidence and --iou are between 0 and 1")
@@ -214,6 +223,7 @@ def frame_record(result: Result) -> dict[str, Any]:
 
 def summary(stream: TextIO, frames: int, labels: Counter[str], stage_sums: dict[str, float],
             dropped: int, writer: FrameWriter) -> None:
+    """Prints what was found in how many frames, the time per stage, and where frames went."""
     found = ", ".join(f"{label} {count}" for label, count in labels.most_common()) or "nothing"
     per_frame = sum(stage_sums.values()) / frames
     stages = "  ".join(f"{stage} {stage_sums[stage] / frames * 1e3:.1f}" for stage in STAGES)
@@ -227,6 +237,7 @@ def summary(stream: TextIO, frames: int, labels: Counter[str], stage_sums: dict[
 
 
 def models_command(args: argparse.Namespace) -> int:
+    """``cyborg detect models``: lists the known models, or fetches one."""
     action, *names = args.models_args or ["list"]
     if action == "list":
         for model in CATALOGUE.values():

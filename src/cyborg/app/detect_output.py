@@ -9,6 +9,7 @@ import cv2
 import numpy as np
 
 from cyborg.app.errors import CommandError
+from cyborg.vision.file_sources import DEFAULT_RATE
 from cyborg.vision.image_files import IMAGE_SUFFIXES, VIDEO_SUFFIXES
 from cyborg.vision.pipeline import Result
 
@@ -18,7 +19,8 @@ _FOURCC = {".mp4": "mp4v", ".m4v": "mp4v", ".mov": "mp4v", ".avi": "MJPG", ".mkv
 class FrameWriter:
     """Writes each result's annotated image to ``path`` (or shows it with ``show``)."""
 
-    def __init__(self, path: Path | None, *, show: bool = False, rate: float = 30.0) -> None:
+    def __init__(self, path: Path | None, *, show: bool = False,
+                 rate: float = DEFAULT_RATE) -> None:
         self.path, self.show, self.rate = path, show, rate
         self.wanted = path is not None or show
         self._video: cv2.VideoWriter | None = None
@@ -33,6 +35,7 @@ class FrameWriter:
             raise CommandError(f"--out {path}: folder {path.parent} does not exist")
 
     def write(self, result: Result) -> None:
+        """Writes (or shows) the result's annotated image, if it has one."""
         image = result.annotated
         if image is None:
             return
@@ -76,6 +79,7 @@ class FrameWriter:
                                "to write the frames instead") from exc
 
     def close(self) -> None:
+        """Finishes the video and closes the window, if any."""
         if self._video is not None:
             self._video.release()
         if self.show:

@@ -7,7 +7,7 @@ A launch file is TOML (or YAML with the same keys)::
     # connect = ["tcp/10.0.0.5:7447"]  # join a router elsewhere
 
     [[node]]
-    kind = "simulator"                 # see cyborg.app.launchables for kinds and parameters
+    kind = "simulator"                 # see cyborg.app.launchables for the kinds
     name = "arnl"
     namespace = "/cyborg"
     process = "robot"                  # nodes with the same process share one (default "main")
@@ -51,21 +51,32 @@ from typing import Any
 
 import yaml
 
-from cyborg.app.launchables import LaunchError, NodeSpec, Running, RunningTree, starter_for
+from cyborg.app.launchables import starter_for
 from cyborg.bus import Context
+from cyborg.bus.component import LaunchError, NodeSpec, Running
 from cyborg.bus.config import DEFAULT_ROUTER
+from cyborg.interfaces import robot
+from cyborg.runner.component import RunningTree
 
 log = logging.getLogger("cyborg.app")
+"""The logger of the launch's steps (``-v`` shows them)."""
 
 NODE_KEYS = {"kind", "name", "namespace", "process", "parameters"}
+"""The fields a ``[[node]]`` entry may have."""
 
 
 @dataclass
 class LaunchDescription:
+    """What to start: the components, in which processes, on which bus."""
+
     nodes: list[NodeSpec]
+    """The components, in the order they start."""
     connect: list[str] = field(default_factory=list)
+    """Routers to join; none: be the router at :attr:`listen`."""
     listen: str = DEFAULT_ROUTER
+    """Where to be the bus's router (or join the one already there)."""
     source: str = "<built in>"
+    """The launch file, which child processes read again."""
 
     def processes(self) -> list[str]:
         """Process names in order of first appearance, ``main`` first."""
@@ -73,8 +84,20 @@ class LaunchDescription:
         return list(dict.fromkeys(names))
 
 
+def under_robot(namespace: str, default: str) -> str:
+    """A component's default namespace, moved from the default robot's to ``namespace``.
+
+    ``default`` lies under the robot's default namespace (``/cyborg``); the same place under
+    the robot ``namespace`` is returned: ``/cyborg/bt`` under ``/robot1`` is ``/robot1/bt``.
+    """
+    if default != robot.NAMESPACE and not default.startswith(robot.NAMESPACE + "/"):
+        raise ValueError(f"{default} is not under the robot's namespace {robot.NAMESPACE}")
+    base = "/" + namespace.strip("/")
+    return (base.rstrip("/") + default.removeprefix(robot.NAMESPACE)) or "/"
+
+
 def read_launch(path: Path) -> LaunchDescription:
-    """Parse and check a launch file; :class:`LaunchError` names the file, node and field."""
+    """The launch file at ``path``, checked; :class:`LaunchError` names the file, node and field."""
     try:
         text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as Notepad writes
     except OSError as exc:
@@ -98,6 +121,7 @@ def read_launch(path: Path) -> LaunchDescription:
 
 
 def parse_launch(data: Any, path: Path) -> LaunchDescription:
+    """Checks the parsed content of the launch file ``path`` and makes it a description."""
     if not isinstance(data, dict):
         raise LaunchError(f"{path}: expected a table with [[node]] entries")
     unknown = set(data) - {"bus", "node"}
@@ -154,7 +178,7 @@ class Launch:
 
     def start(self, process: str = "main", *, children: list[str] | None = None,
               connect: str = "") -> None:
-        """Start this process's nodes (stopping what started if one fails), then children."""
+        """Starts this process's nodes (stopping what started if one fails), then children."""
         try:
             for spec in self.description.nodes:
                 if spec.process == process:
@@ -173,14 +197,18 @@ class Launch:
             self.children.append((name, subprocess.Popen(command)))
 
     def describe(self) -> list[str]:
+        """What runs: each component's lines, then each child process."""
         lines = [item.describe() for item in self.running]
         lines += [f"process      {name} (pid {child.pid}): cyborg launch --process {name}"
                   for name, child in self.children]
         return lines
 
     def wait(self, duration: float | None = None, *, parent: int | None = None) -> int:
-        """Wait for Ctrl-C / SIGTERM (or ``duration`` seconds, or a child dying, or, for a
-        child, its ``parent`` process ending: a launch killed outright leaves no orphans)."""
+        """Waits for Ctrl-C or SIGTERM, or ``duration`` seconds; returns the exit code.
+
+        It ends too when a child dies, or, in a child, when its ``parent`` process has ended:
+        a launch killed outright leaves no orphans.
+        """
         previous = signal.signal(signal.SIGTERM, _interrupt)
         started = time.monotonic()
         try:
@@ -202,7 +230,7 @@ class Launch:
         return 0
 
     def stop(self) -> None:
-        """Stop what this launch started, each part while the parts it needs are still there.
+        """Stops what this launch started, each part while the parts it needs are still there.
 
         1. Tree runners, last started first. Each halts its tree: a running MoveTo cancels its
            goal and the runner waits (up to 5 s) until the robot has confirmed, so the robot
@@ -214,7 +242,8 @@ class Launch:
            way.
 
         :attr:`stopping` says which part is stopping now (for :func:`end_if_stuck`); with
-        ``-v`` each step is logged."""
+        ``-v`` each step is logged.
+        """
         trees = [item for item in self.running if isinstance(item, RunningTree)]
         others = [item for item in self.running if not isinstance(item, RunningTree)]
         for item in [*reversed(trees), *reversed(others)]:
@@ -242,9 +271,12 @@ STOP_DEADLINE = 20.0
 
 
 def end_if_stuck(launch: Launch, deadline: float = STOP_DEADLINE) -> None:
-    """For a command about to stop ``launch`` and exit: Ctrl-C always ends the process. If it
-    is still alive ``deadline`` seconds from now, what was stopping and every thread's stack
-    go to stderr and the process exits with code 1. (Not for a process that goes on.)"""
+    """Ends the process if stopping ``launch`` takes longer than ``deadline`` seconds.
+
+    For a command about to stop ``launch`` and exit, so that Ctrl-C always ends the process:
+    if it is still alive ``deadline`` seconds from now, what was stopping and every thread's
+    stack go to stderr and the process exits with code 1. (Not for a process that goes on.)
+    """
     def overdue() -> None:
         time.sleep(deadline)
         print(f"cyborg: still stopping after {deadline:g} s, at: {launch.stopping}; the "
@@ -259,9 +291,12 @@ def _interrupt(signum: int, frame: object) -> None:
 
 
 def as_child() -> None:
-    """Signals for a launch's child process: SIGTERM (its parent's stop) interrupts it; SIGINT
-    is ignored, since a terminal's Ctrl-C reaches the whole job and the parent stops its
-    children only once its own tree runners have halted."""
+    """Sets the signals of a launch's child process.
+
+    SIGTERM (its parent's stop) interrupts it; SIGINT is ignored, since a terminal's Ctrl-C
+    reaches the whole job and the parent stops its children only once its own tree runners
+    have halted.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _interrupt)
 

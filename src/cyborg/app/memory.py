@@ -26,7 +26,7 @@ _M_ARENA_MAX = -8  # mallopt's parameter number, from glibc's malloc.h
 
 
 def limit_malloc_arenas(arenas: int = ARENAS) -> bool:
-    """Limit glibc's malloc to ``arenas`` arenas; True if it was done.
+    """Limits glibc's malloc to ``arenas`` arenas; True if it was done.
 
     Call it early, before the process starts its threads: arenas made already stay.
     """

@@ -25,48 +25,56 @@ from typing import Any
 from cyborg.app.access_options import access_parameters, add_access_options
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.launch import LaunchDescription
-from cyborg.app.node_spec import NodeSpec
 from cyborg.app.system import run_system
-from cyborg.monitor import DEFAULT_HOST, DEFAULT_PORT
+from cyborg.bus.component import NodeSpec
+from cyborg.monitor import component as monitor
 
 TOKEN_IN_PS = ("cyborg: warning: --token shows in `ps` to every user of this machine; prefer "
                "--token-file PATH or CYBORG_MONITOR_TOKEN")
+"""The warning ``--token`` gets."""
 
 
 def add_parser(commands: Any) -> None:
-    monitor = commands.add_parser(
+    """Adds ``cyborg monitor`` to the commands."""
+    parser = commands.add_parser(
         "monitor", help="serve the web monitor for running behaviour trees",
         description="Serve a web page that shows the running behaviour trees live and "
                     "controls them (run/pause, disable, force, breakpoints).")
-    monitor.add_argument("--port", type=int, default=DEFAULT_PORT,
-                         help=f"web server port (default {DEFAULT_PORT}; 0: any free port)")
-    monitor.add_argument("--host", default=DEFAULT_HOST,
-                         help=f"address to listen on (default {DEFAULT_HOST}: this machine "
-                              "only; 0.0.0.0: every interface, for other machines)")
-    monitor.add_argument("--namespace", action="append", default=[], metavar="NS",
-                         help="tree runner namespace to follow (repeatable; default "
-                              "/cyborg/bt); others on the bus are offered too")
-    add_access_options(monitor)
-    monitor.add_argument("--token", default=None,
-                         help="the token itself (shows in `ps`: prefer --token-file or "
-                              "$CYBORG_MONITOR_TOKEN)")
-    add_bus_options(monitor)
-    monitor.set_defaults(handler=monitor_command)
+    parser.add_argument("--port", type=int, default=monitor.PORT,
+                        help=f"web server port (default {monitor.PORT}; 0: any free port)")
+    parser.add_argument("--host", default=monitor.HOST,
+                        help=f"address to listen on (default {monitor.HOST}: this machine "
+                             "only; 0.0.0.0: every interface, for other machines)")
+    parser.add_argument("--namespace", action="append", default=[], metavar="NS",
+                        help="tree runner namespace to follow (repeatable; default "
+                             f"{', '.join(monitor.TREES)}); others on the bus are offered too")
+    add_access_options(parser)
+    parser.add_argument("--token", default=None,
+                        help="the token itself (shows in `ps`: prefer --token-file or "
+                             "$CYBORG_MONITOR_TOKEN)")
+    add_bus_options(parser)
+    parser.set_defaults(handler=monitor_command)
 
 
 def monitor_description(args: argparse.Namespace) -> LaunchDescription:
-    """What ``cyborg monitor`` starts. A ``--token`` is passed on in memory only (the monitor
-    never makes it a bus parameter), with a warning that it shows in ``ps``."""
-    namespaces = ["/" + namespace.strip("/") for namespace in args.namespace] or ["/cyborg/bt"]
+    """What ``cyborg monitor`` starts, as a launch description.
+
+    A ``--token`` is passed on in memory only (the monitor never makes it a bus parameter),
+    with a warning that it shows in ``ps``.
+    """
+    namespaces = ["/" + namespace.strip("/") for namespace in args.namespace] \
+        or list(monitor.TREES)
     parameters: dict[str, Any] = {"trees": namespaces, "port": args.port, "host": args.host,
                                   **access_parameters(args)}
     if args.token:
         print(TOKEN_IN_PS, file=sys.stderr)
         parameters["token"] = args.token
     return LaunchDescription(
-        [NodeSpec("monitor", "monitor", "/cyborg", parameters, where="cyborg monitor")],
+        [NodeSpec("monitor", monitor.NAME, monitor.NAMESPACE, parameters,
+                  where="cyborg monitor")],
         list(args.connect), args.listen or DEFAULT_ROUTER)
 
 
 def monitor_command(args: argparse.Namespace) -> int:
+    """``cyborg monitor``: serves the web monitor until Ctrl-C."""
     return run_system(monitor_description(args), args, title="cyborg monitor")

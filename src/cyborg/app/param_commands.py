@@ -43,11 +43,13 @@ def _client(args: argparse.Namespace, run: Callable[[ParameterClient], None]) ->
 
 
 def param_list(args: argparse.Namespace) -> int:
+    """``cyborg param list``: the names of a node's parameters."""
     return _client(args, lambda client: print(
         "\n".join(f"  {name}" for name in client.names())))
 
 
 def param_get(args: argparse.Namespace) -> int:
+    """``cyborg param get``: a parameter's value, as YAML."""
     def show(client: ParameterClient) -> None:
         value = client.get([args.name])[args.name]
         print(yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("..."
@@ -56,6 +58,7 @@ def param_get(args: argparse.Namespace) -> int:
 
 
 def param_set(args: argparse.Namespace) -> int:
+    """``cyborg param set``: sets a parameter to a value given as YAML."""
     try:
         value = yaml.safe_load(args.value)
     except yaml.YAMLError as exc:

@@ -16,14 +16,17 @@ import time
 from typing import Literal, TextIO
 
 Unit = Literal["frames", "bytes"]
+"""What a bar counts."""
 
 BAR_WIDTH = (10, 40)
 """Narrowest and widest bar, in columns; narrower than this, no bar is drawn."""
 
 
 def terminal_width() -> int:
-    """Columns a line may use: the terminal's (``$COLUMNS`` first, else 80) less the last one,
-    where a character would make some terminals wrap."""
+    """The columns a line may use: the terminal's (``$COLUMNS`` first, else 80) less one.
+
+    A character in the last column would make some terminals wrap.
+    """
     return shutil.get_terminal_size((80, 24)).columns - 1
 
 
@@ -44,6 +47,8 @@ def duration(seconds: float) -> str:
 
 
 class ProgressBar:
+    """A progress line on ``stream``, counting ``unit`` up to ``total`` (None: unknown)."""
+
     def __init__(self, stream: TextIO, total: int | None, unit: Unit = "frames") -> None:
         self.stream, self.total, self.unit = stream, total, unit
         self.live = stream.isatty()
@@ -84,6 +89,7 @@ class ProgressBar:
         return line
 
     def update(self, done: int, extra: str = "") -> None:
+        """Sets the count to ``done``; redraws when due, with ``extra`` text at the end."""
         self.done, self._updated = done, True
         now = time.monotonic()
         interval = 0.1 if self.live else 10.0
@@ -100,7 +106,7 @@ class ProgressBar:
         self.stream.flush()
 
     def finish(self, extra: str = "") -> None:
-        """Draw the last state and end the line; nothing if there was never an update."""
+        """Draws the last state and ends the line; nothing if there was never an update."""
         if not self._updated:
             return
         self._write(extra)

@@ -1,4 +1,4 @@
-"""The arithmetic of ``cyborg topic hz``: a window of arrival times and the rate it shows.
+r"""The arithmetic of ``cyborg topic hz``: a window of arrival times and the rate it shows.
 
 Pure and clock-injected, so it is tested without a bus. The command calls :meth:`RateWindow.
 arrived` from the subscription callback and :meth:`RateWindow.report` once per report period,
@@ -24,9 +24,12 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
-WINDOW_SIZE = 1000  # arrival times kept, the newest
-STALE_GAPS = 3.0    # a silence this many mean gaps long ends the window
-LONE_LIMIT = 10.0   # seconds a lone arrival waits for a second one
+WINDOW_SIZE = 1000
+"""The arrival times kept, the newest."""
+STALE_GAPS = 3.0
+"""A silence this many mean gaps long ends the window."""
+LONE_LIMIT = 10.0
+"""Seconds a lone arrival waits for a second one."""
 
 
 @dataclass(frozen=True)
@@ -54,15 +57,18 @@ class RateWindow:
         self._lock = threading.Lock()
 
     def arrived(self) -> None:
-        """Note a message arriving now."""
+        """Notes a message arriving now."""
         stamp = self._clock()
         with self._lock:
             self._stamps.append(stamp)
             self._new = True
 
     def report(self) -> Rate | None:
-        """The rate over the window, or None when there is none to show: no message since the
-        last report (the window is dropped if the silence is long enough), or only one."""
+        """The rate over the window, or None when there is none to show.
+
+        None when no message came since the last report (the window is dropped if the silence
+        is long enough), or only one.
+        """
         now = self._clock()
         with self._lock:
             new, self._new = self._new, False

@@ -1,10 +1,14 @@
 """``cyborg bt serve|reload|enable|disable``: a tree runner on the bus, and its controls.
 
+::
+
     cyborg bt serve patrol.b3.json --use-sim-time      # tick it; topics under /cyborg/bt
     cyborg bt reload                                   # load the same file again
     cyborg bt reload other.b3.json                     # or another one
     cyborg bt disable                                  # halt: the robot stops
     cyborg bt enable                                   # start afresh
+
+The runner is the tree runner component (:mod:`cyborg.runner.component`), with its defaults.
 """
 
 from __future__ import annotations
@@ -16,14 +20,15 @@ from typing import Any
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options, open_context
 from cyborg.app.errors import CommandError
 from cyborg.app.launch import LaunchDescription
-from cyborg.app.node_spec import NodeSpec
 from cyborg.app.system import run_system
 from cyborg.bus import Node, ServiceError, new_message
-
-RUNNER_NAMESPACE = "/cyborg/bt"
+from cyborg.bus.component import NodeSpec
+from cyborg.interfaces import Service, tree_runner
+from cyborg.runner import component as runner
 
 
 def add_parsers(sub: Any) -> None:
+    """Adds ``serve``, ``reload``, ``enable`` and ``disable`` to ``cyborg bt``'s group."""
     serve = sub.add_parser("serve", help="run a tree on the bus, with its topics and services",
                            description="Tick a tree as the robot's tree runner: latched "
                                        "structure, active ids, enabled flag, per-tick status, "
@@ -31,11 +36,12 @@ def add_parsers(sub: Any) -> None:
     serve.add_argument("file", type=Path, help="behavior3editor export")
     serve.add_argument("--tree", metavar="ID|TITLE", default="",
                        help="the tree to run (default: the file's selectedTree)")
-    serve.add_argument("--rate", type=float, default=10.0, metavar="HZ", help="ticks per second")
-    serve.add_argument("--namespace", default=RUNNER_NAMESPACE,
-                       help=f"the runner's namespace (default {RUNNER_NAMESPACE})")
-    serve.add_argument("--robot-namespace", default="/cyborg",
-                       help="the robot's namespace (default /cyborg)")
+    serve.add_argument("--rate", type=float, default=runner.RATE, metavar="HZ",
+                       help=f"ticks per second (default {runner.RATE:g})")
+    serve.add_argument("--namespace", default=runner.NAMESPACE,
+                       help=f"the runner's namespace (default {runner.NAMESPACE})")
+    serve.add_argument("--robot-namespace", default=runner.ROBOT_NAMESPACE,
+                       help=f"the robot's namespace (default {runner.ROBOT_NAMESPACE})")
     serve.add_argument("--use-sim-time", action="store_true",
                        help="tick on simulated time from /clock")
     serve.add_argument("--disabled", action="store_true", help="start disabled")
@@ -51,16 +57,17 @@ def add_parsers(sub: Any) -> None:
         if name == "reload":
             parser.add_argument("file", nargs="?", type=Path, default=None,
                                 help="another file to run (default: the same file)")
-        parser.add_argument("--namespace", default=RUNNER_NAMESPACE,
-                            help=f"the runner's namespace (default {RUNNER_NAMESPACE})")
+        parser.add_argument("--namespace", default=runner.NAMESPACE,
+                            help=f"the runner's namespace (default {runner.NAMESPACE})")
         parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                             help="router to join (default $CYBORG_CONNECT or "
-                                 "tcp/127.0.0.1:7447)")
+                                 f"{DEFAULT_ROUTER})")
         parser.add_argument("--wait", type=float, default=0.5, help=argparse.SUPPRESS)
         parser.set_defaults(handler=control_command, action=name)
 
 
 def serve_command(args: argparse.Namespace) -> int:
+    """``cyborg bt serve``: a tree runner on the bus until Ctrl-C."""
     parameters: dict[str, Any] = {
         "tree_file": str(args.file.resolve()), "tree": args.tree, "rate": args.rate,
         "use_sim_time": args.use_sim_time, "robot_namespace": args.robot_namespace,
@@ -68,19 +75,22 @@ def serve_command(args: argparse.Namespace) -> int:
     if args.nodes:
         parameters["nodes"] = list(args.nodes)
     description = LaunchDescription(
-        [NodeSpec("tree_runner", "tree_runner", args.namespace, parameters, where=str(args.file))],
+        [NodeSpec("tree_runner", runner.NAME, args.namespace, parameters,
+                  where=str(args.file))],
         list(args.connect), args.listen or DEFAULT_ROUTER)
     return run_system(description, args, title="cyborg bt serve")
 
 
 def control_command(args: argparse.Namespace) -> int:
+    """``cyborg bt reload|enable|disable``: calls the running tree runner's service."""
     namespace = "/" + args.namespace.strip("/")
     if args.action == "reload":
-        service, kind = f"{namespace}/reload", "cyborg_msgs/srv/ReloadTree"
+        contract: Service[Any, Any] = tree_runner.RELOAD
         fields: dict[str, Any] = {"path": str(args.file.resolve()) if args.file else ""}
     else:
-        service, kind = f"{namespace}/enable", "std_srvs/srv/SetBool"
+        contract = tree_runner.ENABLE
         fields = {"data": args.action == "enable"}
+    service, kind = contract.full_name(namespace), contract.type_name
     with open_context(args) as context:
         node = Node("cyborg_bt", context=context)
         client = node.create_client(service, kind)

@@ -1,9 +1,13 @@
 """``cyborg sim`` (the simulated robot as a bus node) and ``cyborg nav`` (maps offline).
 
+::
+
     cyborg sim --map AMROffice.map [--speed 10] [--start Dock] [--namespace /cyborg]
     cyborg sim --map AMROffice.map --speed 0 --duration 3600   # an hour, flat out
     cyborg nav goals AMROffice.map
     cyborg nav plan AMROffice.map Dock room1        # names, or x,y[,heading] in metres/degrees
+
+``cyborg sim`` runs the simulator component (:mod:`cyborg.sim.component`), with its defaults.
 """
 
 from __future__ import annotations
@@ -17,34 +21,36 @@ from typing import Any
 
 from cyborg.app.bus_options import DEFAULT_ROUTER, bus_context
 from cyborg.app.errors import CommandError
-from cyborg.bus import Node
+from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
-from cyborg.sim.loop import SimulationLoop
-from cyborg.sim.node import SimulatorNode
-from cyborg.sim.simulator import Simulator
+from cyborg.sim import component as sim
 
 
 def add_parser(commands: Any) -> None:
-    sim = commands.add_parser("sim", help="run the simulated robot on an ARNL map",
-                              description="Simulate the Pioneer LX on a map and serve it on "
-                                          "the bus with an ARNL-like interface.")
-    sim.add_argument("--map", type=Path, required=True, metavar="FILE", help="ARNL .map file")
-    sim.add_argument("--speed", type=float, default=1.0, metavar="X",
-                     help="simulated seconds per wall-clock second (0: as fast as possible)")
-    sim.add_argument("--start", default=None, metavar="NAME",
-                     help="home, goal or dock to start at (default: the map's home, else "
-                          "its dock, else the free point nearest the map's centre)")
-    sim.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
-    sim.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                     help="join the router there instead of being one")
-    sim.add_argument("--listen", default=DEFAULT_ROUTER, metavar="ENDPOINT",
-                     help=f"be the bus's router there (default {DEFAULT_ROUTER}); if a router "
-                          "already runs there, join it")
-    sim.add_argument("--duration", type=float, default=None, metavar="SECONDS",
-                     help="stop after this much simulated time")
-    sim.set_defaults(handler=sim_command)
+    """Adds ``cyborg sim`` and ``cyborg nav`` to the commands."""
+    parser = commands.add_parser("sim", help="run the simulated robot on an ARNL map",
+                                 description="Simulate the Pioneer LX on a map and serve it "
+                                             "on the bus with an ARNL-like interface.")
+    parser.add_argument("--map", type=Path, required=True, metavar="FILE",
+                        help="ARNL .map file")
+    parser.add_argument("--speed", type=float, default=sim.SPEED, metavar="X",
+                        help=f"simulated seconds per wall-clock second (default {sim.SPEED:g}; "
+                             "0: as fast as possible)")
+    parser.add_argument("--start", default=None, metavar="NAME",
+                        help="home, goal or dock to start at (default: the map's home, else "
+                             "its dock, else the free point nearest the map's centre)")
+    parser.add_argument("--namespace", default=sim.NAMESPACE,
+                        help=f"the robot's namespace (default {sim.NAMESPACE})")
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="join the router there instead of being one")
+    parser.add_argument("--listen", default=DEFAULT_ROUTER, metavar="ENDPOINT",
+                        help=f"be the bus's router there (default {DEFAULT_ROUTER}); if a "
+                             "router already runs there, join it")
+    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                        help="stop after this much simulated time")
+    parser.set_defaults(handler=sim_command)
 
     nav = commands.add_parser("nav", help="goals and paths of an ARNL map")
     actions = nav.add_subparsers(dest="nav_command", metavar="COMMAND", required=True)
@@ -60,6 +66,7 @@ def add_parser(commands: Any) -> None:
 
 
 def load(path: Path) -> ArnlMap:
+    """The map at ``path``; an error names the file and line."""
     try:
         return read_map(path)
     except MapError as exc:
@@ -85,6 +92,7 @@ def pose_argument(arnl_map: ArnlMap, text: str) -> Pose2D:
 
 
 def goals_command(args: argparse.Namespace) -> int:
+    """``cyborg nav goals``: the goals and docks of a map, with their poses."""
     arnl_map = load(args.map)
     print(f"{'name':24} {'kind':16} {'x m':>9} {'y m':>9} {'heading':>8}  description")
     for item in arnl_map.goals():
@@ -95,6 +103,7 @@ def goals_command(args: argparse.Namespace) -> int:
 
 
 def plan_command(args: argparse.Namespace) -> int:
+    """``cyborg nav plan``: a path's length between two places, or why there is none."""
     arnl_map = load(args.map)
     start, goal = pose_argument(arnl_map, args.start), pose_argument(arnl_map, args.goal)
     result = Planner(arnl_map).plan(start, goal)
@@ -110,31 +119,34 @@ def plan_command(args: argparse.Namespace) -> int:
 
 
 def sim_command(args: argparse.Namespace) -> int:
+    """``cyborg sim``: the simulator on the bus until Ctrl-C or ``--duration``."""
     if args.speed < 0:
         print("cyborg sim: --speed must be positive (or 0 for as fast as possible)",
               file=sys.stderr)
         return 2
-    arnl_map = load(args.map)
-    try:
-        simulator = Simulator(arnl_map, start=args.start)
-    except KeyError as exc:
-        raise CommandError(str(exc).strip("\"'")) from exc
+    parameters: dict[str, Any] = {"map": str(args.map), "speed": args.speed}
+    if args.start:
+        parameters["start"] = args.start
+    spec = NodeSpec("simulator", sim.NAME, args.namespace, parameters, where="simulator")
     context, where = bus_context(args.connect, args.listen)
-    loop = SimulationLoop(simulator, args.speed)
     try:
-        node = Node("arnl", args.namespace, context=context)
-        SimulatorNode(node, loop)
-        loop.start()
-        pace = "full speed" if args.speed == 0 else f"{args.speed:g}x real time"
-        print(f"cyborg sim: {arnl_map.source} at {pace}, namespace {args.namespace}, {where}; "
-              "Ctrl-C stops", flush=True)
-        while loop.running:
-            if args.duration is not None and simulator.time >= args.duration:
-                break
-            time.sleep(0.1)
-        if loop.error is not None:
-            raise CommandError(f"the simulation stopped: {loop.error}")
+        try:
+            running = sim.start(context, spec)
+        except LaunchError as exc:
+            raise CommandError(str(exc)) from exc
+        try:
+            loop = running.loop
+            pace = "full speed" if args.speed == 0 else f"{args.speed:g}x real time"
+            print(f"cyborg sim: {loop.simulator.map.source} at {pace}, namespace "
+                  f"{args.namespace}, {where}; Ctrl-C stops", flush=True)
+            while loop.running:
+                if args.duration is not None and loop.simulator.time >= args.duration:
+                    break
+                time.sleep(0.1)
+            if loop.error is not None:
+                raise CommandError(f"the simulation stopped: {loop.error}")
+        finally:
+            running.stop()
     finally:
-        loop.stop()
         context.close()
     return 0

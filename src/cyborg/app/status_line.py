@@ -17,12 +17,15 @@ from cyborg.bt import Status, Tree
 from cyborg.bt.snapshot import TickSnapshot
 
 SEPARATOR, ELLIPSIS = " > ", "…"
+"""What stands between two labels of the path, and for the labels left out."""
 
 
 def fit_status(tick: int, status: Status, labels: Sequence[str], width: int) -> str:
-    """``tick     42  RUNNING  Root tree > … > Patrol > MoveTo room1`` in at most ``width``
-    columns. The tick number and the status are always there (with single spaces when the
-    line is very narrow); the active path (root first) takes what room is left."""
+    """The line of one tick, ``tick 42  RUNNING  Root tree > … > MoveTo``, in ``width`` columns.
+
+    The tick number and the status are always there (with single spaces when the line is very
+    narrow); the active path (root first) takes what room is left.
+    """
     head = f"tick {tick:>6}  {status.name:<7}"
     if len(head) + 2 > width:
         head = f"tick {tick} {status.name}"
@@ -32,9 +35,12 @@ def fit_status(tick: int, status: Status, labels: Sequence[str], width: int) -> 
 
 
 def fit_path(labels: Sequence[str], room: int) -> str:
-    """The active path in at most ``room`` columns, the first of these that fits: all of it;
-    the root, ``…`` and the deepest nodes (the one running now last); ``…`` and the deepest
-    nodes; the deepest node cut short. Whole labels are dropped, never halves of them."""
+    """The active path in at most ``room`` columns.
+
+    The first of these that fits: all of it; the root, ``…`` and the deepest nodes (the one
+    running now last); ``…`` and the deepest nodes; the deepest node cut short. Whole labels
+    are dropped, never halves of them.
+    """
     full = SEPARATOR.join(labels)
     if len(full) <= room:
         return full
@@ -47,6 +53,12 @@ def fit_path(labels: Sequence[str], room: int) -> str:
 
 
 class StatusLine:
+    """A live line on ``stream`` of what ``tree`` does, redrawn at most ``redraw_hz`` a second.
+
+    On a terminal the line is redrawn in place; into a pipe or file a line is written when
+    the status or the active path changes.
+    """
+
     def __init__(self, tree: Tree, stream: TextIO, *, redraw_hz: float = 10.0) -> None:
         self.tree = tree
         self.stream = stream
@@ -57,8 +69,10 @@ class StatusLine:
         self._last: TickSnapshot | None = None
 
     def text(self, snapshot: TickSnapshot, width: int | None = None) -> str:
-        """``tick     42  RUNNING  Root tree > Priority > Patrol tree > MoveTo room1``; with
-        ``width``, fitted into that many columns (:func:`fit_status`)."""
+        """The line of ``snapshot``: ``tick     42  RUNNING  Root tree > Patrol > MoveTo``.
+
+        With ``width``, fitted into that many columns (:func:`fit_status`).
+        """
         labels = [self.tree.by_uid[uid].label for uid in snapshot.active]
         if width is not None:
             return fit_status(snapshot.tick, snapshot.status, labels, width)
@@ -66,6 +80,7 @@ class StatusLine:
         return f"tick {snapshot.tick:>6}  {snapshot.status.name:<7}  {path}"
 
     def update(self, snapshot: TickSnapshot) -> None:
+        """Shows a tick's snapshot (a tick listener: runs on the tick thread)."""
         self._last = snapshot
         if self.live:
             now = time.monotonic()
@@ -84,6 +99,7 @@ class StatusLine:
         self.stream.flush()
 
     def finish(self, *, interrupted: bool = False) -> None:
+        """Draws the last tick and ends the line, then says how the run ended."""
         last = self._last
         if self.live:
             if last is not None:

@@ -1,6 +1,9 @@
-"""The running system: a launch description's nodes started on the bus, followed on the
-terminal and stopped in order. ``cyborg up``, ``launch``, ``monitor`` and ``bt serve`` each
-build a :class:`~cyborg.app.launch.LaunchDescription` and hand it to :func:`run_system`."""
+"""The running system: a launch description's components, followed on the terminal.
+
+They are started on the bus, followed, and stopped in order. ``cyborg up``, ``launch``,
+``monitor`` and ``bt serve`` each build a :class:`~cyborg.app.launch.LaunchDescription` and
+hand it to :func:`run_system`.
+"""
 
 from __future__ import annotations
 
@@ -11,18 +14,21 @@ from collections.abc import Sequence
 from cyborg.app.bus_options import bus_context
 from cyborg.app.errors import CommandError
 from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck
-from cyborg.app.launchables import RunningTree
-from cyborg.app.node_spec import LaunchError
 from cyborg.app.status_line import StatusLine
+from cyborg.bus.component import LaunchError
+from cyborg.runner.component import RunningTree
 
 
 def run_system(description: LaunchDescription, args: argparse.Namespace, *, title: str,
                process: str = "main", parent: int | None = None,
                notes: Sequence[str] = ()) -> int:
-    """Start ``process``'s nodes (and, for ``main``, the other processes as children), print
-    ``notes`` and what runs, follow the tree, and stop everything in order
+    """Runs ``process``'s part of ``description`` until it is stopped; returns the exit code.
+
+    Starts ``process``'s components (and, for ``main``, the other processes as children),
+    prints ``notes`` and what runs, follows the tree, and stops everything in order
     (:meth:`Launch.stop`) on Ctrl-C, after ``--duration``, or when ``parent`` (a child's
-    launch) has gone."""
+    launch) has gone.
+    """
     context, where = bus_context(description.connect, description.listen)
     launch = Launch(description, context)
     status_line: StatusLine | None = None
@@ -52,7 +58,7 @@ def run_system(description: LaunchDescription, args: argparse.Namespace, *, titl
 
 
 def _follow_tree(launch: Launch) -> StatusLine | None:
-    """Print a live status line for the first tree runner of this process."""
+    """Prints a live status line for the first tree runner of this process."""
     for item in launch.running:
         if isinstance(item, RunningTree):
             line = StatusLine(item.runner.tree, sys.stdout)

@@ -31,14 +31,20 @@ from typing import Any
 from cyborg.app.access_options import access_parameters, add_access_options
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.errors import CommandError
-from cyborg.app.launch import LaunchDescription, as_child, read_launch
-from cyborg.app.node_spec import LaunchError, NodeSpec
+from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_robot
 from cyborg.app.system import run_system
 from cyborg.app.up_vision import add_vision_options, vision_nodes
+from cyborg.bus.component import LaunchError, NodeSpec
+from cyborg.monitor import component as monitor
+from cyborg.runner import component as runner
+from cyborg.sim import component as sim
 
 DATA = files("cyborg.app").joinpath("data")
+"""The bundled data: the campus map and its patrol tree."""
 CAMPUS_MAP = "campus.map"
+"""The bundled map, in ARNL format, in :data:`DATA`."""
 CAMPUS_TREE = "campus_patrol.b3.json"
+"""The bundled patrol-and-recharge tree, a behavior3editor export, in :data:`DATA`."""
 CAMPUS_THRESHOLD = 30.0
 """The bundled tree's CheckBattery threshold, percent: below it the robot goes to recharge."""
 DEFAULT_SPEED = 30.0
@@ -48,6 +54,7 @@ DEFAULT_BATTERY = 33.0
 
 
 def add_parser(commands: Any) -> None:
+    """Adds ``cyborg up`` and ``cyborg launch`` to the commands."""
     up = commands.add_parser("up", help="run the robot's system on built-in defaults",
                              description="Start the simulated robot on the bundled campus map, "
                                          "its navigation services and the tree runner with the "
@@ -58,19 +65,20 @@ def add_parser(commands: Any) -> None:
                     help="behavior3editor export to run (default: the bundled patrol)")
     up.add_argument("--speed", type=float, default=DEFAULT_SPEED, metavar="X",
                     help=f"simulated seconds per wall-clock second (default {DEFAULT_SPEED:g}, "
-                         "so a recharge shows within a minute; 1: real time; 0: as fast as "
-                         "possible)")
+                         f"so a recharge shows within a minute; {sim.SPEED:g}: real time; 0: as "
+                         "fast as possible)")
     up.add_argument("--start", default=None, metavar="NAME",
                     help="goal or dock to start at (default: the map's home, else its dock)")
     up.add_argument("--battery", type=float, default=DEFAULT_BATTERY, metavar="PERCENT",
                     help=f"battery charge at the start (default {DEFAULT_BATTERY:g}, just "
                          f"above the bundled tree's {CAMPUS_THRESHOLD:g} %% recharge threshold)")
-    up.add_argument("--namespace", default="/cyborg", help="the robot's namespace")
-    up.add_argument("--monitor-port", type=int, default=8080, metavar="PORT",
-                    help="port of the web monitor (default 8080; 0: any free port)")
-    up.add_argument("--monitor-host", default="127.0.0.1", metavar="ADDRESS",
-                    help="address the web monitor listens on (default 127.0.0.1: this machine "
-                         "only; 0.0.0.0: every interface)")
+    up.add_argument("--namespace", default=sim.NAMESPACE,
+                    help=f"the robot's namespace (default {sim.NAMESPACE})")
+    up.add_argument("--monitor-port", type=int, default=monitor.PORT, metavar="PORT",
+                    help=f"port of the web monitor (default {monitor.PORT}; 0: any free port)")
+    up.add_argument("--monitor-host", default=monitor.HOST, metavar="ADDRESS",
+                    help=f"address the web monitor listens on (default {monitor.HOST}: this "
+                         "machine only; 0.0.0.0: every interface)")
     up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
     add_access_options(up)
     add_vision_options(up)
@@ -92,19 +100,20 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
         raise CommandError("--speed must be positive, or 0 for as fast as possible")
     map_path = args.map or Path(str(DATA.joinpath(CAMPUS_MAP)))
     tree_path = args.tree or Path(str(DATA.joinpath(CAMPUS_TREE)))
-    namespace = "/" + args.namespace.strip("/")
-    sim = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
+    namespace = under_robot(args.namespace, sim.NAMESPACE)
+    tree_namespace = under_robot(args.namespace, runner.NAMESPACE)
+    robot: dict[str, Any] = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
     if args.start:
-        sim["start"] = args.start
+        robot["start"] = args.start
     nodes = [] if args.no_monitor else [
         # first: a taken port stops the launch before the robot moves
-        NodeSpec("monitor", "monitor", namespace,
-                 {"trees": [f"{namespace}/bt"], "port": args.monitor_port,
+        NodeSpec("monitor", monitor.NAME, namespace,
+                 {"trees": [tree_namespace], "port": args.monitor_port,
                   "host": args.monitor_host, **access_parameters(args)},
                  where="monitor (--monitor-port)")]
     nodes += [
-        NodeSpec("simulator", "arnl", namespace, sim, where="simulator"),
-        NodeSpec("tree_runner", "tree_runner", f"{namespace}/bt",
+        NodeSpec("simulator", sim.NAME, namespace, robot, where="simulator"),
+        NodeSpec("tree_runner", runner.NAME, tree_namespace,
                  {"tree_file": str(tree_path), "use_sim_time": True,
                   "robot_namespace": namespace}, where="tree runner"),
     ]
@@ -113,25 +122,29 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
 
 
 def up_notes(args: argparse.Namespace) -> list[str]:
-    """The lines ``cyborg up`` prints first, under the bus: the pace and the charge it runs at,
-    and, on the bundled mission at the defaults, when the recharge comes and how to choose
-    otherwise (a recharge is seven hours away at real time on a full battery)."""
+    """The lines ``cyborg up`` prints first, under the bus: the pace and the charge it runs at.
+
+    On the bundled mission at the defaults they say too when the recharge comes and how to
+    choose otherwise (a recharge is seven hours away at real time on a full battery).
+    """
     pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
     lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
     if (args.map, args.tree, args.speed, args.battery) == (None, None, DEFAULT_SPEED,
                                                            DEFAULT_BATTERY):
         lines += [f"             the patrol goes to recharge below {CAMPUS_THRESHOLD:g} % "
                   "within a minute and",
-                  "             charges for about 4 minutes; --speed 1 --battery 100: real "
-                  "time"]
+                  f"             charges for about 4 minutes; --speed {sim.SPEED:g} --battery "
+                  f"{sim.BATTERY:g}: real time"]
     return lines
 
 
 def up_command(args: argparse.Namespace) -> int:
+    """``cyborg up``: the robot's system on built-in defaults, until Ctrl-C."""
     return run_system(up_description(args), args, title="cyborg up", notes=up_notes(args))
 
 
 def launch_command(args: argparse.Namespace) -> int:
+    """``cyborg launch``: what a launch file lists, or, in a child, one process of it."""
     try:
         description = read_launch(args.file)
     except LaunchError as exc:

@@ -14,27 +14,38 @@ import argparse
 import sys
 from pathlib import Path
 
-from cyborg.app.node_spec import NodeSpec
+from cyborg.app.launch import under_robot
+from cyborg.bus.component import NodeSpec
+from cyborg.interfaces.detector import DEPTH, IMAGE
 from cyborg.vision import VisionError
+from cyborg.vision import component as vision
 from cyborg.vision.models import CATALOGUE, fetch, find_model
 from cyborg.vision.sources import anchored
 
-DEFAULT_CAMERA_SOURCE = "sample:motorcycle"
+CAMERA_SOURCE = "sample:motorcycle"
+"""What ``cyborg up``'s camera plays unless told otherwise: a stereo sample with depth."""
+CAMERA_RATE = 5.0
+"""Frames per second ``cyborg up``'s camera plays: a few, to leave the robot its CPU."""
+DETECTOR_THREADS = 1
+"""Inference threads of ``cyborg up``'s detector, for the same reason."""
 
 
 def add_vision_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--camera", default=DEFAULT_CAMERA_SOURCE, metavar="SOURCE",
+    """Adds ``--camera``, ``--model`` and ``--no-detector`` to ``cyborg up``."""
+    parser.add_argument("--camera", default=CAMERA_SOURCE, metavar="SOURCE",
                         help="frames the camera plays: a video, folder, bag, camera:N "
-                             f"(default {DEFAULT_CAMERA_SOURCE})")
-    parser.add_argument("--model", default="yolox_nano", metavar="MODEL",
-                        help="detector model file or name (default yolox_nano)")
+                             f"(default {CAMERA_SOURCE})")
+    parser.add_argument("--model", default=vision.MODEL, metavar="MODEL",
+                        help=f"detector model file or name (default {vision.MODEL})")
     parser.add_argument("--no-detector", action="store_true",
                         help="start neither the camera nor the detector")
 
 
 def model_for_up(name: str) -> Path | None:
-    """The model's file, fetched into the cache if it is a known one; None (and a printed
-    reason) when it cannot be had."""
+    """The model's file, fetched into the cache if it is a known one; None when it cannot be had.
+
+    Why not is printed on stderr.
+    """
     try:
         return find_model(name)
     except VisionError as missing:
@@ -52,19 +63,21 @@ def model_for_up(name: str) -> Path | None:
 
 
 def vision_nodes(args: argparse.Namespace, namespace: str) -> list[NodeSpec]:
+    """The camera and the detector for the robot ``namespace``; none without a model."""
     if args.no_detector:
         return []
     model = model_for_up(args.model)
     if model is None:
         return []
-    camera_ns = f"{namespace}/camera"
+    camera_ns = under_robot(namespace, vision.CAMERA_NAMESPACE)
     source = anchored(args.camera, Path.cwd())
     return [
-        NodeSpec("camera", "camera", camera_ns, {"source": source, "rate": 5.0},
-                 where="camera (--camera)"),
-        NodeSpec("detector", "detector", f"{namespace}/detector",
-                 {"model": str(model), "threads": 1,
-                  "image_topic": f"{camera_ns}/left/image_raw",
-                  "depth_topic": f"{camera_ns}/depth/depth_registered"},
+        NodeSpec("camera", vision.CAMERA_NAME, camera_ns,
+                 {"source": source, "rate": CAMERA_RATE}, where="camera (--camera)"),
+        NodeSpec("detector", vision.DETECTOR_NAME,
+                 under_robot(namespace, vision.DETECTOR_NAMESPACE),
+                 {"model": str(model), "threads": DETECTOR_THREADS,
+                  "image_topic": IMAGE.full_name(camera_ns),
+                  "depth_topic": DEPTH.full_name(camera_ns)},
                  where="detector (--model)"),
     ]

@@ -50,13 +50,16 @@ class Blackboard(MutableMapping[str, Any]):
     # behavior3-style access to any scope.
     def get(self, key: str, default: Any = None, *, tree: str | None = None,
             node: str | None = None) -> Any:
-        """Read ``key`` from the node scope (if ``node``), else tree scope (if ``tree``), else
-        the global scope; ``default`` when missing."""
+        """Reads ``key`` from one scope; ``default`` when the key is missing there.
+
+        The scope is the node's (``node``: its uid) if given, else the tree instance's
+        (``tree``: its uid) if given, else the global scope.
+        """
         return self._scope(tree, node).get(key, default)
 
     def set(self, key: str, value: Any, *, tree: str | None = None,
             node: str | None = None) -> None:
-        """Write ``key`` into the scope chosen as for :meth:`get`."""
+        """Writes ``key`` into the scope chosen as for :meth:`get`."""
         self._scope(tree, node)[key] = value
 
     def tree_scope(self, tree_uid: str) -> dict[str, Any]:

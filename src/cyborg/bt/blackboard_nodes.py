@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import logging
 
+from typing_extensions import override
+
 from cyborg.bt.node import Action, Condition
 from cyborg.bt.status import FAILURE, SUCCESS, Status
 
@@ -21,8 +23,11 @@ _LEVELS = {"log": logging.INFO, "info": logging.INFO, "debug": logging.DEBUG,
 
 
 class Log(Action):
-    """Log ``message`` (and the value of the ``value`` port, when bound) at ``level`` (log,
-    debug, info, warn, error) on the ``cyborg.bt.log`` logger; SUCCESS."""
+    """Logs ``message`` on the ``cyborg.bt.log`` logger, then returns SUCCESS.
+
+    ``level`` is log (as info), debug, info, warn or error. When the ``value`` port is bound,
+    the value it reads follows the message.
+    """
 
     inputs = ("value?",)
 
@@ -32,6 +37,7 @@ class Log(Action):
         self.message = message
         self.level = _LEVELS[level.lower()]
 
+    @override
     def tick(self) -> Status:
         if "value" in self.ports:
             log.log(self.level, "%s %r", self.message, self.read("value"))
@@ -45,6 +51,7 @@ class IsNull(Condition):
 
     inputs = ("value",)
 
+    @override
     def tick(self) -> Status:
         return SUCCESS if self.read("value") is None else FAILURE
 
@@ -54,5 +61,6 @@ class NotNull(Condition):
 
     inputs = ("value",)
 
+    @override
     def tick(self) -> Status:
         return FAILURE if self.read("value") is None else SUCCESS

@@ -30,6 +30,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from typing_extensions import override
+
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 from cyborg.bt.editor_v1_names import REPLACED_IN_CYBORG
@@ -57,18 +59,25 @@ class Subtree(Node):
     """Id of the tree this instance was built from."""
     tree_title: str = ""
 
+    @override
     def tick(self) -> Status:
         return self.children[0].execute()
 
     def check(self) -> list[str]:
+        """One problem unless the instance holds exactly one root node."""
         return [] if len(self.children) == 1 else ["a subtree needs exactly one root node"]
 
 
 @dataclass
 class BuildResult:
+    """What :func:`build` returns."""
+
     root: Subtree | None
+    """The chosen tree's instance; ``None`` if none was chosen or it was too big."""
     tree: TreeSpec | None
+    """The chosen tree's spec; ``None`` if none could be chosen."""
     problems: list[Problem]
+    """Every problem found, errors and warnings; with an error, ``root`` is incomplete."""
 
 
 class _TooManyNodesError(Exception):
@@ -114,14 +123,13 @@ class _Builder:
             spec.id if spec else None, spec.label if spec else None, field, severity))
 
     def counted(self, tree: TreeSpec, spec: NodeSpec | None) -> None:
-        """Count one more instance; past ``max_nodes``, stop the whole build."""
+        """Counts one more instance; past ``max_nodes``, stops the whole build."""
         self.count += 1
         if self.count > self.limits.max_nodes:
             raise _TooManyNodesError(tree, spec)
 
     def too_deep(self, tree: TreeSpec, spec: NodeSpec, level: int) -> bool:
-        """Whether a node whose deepest level is ``level`` is past ``max_depth``; if so,
-        report it (the caller builds nothing below it)."""
+        """Whether a node at ``level`` (its deepest) is past ``max_depth``; if so, reports it."""
         limits = self.limits
         if level <= limits.max_depth:
             return False
@@ -133,7 +141,7 @@ class _Builder:
 
     def properties_too_deep(self, tree: TreeSpec, spec: NodeSpec | None,
                             properties: dict[str, object]) -> bool:
-        """Report each property whose value nests deeper than MAX_VALUE_DEPTH."""
+        """Reports each property whose value nests deeper than MAX_VALUE_DEPTH."""
         deep = [key for key, value in properties.items()
                 if nesting_exceeds(value, MAX_VALUE_DEPTH)]
         for key in deep:
@@ -145,8 +153,7 @@ class _Builder:
     def instance(self, tree: TreeSpec, uid: str, prefix: str, depth: int,
                  stack: tuple[TreeSpec, ...], title: str, outer_uid: str,
                  level: int = 1, expand: bool = True) -> Subtree:
-        """A Subtree node (at ``level``) for one instance of ``tree`` and everything below
-        (only the Subtree node itself unless ``expand``)."""
+        """A Subtree node at ``level`` for one instance of ``tree``; with ``expand``, all below."""
         self.counted(tree, None)
         self.built.add(tree.id)
         properties = {} if self.properties_too_deep(tree, None, tree.properties) \
@@ -221,8 +228,10 @@ class _Builder:
         return node
 
     def wire(self, tree: TreeSpec, spec: NodeSpec, node: Node) -> None:
-        """Bind the file's input/output keys to the node's ports (see :mod:`cyborg.bt.ports`);
-        a stub is checked against the ports its definition declares."""
+        """Binds the file's input/output keys to the node's ports (see :mod:`cyborg.bt.ports`).
+
+        A stub is checked against the ports its definition declares.
+        """
         cls = type(node)
         declared: tuple[Sequence[str], Sequence[str]] = (cls.inputs, cls.outputs)
         if cls.__module__ == stub_class.__module__:
@@ -312,7 +321,7 @@ def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = No
           blackboard: Blackboard | None = None, record: TickRecord | None = None,
           stub_missing: Status | None = None, check_all: bool = False,
           limits: Limits | None = None) -> BuildResult:
-    """Build the chosen tree (and every tree it references) into live nodes.
+    """Builds the chosen tree (and every tree it references) into live nodes.
 
     With ``check_all`` every other tree in the project is also built, to find its problems;
     only the chosen tree is returned. Problems of both severities are in the result.
@@ -365,7 +374,7 @@ def _too_many(builder: _Builder, tree: TreeSpec, spec: NodeSpec | None) -> None:
 
 
 def _reach_below(tree: TreeSpec, spec: NodeSpec, reached: set[str]) -> None:
-    """Mark the nodes below ``spec`` in its tree as reached, without recursion."""
+    """Marks the nodes below ``spec`` in its tree as reached, without recursion."""
     pending = list(spec.children)
     while pending:
         node_id = pending.pop()

@@ -21,7 +21,7 @@ class Clock(Protocol):
         ...
 
     def sleep_until(self, deadline: float, wake: threading.Event) -> None:
-        """Return when :meth:`now` reaches ``deadline``, or earlier when ``wake`` is set."""
+        """Returns when :meth:`now` reaches ``deadline``, or earlier when ``wake`` is set."""
         ...
 
 
@@ -29,9 +29,11 @@ class MonotonicClock:
     """Wall-clock time that never jumps backwards (``time.monotonic``)."""
 
     def now(self) -> float:
+        """Seconds of ``time.monotonic``, from an arbitrary start."""
         return time.monotonic()
 
     def sleep_until(self, deadline: float, wake: threading.Event) -> None:
+        """Blocks the calling thread until ``deadline`` or until ``wake`` is set."""
         delay = deadline - time.monotonic()
         if delay > 0:
             wake.wait(delay)
@@ -49,23 +51,25 @@ class ManualClock:
         self._lock = threading.Lock()
 
     def now(self) -> float:
+        """The seconds the clock was started at or last moved to."""
         return self._now
 
     def advance(self, seconds: float) -> None:
-        """Move time forward by ``seconds`` (must not be negative)."""
+        """Moves time forward by ``seconds``; :class:`ValueError` if they are negative."""
         if seconds < 0:
             raise ValueError(f"a clock cannot go back ({seconds} s)")
         with self._lock:
             self._now += seconds
 
     def set(self, now: float) -> None:
-        """Move time forward to ``now``."""
+        """Moves time forward to ``now``; :class:`ValueError` if that lies in the past."""
         with self._lock:
             if now < self._now:
                 raise ValueError(f"a clock cannot go back from {self._now} to {now}")
             self._now = now
 
     def sleep_until(self, deadline: float, wake: threading.Event) -> None:
+        """Jumps to ``deadline`` at once if it lies ahead; never blocks, ignores ``wake``."""
         with self._lock:
             if deadline > self._now:
                 self._now = deadline

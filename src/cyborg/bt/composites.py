@@ -8,13 +8,16 @@ RUNNING, and starts from the first child only when a new activation begins.
 
 from __future__ import annotations
 
+from typing_extensions import override
+
 from cyborg.bt.node import Composite
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 
 class Sequence(Composite):
-    """Tick children in order; return the first status that is not SUCCESS, else SUCCESS."""
+    """Ticks children in order; returns the first status that is not SUCCESS, else SUCCESS."""
 
+    @override
     def tick(self) -> Status:
         for child in self.children:
             status = child.execute()
@@ -24,11 +27,12 @@ class Sequence(Composite):
 
 
 class Priority(Composite):
-    """Tick children in order; return the first status that is not FAILURE, else FAILURE.
+    """Ticks children in order; returns the first status that is not FAILURE, else FAILURE.
 
     Also known as Selector or Fallback.
     """
 
+    @override
     def tick(self) -> Status:
         for child in self.children:
             status = child.execute()
@@ -43,9 +47,15 @@ class MemSequence(Composite):
     _continue: Status = SUCCESS
 
     def on_start(self) -> None:
+        """Starts a new activation at the first child."""
         self.memory["running_child"] = 0
 
     def tick(self) -> Status:
+        """Ticks children from the one left RUNNING (``memory["running_child"]``) on.
+
+        Returns the first status that is not SUCCESS (for :class:`MemPriority`: FAILURE),
+        noting the child's index when that status is RUNNING; else SUCCESS (FAILURE).
+        """
         memory = self.memory
         children = self.children
         go_on = self._continue
@@ -65,7 +75,7 @@ class MemPriority(MemSequence):
 
 
 class Parallel(Composite):
-    """Tick all children every tick until enough of them succeed or fail.
+    """Ticks all children every tick until enough of them succeed or fail.
 
     ``successThreshold`` children must succeed for SUCCESS, and ``failureThreshold`` failures
     give FAILURE; ``-1`` means "all children". Children that have completed in the current
@@ -79,6 +89,7 @@ class Parallel(Composite):
         self.failure_threshold = failure_threshold
 
     def check(self) -> list[str]:
+        """One problem for each threshold that is neither ``-1`` nor 1 to the child count."""
         problems = []
         count = len(self.children)
         for field, value in (
@@ -93,9 +104,17 @@ class Parallel(Composite):
         return len(self.children) if threshold == -1 else threshold
 
     def on_start(self) -> None:
+        """Forgets the results of the last activation: every child is ticked again."""
         self.memory["done"] = [None] * len(self.children)
 
     def tick(self) -> Status:
+        """Ticks each child not yet completed in this activation, then counts the results.
+
+        SUCCESS once ``successThreshold`` children have succeeded, else FAILURE once
+        ``failureThreshold`` have failed or all have completed; a decided result halts the
+        children still RUNNING. A child's ERROR halts the others and is returned at once,
+        before the children after it are ticked.
+        """
         done: list[Status | None] = self.memory["done"]
         successes = failures = 0
         for index, child in enumerate(self.children):

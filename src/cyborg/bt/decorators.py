@@ -10,13 +10,16 @@ RunOnce) live in node memory and are not reset when the node starts again.
 
 from __future__ import annotations
 
+from typing_extensions import override
+
 from cyborg.bt.node import Decorator
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 
 class Inverter(Decorator):
-    """Swap SUCCESS and FAILURE; RUNNING and ERROR pass through."""
+    """Swaps SUCCESS and FAILURE; RUNNING and ERROR pass through."""
 
+    @override
     def tick(self) -> Status:
         status = self.child.execute()
         if status is SUCCESS:
@@ -29,6 +32,7 @@ class Inverter(Decorator):
 class ForceSuccess(Decorator):
     """SUCCESS whenever the child completes with SUCCESS or FAILURE; RUNNING and ERROR pass."""
 
+    @override
     def tick(self) -> Status:
         status = self.child.execute()
         return SUCCESS if status is FAILURE else status
@@ -37,6 +41,7 @@ class ForceSuccess(Decorator):
 class ForceFailure(Decorator):
     """FAILURE whenever the child completes with SUCCESS or FAILURE; RUNNING and ERROR pass."""
 
+    @override
     def tick(self) -> Status:
         status = self.child.execute()
         return FAILURE if status is SUCCESS else status
@@ -49,7 +54,7 @@ def _check_loop(field: str, value: int) -> list[str]:
 
 
 class Repeater(Decorator):
-    """Tick the child again each time it completes, ``maxLoop`` times (``-1``: forever).
+    """Ticks the child again each time it completes, ``maxLoop`` times (``-1``: forever).
 
     Completion with SUCCESS or FAILURE both count as one loop; ERROR stops the loop and is
     returned. After the last loop the child's last status is returned. One loop per tick.
@@ -61,11 +66,14 @@ class Repeater(Decorator):
         self.max_loop = max_loop
 
     def check(self) -> list[str]:
+        """The decorator's problems, plus a ``maxLoop`` neither ``-1`` nor at least 1."""
         return super().check() + _check_loop("maxLoop", self.max_loop)
 
     def on_start(self) -> None:
+        """Starts the new activation's count of loops at 0."""
         self.memory["loops"] = 0
 
+    @override
     def tick(self) -> Status:
         status = self.child.execute()
         if status is RUNNING or status is ERROR or status is self._until:
@@ -78,7 +86,7 @@ class Repeater(Decorator):
 
 
 class RepeatUntilFailure(Repeater):
-    """Repeat while the child succeeds; return FAILURE once it fails.
+    """Repeats while the child succeeds; returns FAILURE once it fails.
 
     After ``maxLoop`` successes (``-1``: no limit) it returns SUCCESS.
     """
@@ -87,7 +95,7 @@ class RepeatUntilFailure(Repeater):
 
 
 class RepeatUntilSuccess(Repeater):
-    """Repeat while the child fails; return SUCCESS once it succeeds.
+    """Repeats while the child fails; returns SUCCESS once it succeeds.
 
     After ``maxLoop`` failures (``-1``: no limit) it returns FAILURE.
     """
@@ -96,17 +104,18 @@ class RepeatUntilSuccess(Repeater):
 
 
 class Retry(RepeatUntilSuccess):
-    """Retry a failing child up to ``maxAttempts`` times in all (``-1``: forever)."""
+    """Retries a failing child up to ``maxAttempts`` times in all (``-1``: forever)."""
 
     def __init__(self, max_attempts: int = 3) -> None:
         self.max_loop = max_attempts
 
     def check(self) -> list[str]:
+        """The decorator's problems, plus a ``maxAttempts`` neither ``-1`` nor at least 1."""
         return Decorator.check(self) + _check_loop("maxAttempts", self.max_loop)
 
 
 class Limiter(Decorator):
-    """Let the child complete at most ``maxLoop`` times; after that return FAILURE.
+    """Lets the child complete at most ``maxLoop`` times; after that returns FAILURE.
 
     The count lives in node memory and survives activations, so the limit holds across the
     whole run (behavior3's Limiter reset it on every activation and never limited).
@@ -116,11 +125,13 @@ class Limiter(Decorator):
         self.max_loop = max_loop
 
     def check(self) -> list[str]:
+        """The decorator's problems, plus a negative ``maxLoop``."""
         problems = super().check()
         if self.max_loop < 0:
             problems.append(f"maxLoop must be 0 or more, not {self.max_loop}")
         return problems
 
+    @override
     def tick(self) -> Status:
         memory = self.memory
         completed = memory.get("completed", 0)
@@ -133,7 +144,7 @@ class Limiter(Decorator):
 
 
 class Timeout(Decorator):
-    """Fail if the child is still RUNNING ``milliseconds`` after the activation began.
+    """Fails if the child is still RUNNING ``milliseconds`` after the activation began.
 
     The deadline is checked *before* the child is ticked; when it has passed, the child is
     halted (its on_halt runs) and Timeout returns FAILURE.
@@ -145,14 +156,17 @@ class Timeout(Decorator):
         self.limit_ms = milliseconds
 
     def check(self) -> list[str]:
+        """The decorator's problems, plus a limit that is not more than 0 ms."""
         problems = super().check()
         if not self.limit_ms > 0:
             problems.append(f"{self._field} must be more than 0 ms, not {self.limit_ms}")
         return problems
 
     def on_start(self) -> None:
+        """Notes the activation's start (:attr:`now`) in ``memory["start"]``."""
         self.memory["start"] = self.now
 
+    @override
     def tick(self) -> Status:
         if self.ms_since() >= self.limit_ms:
             self.child.halt()
@@ -170,20 +184,23 @@ class MaxTime(Timeout):
 
 
 class Delay(Decorator):
-    """Wait ``milliseconds`` (RUNNING) before ticking the child, once per activation."""
+    """Waits ``milliseconds`` (RUNNING) before ticking the child, once per activation."""
 
     def __init__(self, milliseconds: float) -> None:
         self.delay_ms = milliseconds
 
     def check(self) -> list[str]:
+        """The decorator's problems, plus a negative ``milliseconds``."""
         problems = super().check()
         if self.delay_ms < 0:
             problems.append(f"milliseconds must be 0 or more, not {self.delay_ms}")
         return problems
 
     def on_start(self) -> None:
+        """Notes the activation's start (:attr:`now`) in ``memory["start"]``."""
         self.memory["start"] = self.now
 
+    @override
     def tick(self) -> Status:
         if self.ms_since() < self.delay_ms:
             return RUNNING
@@ -191,11 +208,12 @@ class Delay(Decorator):
 
 
 class RunOnce(Decorator):
-    """Tick the child until it completes once; afterwards return that status without ticking.
+    """Ticks the child until it completes once, then returns that status without ticking.
 
     The remembered result lives in node memory; it is forgotten only when the tree is rebuilt.
     """
 
+    @override
     def tick(self) -> Status:
         memory = self.memory
         result: Status | None = memory.get("result")

@@ -29,8 +29,11 @@ _SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def quote(text: str) -> str:
-    """A DOT double-quoted string; a lone surrogate (not a character, and not writable as
-    UTF-8) becomes U+FFFD, so the output can always be written."""
+    """``text`` as a DOT double-quoted string, escaped.
+
+    A lone surrogate (not a character, and not writable as UTF-8) becomes U+FFFD, so the output
+    can always be written.
+    """
     if not text.isascii():
         text = _SURROGATE.sub("\ufffd", text)
     escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")

@@ -233,10 +233,13 @@ class _Reader:
 
 def parse_project(text: str, source: str = "<string>", path: Path | None = None, *,
                   limits: Limits | None = None) -> ProjectSpec:
-    """Read an export from ``text``: behavior3editor 0.3.0, or a 1.x tree file or node
-    definitions (:mod:`cyborg.bt.editor_v1`, which finds the files it references from
-    ``path`` and charges them to ``limits``). Raises :class:`TreeLoadError` naming every
-    problem."""
+    """Parses an export from ``text`` into a project.
+
+    The export is behavior3editor 0.3.0's, or a 1.x tree file or node definitions
+    (:mod:`cyborg.bt.editor_v1`, which finds the files it references from ``path`` and charges
+    them to ``limits``). Raises :class:`TreeLoadError` naming every problem when one is an
+    error; warnings stay in the project's ``problems``.
+    """
     text = text.removeprefix("\ufeff")
     limits = limits if limits is not None else Limits.resolve(source=source)
     data = decode_json(text, source, limits)
@@ -259,9 +262,12 @@ def parse_project(text: str, source: str = "<string>", path: Path | None = None,
 
 
 def read_project(path: str | Path, *, limits: Limits | None = None) -> ProjectSpec:
-    """Read an export file. Raises :class:`TreeLoadError` (also for a file that cannot or may
-    not be read: see :mod:`cyborg.bt.files`). ``limits`` default to
-    :meth:`Limits.resolve() <cyborg.bt.limits.Limits.resolve>`."""
+    """Reads and parses an export file, as :func:`parse_project` does.
+
+    Raises :class:`TreeLoadError`, also for a file that cannot or may not be read (see
+    :mod:`cyborg.bt.files`). ``limits`` default to
+    :meth:`Limits.resolve() <cyborg.bt.limits.Limits.resolve>`.
+    """
     path = Path(path)
     limits = limits if limits is not None else Limits.resolve(source=str(path))
     try:

@@ -63,8 +63,11 @@ def is_v1_definitions(data: Any) -> bool:
 
 
 def find_workdir(tree_file: Path) -> Path:
-    """The nearest folder at or above ``tree_file`` with a ``*.b3-workspace`` (or, lacking
-    one, a ``node-config.b3-setting``), else the tree file's own folder."""
+    """The workdir of ``tree_file``: the folder the files a tree names are relative to.
+
+    That is the nearest folder at or above ``tree_file`` with a ``*.b3-workspace`` (or, lacking
+    one, a ``node-config.b3-setting``), else the tree file's own folder.
+    """
     start = tree_file.resolve().parent
     for folder in (start, *start.parents):
         if any(folder.glob("*.b3-workspace")) or (folder / SETTING_FILE).is_file():
@@ -74,8 +77,12 @@ def find_workdir(tree_file: Path) -> Path:
 
 def parse_definitions(raw: list[Any], source: str, text: str = "") -> tuple[
         list[NodeDefinition], list[Problem]]:
-    """Node definitions from a ``.b3-setting`` array: category from ``type``, properties
-    from the args' defaults, and the declared input/output ports."""
+    """Node definitions from a ``.b3-setting`` array, and the problems found in it.
+
+    Each definition takes its category from ``type``, its properties from the args' defaults,
+    and its declared input/output ports; an entry without a ``name`` is an error and left out.
+    ``text``, the file's text, gives the definitions their lines.
+    """
     lines = _LineIndex(text)
     definitions, problems = [], []
     for index, item in enumerate(raw):
@@ -130,6 +137,7 @@ class V1Reader:
     def problem(self, message: str, source: str | None = None, *, line: int | None = None,
                 tree: TreeSpec | None = None, node: NodeSpec | None = None,
                 field: str | None = None, severity: Severity = Severity.ERROR) -> None:
+        """Records a problem in ``source`` (default: the main file), at ``node``'s line if given."""
         self.problems.append(Problem(
             message, source or self.source, line if node is None else node.line, None,
             tree.display_name if tree else None, node.id if node else None,
@@ -137,6 +145,10 @@ class V1Reader:
 
     # ------------------------------------------------------------------ files
     def read(self, data: dict[str, Any], text: str) -> ProjectSpec:
+        """The project of the main tree ``data`` (parsed from ``text``) and the files it names.
+
+        Its problems are collected in :attr:`problems`, for the caller to raise or report.
+        """
         project = ProjectSpec(self.source, "v1")
         project.definitions = self.definitions()
         self._defaults = {d.name: d.properties for d in project.definitions}
@@ -148,8 +160,11 @@ class V1Reader:
         return project
 
     def resolve(self, relative: str) -> Path | None:
-        """A file named in the tree: workdir-relative as the editor writes it, else relative
-        to the tree file's folder."""
+        """The path of a file named in the tree; ``None`` if not found or no tree file.
+
+        The name is workdir-relative as the editor writes it, else relative to the tree file's
+        folder.
+        """
         if self.path is None:
             return None
         folders = [self.workdir, self.path.resolve().parent]
@@ -161,7 +176,7 @@ class V1Reader:
 
     def load(self, relative: str, field: str, tree: TreeSpec, node: NodeSpec | None = None,
              ) -> tuple[Path, Any, str] | None:
-        """Read a referenced JSON file; a located problem when it cannot be."""
+        """Reads and parses a referenced JSON file; ``None`` and a located problem if it fails."""
         path = self.resolve(relative)
         where = "the workdir or the tree's folder" if self.path else "a file (text given)"
         if path is None:
@@ -179,6 +194,11 @@ class V1Reader:
         return None
 
     def definitions(self) -> list[NodeDefinition]:
+        """The node definitions of the workdir's ``node-config.b3-setting``.
+
+        Lacking that file, the workdir's only ``*.b3-setting`` file is read. A file that cannot
+        be read, or holds no array of definitions, is a warning and gives none.
+        """
         if self.workdir is None:
             return []
         setting = self.workdir / SETTING_FILE
@@ -207,8 +227,10 @@ class V1Reader:
         return definitions
 
     def declarations(self, data: dict[str, Any], source: str) -> set[str]:
-        """Variable names declared by a tree and by the files it imports, and theirs (each
-        file once, followed with a work list rather than recursion)."""
+        """Variable names declared by a tree and by the files it imports, and theirs.
+
+        Each file is read once, followed with a work list rather than recursion.
+        """
         names: set[str] = set()
         seen: set[Path] = set()
         pending: list[tuple[dict[str, Any], str]] = [(data, source)]
@@ -231,7 +253,7 @@ class V1Reader:
     # ------------------------------------------------------------------ trees
     def tree(self, data: dict[str, Any], text: str, source: str, path: Path | None,
              depth: int) -> TreeSpec:
-        """Read one tree file whose root sits ``depth`` levels below the main tree's root."""
+        """Reads one tree file whose root sits ``depth`` levels below the main tree's root."""
         tree_id = self.tree_id(path)
         stem = path.stem if path is not None else "tree"
         title = _text(data.get("name")) or stem
@@ -249,6 +271,10 @@ class V1Reader:
         return tree
 
     def tree_id(self, path: Path | None) -> str:
+        """The tree id of the file at ``path``: its workdir-relative path without suffix.
+
+        Outside the workdir it is the file's stem; a tree given as text is ``"tree"``.
+        """
         if path is None:
             return "tree"
         resolved = path.resolve()
@@ -258,7 +284,11 @@ class V1Reader:
 
     def node(self, raw: Any, tree: TreeSpec, lines: _LineIndex, source: str,
              counter: list[int], depth: int = 0) -> NodeSpec | None:
-        """Flatten ``raw`` and its enabled descendants into ``tree.nodes``."""
+        """Flattens ``raw`` and its enabled descendants into ``tree.nodes``.
+
+        Returns ``raw``'s spec, or ``None`` when it is left out (not an object, too deep, or its
+        id used twice).
+        """
         if not isinstance(raw, dict):
             self.problem("a node must be a JSON object", source, tree=tree, field="children")
             return None
@@ -320,8 +350,11 @@ class V1Reader:
 
     def reference(self, spec: NodeSpec, relative: str, tree: TreeSpec,
                   source: str, depth: int) -> NodeSpec | None:
-        """A node with ``path``: the subtree file becomes a tree of the project (read once);
-        the node refers to it by id."""
+        """The spec of a node with ``path``, which refers to the subtree file's tree by id.
+
+        The file becomes a tree of the project, read once however many nodes refer to it; if
+        it cannot be read, the node's name is left empty.
+        """
         spec.title = ""  # the subtree's own name labels it
         tree.nodes[spec.id] = spec
         resolved = self.resolve(relative)
@@ -351,6 +384,7 @@ class V1Reader:
 
     def keys(self, raw: dict[str, Any], field: str, tree: TreeSpec, spec: NodeSpec,
              source: str) -> list[str]:
+        """The variable names in ``raw[field]``; none and a problem if not an array of strings."""
         value = raw.get(field, [])
         if not isinstance(value, list) or not all(isinstance(k, str) for k in value):
             self.problem(f"'{field}' must be an array of blackboard variable names", source,

@@ -1,13 +1,13 @@
-"""How big each tree of a project becomes once its subtree references are expanded, measured
-on the specs before anything is built.
+"""How big each tree of a project becomes once its subtree references are expanded.
 
-Each use of a subtree builds its own copy (see :mod:`cyborg.bt.builder`), so a tree that uses
-the next tree twice, twenty times over, would build 2^20 copies: a million nodes, gigabytes and
-minutes, from a file of a few kilobytes. :func:`measure` computes, for every tree, the number
-of node instances and the levels its instance would have, in time proportional to the file
-(each tree is measured once, without recursion, and counts stop growing just past the cap), so
-the builder can refuse a tree that is too big before building any of it, and ``check_file`` can
-check a project's other trees without expanding the same subtrees again and again.
+The sizes are measured on the specs, before anything is built. Each use of a subtree builds its
+own copy (see :mod:`cyborg.bt.builder`), so a tree that uses the next tree twice, twenty times
+over, would build 2^20 copies: a million nodes, gigabytes and minutes, from a file of a few
+kilobytes. :func:`measure` computes, for every tree, the number of node instances and the
+levels its instance would have, in time proportional to the file (each tree is measured once,
+without recursion, and counts stop growing just past the cap), so the builder can refuse a tree
+that is too big before building any of it, and ``check_file`` can check a project's other trees
+without expanding the same subtrees again and again.
 
 Counting follows the builder: an instance is one node for the tree itself plus, for every node
 reached from the tree's root, one node, or the whole instance of the tree it references. Levels
@@ -30,11 +30,14 @@ class Size:
     nodes: int
     """Node instances, at most ``cap + 1`` (larger counts are not kept)."""
     levels: int
+    """Levels of the instance, the tree's own node being level 1."""
 
 
 def measure(project: ProjectSpec, cap: int) -> dict[str, Size]:
-    """The :class:`Size` of every tree of ``project``, by tree id; node counts stop at
-    ``cap + 1``."""
+    """The :class:`Size` of every tree of ``project``, by tree id.
+
+    Node counts stop at ``cap + 1``: such a count only says that the tree is too big.
+    """
     trees = project.tree_by_id()
     sizes: dict[str, Size] = {}
     active: set[str] = set()  # trees being measured: a reference to one of them is a cycle
@@ -69,8 +72,10 @@ def measure(project: ProjectSpec, cap: int) -> dict[str, Size]:
 
 
 def _layout(tree: TreeSpec, trees: dict[str, TreeSpec]) -> list[tuple[int, str | None]]:
-    """Each node reached from the tree's root, once: its level in the tree (the root is 1)
-    and the id of the tree it references, if it is a reference."""
+    """Each node reached from the tree's root, once, as (level, referenced tree id).
+
+    The root's level is 1; the tree id is ``None`` for a node that is not a reference.
+    """
     if tree.root is None or tree.root not in tree.nodes:
         return []
     found: list[tuple[int, str | None]] = []

@@ -81,7 +81,8 @@ _POSTFIX_POWER = 15
 class ExpressionError(ValueError):
     """An expression that cannot be parsed, or whose operands do not fit its operators.
 
-    The message quotes the expression and, where it helps, the part of it at fault."""
+    The message quotes the expression and, where it helps, the part of it at fault.
+    """
 
 
 # ---------------------------------------------------------------------------- syntax tree
@@ -96,16 +97,22 @@ class Expr:
 
 @dataclass(frozen=True, slots=True)
 class Literal(Expr):
+    """A constant: a number, a string, or a keyword's value (``null`` is ``None``)."""
+
     value: Any
 
 
 @dataclass(frozen=True, slots=True)
 class Name(Expr):
+    """An identifier: the variable ``name``, ``undefined`` (``None``) while it is unset."""
+
     name: str
 
 
 @dataclass(frozen=True, slots=True)
 class Member(Expr):
+    """Member access, ``target.key`` or ``target[key]``: a key, element or ``length``."""
+
     target: Expr
     key: Expr
     """The key: a :class:`Literal` for ``a.b``, any expression for ``a[k]``."""
@@ -113,6 +120,8 @@ class Member(Expr):
 
 @dataclass(frozen=True, slots=True)
 class Unary(Expr):
+    """A prefix operator (``!``, ``~``, ``-`` or ``+``) applied to ``operand``."""
+
     op: str
     operand: Expr
 
@@ -128,6 +137,8 @@ class Binary(Expr):
 
 @dataclass(frozen=True, slots=True)
 class Conditional(Expr):
+    """``test ? then : otherwise``; only the branch chosen is evaluated."""
+
     test: Expr
     then: Expr
     otherwise: Expr

@@ -76,9 +76,15 @@ class ExtensionPoints:
         _starts: ClassVar[bool]
         _ends: ClassVar[bool]
 
-        def on_start(self) -> None: ...
-        def tick(self) -> Status: ...
-        def halt(self) -> None: ...
+        def on_start(self) -> None:
+            """Declared here for the slow path: see :meth:`~cyborg.bt.node.Node.on_start`."""
+
+        def tick(self) -> Status:
+            """Declared here for the slow path: see :meth:`~cyborg.bt.node.Node.tick`."""
+
+        def halt(self) -> None:
+            """Declared here for the slow path: see :meth:`~cyborg.bt.node.Node.halt`."""
+
         def _end(self, status: Status) -> None: ...
         def _coerce(self, value: object) -> Status: ...
         def _raised(self, exc: Exception, during: str = "tick") -> Status: ...
@@ -112,14 +118,14 @@ class ExtensionPoints:
 
     @property
     def post_tick(self) -> Callable[[Self, Status], Status | None] | None:
-        """Called as ``post_tick(node, status)`` each time the node returned ``status``;
-        ``None``: nothing.
+        """Called as ``post_tick(node, status)`` each time the node has returned ``status``.
 
-        Return ``None`` (or ``status``) to keep the result, or another status to make it the
-        node's result: the parent sees it, the snapshot records it, and a RUNNING node made to
-        finish ends its activation (``on_end`` runs with the new status). A finished node made
-        RUNNING stays active. :class:`~cyborg.bt.hooks.TreeHooks` forces results here, calling
-        the callback it found first.
+        ``None`` (the default): nothing is called. Return ``None`` (or ``status``) to keep the
+        result, or another status to make it the node's result: the parent sees it, the
+        snapshot records it, and a RUNNING node made to finish ends its activation (``on_end``
+        runs with the new status). A finished node made RUNNING stays active.
+        :class:`~cyborg.bt.hooks.TreeHooks` forces results here, calling the callback it found
+        first.
         """
         return self._post_tick
 
@@ -130,9 +136,12 @@ class ExtensionPoints:
 
     @property
     def timed(self) -> bool:
-        """Whether each visit's wall time (the node and its subtree, pre-tick time left out)
-        goes into the tick's snapshot. The tree sets it on every node from
-        :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>` between ticks; set that instead."""
+        """Whether each visit's wall time goes into the tick's snapshot.
+
+        The time covers the node and its subtree, pre-tick time left out. The tree sets this on
+        every node from :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>` between ticks; set
+        that instead.
+        """
         return self._timed
 
     @timed.setter
@@ -142,7 +151,7 @@ class ExtensionPoints:
 
     # ----------------------------------------------------------------- the slow path
     def _rehook(self) -> None:
-        """Join or leave the record's ``hooked`` set, as the slots now say."""
+        """Joins or leaves the record's ``hooked`` set, as the slots now say."""
         record: TickRecord | None = getattr(self, "_record", None)
         if record is None:
             return  # not bound yet: `Node.bind` calls this again
@@ -153,8 +162,10 @@ class ExtensionPoints:
                 record.hooked.discard(self)
 
     def _execute_hooked(self: Self) -> Status:
-        """``execute`` through the slots: the pre-tick callback, the tick (or the status it
-        substituted), the post-tick callback, and the visit's time when timed.
+        """``execute`` through the slots, for a node that uses one or is timed.
+
+        Runs the pre-tick callback, the tick (or the status it substituted), the post-tick
+        callback, and takes the visit's time when timed.
 
         Four frames per tree level (``execute``, this, ``_tick_once``, ``tick``): the budget
         of :data:`cyborg.bt.limits.FRAMES_PER_LEVEL`; the callbacks return before the tick.
@@ -204,9 +215,11 @@ class ExtensionPoints:
         return status
 
     def _skip(self, status: Status) -> Status:
-        """Return ``status`` without ticking (a pre-tick substitute). A finished one (a
-        disabled node) halts the node and its RUNNING subtree; a RUNNING one keeps the
-        activation, and what is not reached below is halted by the tree."""
+        """Returns ``status`` without ticking (a pre-tick substitute).
+
+        A finished one (a disabled node) halts the node and its RUNNING subtree; a RUNNING one
+        keeps the activation, and what is not reached below is halted by the tree.
+        """
         record = self._record
         if status is not RUNNING:
             self.halt()
@@ -217,7 +230,7 @@ class ExtensionPoints:
         return status
 
     def _replace_result(self, original: Status, forced: Status) -> None:
-        """Make ``forced`` the result of the visit that just returned ``original``.
+        """Makes ``forced`` the result of the visit that just returned ``original``.
 
         This node's entries are the last ones appended to the tick record (children finish
         first), so they are patched in place; a RUNNING node forced to finish ends normally.

@@ -1,4 +1,4 @@
-"""Reading tree files without trusting them: no blocking, bounded size, clean text.
+r"""Reading tree files without trusting them: no blocking, bounded size, clean text.
 
 Every file a load reads (the tree file, and for behavior3 v1 its subtree files, imports and node
 definitions) goes through :func:`read_text`, and every JSON text through :func:`decode_json`:
@@ -14,7 +14,7 @@ definitions) goes through :func:`read_text`, and every JSON text through :func:`
   levels (enough for a tree ``max_depth`` deep in the nested v1 format, with its property
   values): checked on the text before it is parsed, so nothing later (a comparison, a ``str``,
   a copy) recurses through a value hundreds of levels deep, and the error has a line.
-* JSON must be **clean text**: a lone UTF-16 surrogate (``"\\ud800"`` with no partner) is not a
+* JSON must be **clean text**: a lone UTF-16 surrogate (``"\ud800"`` with no partner) is not a
   character, cannot be written as UTF-8, and used to break ``cyborg bt dot`` and JSON output
   later; it is refused here with its line and column. So is an integer of more than
   :data:`~cyborg.bt.limits.MAX_INT_DIGITS` digits, before Python spends quadratic time on it.
@@ -114,9 +114,11 @@ def _too_large(count: int, limits: Limits, at_least: bool = False) -> str:
 
 
 def decode_json(text: str, source: str, limits: Limits) -> Any:
-    """Parse JSON ``text`` read from ``source``; :class:`TreeLoadError` with the line (and
-    column) of malformed JSON, of nesting deeper than ``limits`` allow, of an integer with too
-    many digits, or of a lone surrogate."""
+    """Parses JSON ``text`` read from ``source``, refusing what it cannot trust.
+
+    Raises :class:`TreeLoadError` with the line (and column) of malformed JSON, of nesting
+    deeper than ``limits`` allow, of an integer with too many digits, or of a lone surrogate.
+    """
     text = text.removeprefix("\ufeff")
     deep = too_deep(text, limits.max_nesting)
     if deep is not None:

@@ -53,6 +53,8 @@ if TYPE_CHECKING:
 
 
 class HookMode(StrEnum):
+    """What a :class:`Hook` does at its node: see the module docstring."""
+
     DISABLE = "disable"
     FORCE = "force"
     BREAKPOINT = "breakpoint"
@@ -68,7 +70,7 @@ class Hook:
     status: Status = SUCCESS
     """The status a disabled node returns, or a forced node's result."""
     once: bool = False
-    """Remove the hook after it was used once (force and breakpoint)."""
+    """Whether the hook goes away after its first use (force and breakpoint)."""
     owner: str = ""
     """Who set it; :meth:`TreeHooks.clear_owner` removes an owner's hooks."""
 
@@ -105,7 +107,7 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ setting
     def set(self, hook: Hook) -> None:
-        """Set (or replace) the hook of ``hook.node``; :class:`HookError` if it cannot be."""
+        """Sets (or replaces) the hook of ``hook.node``; :class:`HookError` if it cannot be."""
         node = self._nodes.get(hook.node)
         if node is None:
             raise HookError(f"no node with id {hook.node!r} in the tree")
@@ -119,16 +121,31 @@ class TreeHooks:
         self._changed()
 
     def disable(self, uid: str, status: Status = FAILURE, *, owner: str = "") -> None:
+        """Disables node ``uid``: it returns ``status`` (SUCCESS or FAILURE) without ticking.
+
+        Nothing below it ticks either, and a RUNNING subtree is halted. Raises
+        :class:`HookError` as :meth:`set` does.
+        """
         self.set(Hook(uid, HookMode.DISABLE, status, owner=owner))
 
     def force(self, uid: str, status: Status, *, once: bool = False, owner: str = "") -> None:
+        """Makes ``status`` the result of node ``uid`` each time it has ticked as usual.
+
+        With ``once`` the hook goes away after its first use. Raises :class:`HookError` as
+        :meth:`set` does.
+        """
         self.set(Hook(uid, HookMode.FORCE, status, once=once, owner=owner))
 
     def breakpoint(self, uid: str, *, once: bool = False, owner: str = "") -> None:
+        """Makes the ticking thread wait before node ``uid`` ticks, until let go.
+
+        :meth:`resume`, :meth:`step` and :meth:`release` let it go; with ``once`` the
+        breakpoint goes away after it was hit. Raises :class:`HookError` as :meth:`set` does.
+        """
         self.set(Hook(uid, HookMode.BREAKPOINT, once=once, owner=owner))
 
     def clear(self, uid: str) -> bool:
-        """Remove the hook of node ``uid``; False if it had none."""
+        """Removes the hook of node ``uid`` (a tick waiting there goes on); False if none."""
         with self._lock:
             hook = self._hooks.pop(uid, None)
             if hook is None:
@@ -140,13 +157,14 @@ class TreeHooks:
         return True
 
     def clear_owner(self, owner: str) -> list[str]:
-        """Remove every hook set by ``owner``; returns the node ids that had one."""
+        """Removes every hook set by ``owner``; returns the node ids that had one."""
         ids = [uid for uid, hook in list(self._hooks.items()) if hook.owner == owner]
         for uid in ids:
             self.clear(uid)
         return ids
 
     def clear_all(self) -> None:
+        """Removes every hook and lets any waiting tick run to its end."""
         for uid in list(self._hooks):
             self.clear(uid)
         self.release()
@@ -158,13 +176,17 @@ class TreeHooks:
         return sorted(self._hooks.values(), key=lambda hook: order[hook.node])
 
     def get(self, uid: str) -> Hook | None:
+        """The hook of node ``uid``, or ``None``."""
         return self._hooks.get(uid)
 
     # ------------------------------------------------------------------ timing
     @property
     def timing(self) -> bool:
-        """Another name for :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>` (applied between
-        ticks); False for hooks made without a tree."""
+        """Another name for :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>`.
+
+        It is applied between ticks. Hooks made without a tree read False, and setting it
+        raises :class:`RuntimeError`.
+        """
         return self._tree is not None and self._tree.timing
 
     @timing.setter
@@ -175,8 +197,11 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ the nodes' slots
     def before_tick(self, node: Node) -> Status | None:
-        """The pre-tick callback of a hooked node: wait at a breakpoint (or while stepping),
-        return the status of a disabled node, else what the node's own callback says."""
+        """The pre-tick callback of a hooked node, called in the ticking thread.
+
+        Waits at a breakpoint (or while stepping), then returns the status of a disabled node,
+        else what the node's own callback says.
+        """
         hook = self._hooks.get(node.uid)
         if self.stepping or (hook is not None and hook.mode is HookMode.BREAKPOINT):
             self.wait_at(node, hook)
@@ -186,8 +211,10 @@ class TreeHooks:
         return None if held is None or held[0] is None else held[0](node)
 
     def after_tick(self, node: Node, status: Status) -> Status | None:
-        """The post-tick callback of a hooked node: the node's own callback, then a forced
-        result (a ``once`` hook goes away here)."""
+        """The post-tick callback of a hooked node: its own callback, then a forced result.
+
+        A ``once`` hook goes away here.
+        """
         held = self._held.get(node.uid)
         if held is not None and held[1] is not None:
             replaced = held[1](node, status)
@@ -202,7 +229,7 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ pausing
     def wait_at(self, node: Node, hook: Hook | None) -> None:
-        """Called in the ticking thread: wait before ``node`` until released."""
+        """Called in the ticking thread: waits before ``node`` until released."""
         started = perf_counter()
         with self._lock:
             if self.stepping:
@@ -221,14 +248,14 @@ class TreeHooks:
         self._changed()
 
     def resume(self) -> bool:
-        """Let a tick waiting at a breakpoint go on; False if none was waiting."""
+        """Lets a tick waiting at a breakpoint go on; False if none was waiting."""
         with self._lock:
             waiting = self.paused_at is not None
             self._release_locked()
         return waiting
 
     def step(self) -> bool:
-        """Let a waiting tick go on to the next node about to tick, and stop there.
+        """Lets a waiting tick go on to the next node about to tick, and stops it there.
 
         False (and nothing happens) when no tick is waiting.
         """
@@ -242,7 +269,7 @@ class TreeHooks:
         return True
 
     def release(self) -> None:
-        """Let any waiting tick run to its end (used when the runner pauses or stops)."""
+        """Lets any waiting tick run to its end (used when the runner pauses or stops)."""
         with self._lock:
             if self.stepping:
                 self.stepping = False
@@ -251,8 +278,10 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ moving to a new tree
     def carry_to(self, other: TreeHooks) -> list[str]:
-        """Set this tree's hooks on ``other`` where the node ids still exist; returns the ids
-        of hooks that were dropped."""
+        """Sets this tree's hooks on ``other``; returns the node ids of those dropped.
+
+        A hook is dropped where ``other`` has no node of its id (after a reload).
+        """
         dropped = []
         for hook in self.hooks():
             try:
@@ -263,7 +292,7 @@ class TreeHooks:
 
     # ------------------------------------------------------------------ internals
     def _attach(self, node: Node) -> None:
-        """Take ``node``'s slots if it is hooked or a tick is stepped; give them back if not."""
+        """Takes ``node``'s slots if it is hooked or a tick is stepped; gives them back if not."""
         uid = node.uid
         wanted = self.stepping or uid in self._hooks
         if wanted and uid not in self._held:

@@ -1,8 +1,8 @@
-"""JavaScript's value rules, as behavior3 v1 trees expect them: truthiness, ``===``, number
-text, 32-bit bitwise arithmetic, ``/`` and ``%`` by zero, and reading ``a[k]``.
+"""JavaScript's value rules, as behavior3 v1 trees expect them.
 
-behavior3-ts runs in JavaScript, so a tree drawn for it counts on these rules; cyborg's
-expression evaluator (:mod:`cyborg.bt.expressions`) and the v1 data nodes
+They cover truthiness, ``===``, number text, 32-bit bitwise arithmetic, ``/`` and ``%`` by zero,
+and reading ``a[k]``. behavior3-ts runs in JavaScript, so a tree drawn for it counts on these
+rules; cyborg's expression evaluator (:mod:`cyborg.bt.expressions`) and the v1 data nodes
 (:mod:`cyborg.bt.v1_data`) apply them to Python values: ``None`` is both ``null`` and
 ``undefined``, lists are arrays, dicts (any mapping) are objects.
 """
@@ -15,8 +15,11 @@ from typing import Any
 
 
 def truthy(value: Any) -> bool:
-    """JavaScript's truthiness: false, 0, NaN, "" and null/undefined are false; every other
-    value, including an empty list or dict, is true."""
+    """JavaScript's truthiness of ``value``.
+
+    false, 0, NaN, "" and null/undefined are false; every other value, including an empty list
+    or dict, is true.
+    """
     if value is None or value is False:
         return False
     if isinstance(value, int | float):
@@ -27,8 +30,11 @@ def truthy(value: Any) -> bool:
 
 
 def strict_equal(a: Any, b: Any) -> bool:
-    """JavaScript's ``===``: numbers by value (NaN equals nothing), strings and booleans by
-    value, lists and dicts only when they are the same object."""
+    """JavaScript's ``a === b``.
+
+    Numbers compare by value (NaN equals nothing), strings and booleans by value, lists and
+    dicts only when they are the same object.
+    """
     if is_number(a) and is_number(b):
         return bool(a == b)
     if type(a) is bool or type(b) is bool:
@@ -113,9 +119,12 @@ ORDER: dict[str, Callable[[Any, Any], bool]] = {
 
 
 def read_member(target: Any, key: Any) -> Any:
-    """``target[key]`` as JavaScript reads it: a dict's key (a number also finds its text, as
-    object keys are text in JavaScript), a list's or string's element or ``length``; ``None``
-    (undefined) when absent. Raises TypeError when ``target`` is not a dict, list or string."""
+    """``target[key]`` as JavaScript reads it; ``None`` (undefined) when absent.
+
+    It reads a dict's key (a number also finds its text, as object keys are text in JavaScript),
+    a list's or string's element or ``length``. Raises TypeError when ``target`` is not a dict,
+    list or string.
+    """
     if isinstance(target, Mapping):
         if isinstance(key, str):
             return target.get(key)

@@ -1,4 +1,4 @@
-"""Facts about JSON *text* that a parsed value no longer has: lines, and how deep it nests.
+r"""Facts about JSON *text* that a parsed value no longer has: lines, and how deep it nests.
 
 Tree files are JSON; a problem found in the parsed data must still name the line it came
 from, and nesting must be measured before ``json.loads`` recurses into it. Both readers of tree
@@ -7,7 +7,7 @@ files (behavior3editor 0.3.0 and 1.x) and the web monitor's message check use th
     lines = TextLines(text)
     lines.line_of(text.find('"id"'))               # 1-based line of an offset
     lines.position(offset)                         # (line, column), both 1-based
-    first_lines(text, r'"id"\\s*:\\s*"([^"]*)"')   # {value: line of its first occurrence}
+    first_lines(text, r'"id"\s*:\s*"([^"]*)"')     # {value: line of its first occurrence}
     too_deep(text, 32)                             # offset of the 33rd open bracket, or None
 
 Brackets inside strings never count, and every scan is linear in the text's length.
@@ -43,9 +43,12 @@ class TextLines:
 
 def first_lines(text: str, pattern: str | re.Pattern[str],
                 lines: TextLines | None = None) -> dict[str, int]:
-    """For each value ``pattern`` captures in ``text``, the line where it first occurs (later
-    occurrences keep the first line). The value is the match's group that matched (a pattern
-    may offer alternatives, such as a quoted or a numeric id, each in a group of its own)."""
+    """For each value ``pattern`` captures in ``text``, the line where it first occurs.
+
+    Later occurrences keep the first line. The value is the match's group that matched (a
+    pattern may offer alternatives, such as a quoted or a numeric id, each in a group of its
+    own). ``lines`` saves indexing the text again.
+    """
     lines = lines if lines is not None else TextLines(text)
     found: dict[str, int] = {}
     for match in re.finditer(pattern, text):
@@ -54,11 +57,10 @@ def first_lines(text: str, pattern: str | re.Pattern[str],
 
 
 def too_deep(text: str, cap: int) -> int | None:
-    """Offset of the first bracket opening nesting level ``cap + 1`` (brackets in strings do
-    not count); None when there is none.
+    """Offset of the first bracket opening nesting level ``cap + 1``; None when there is none.
 
-    Quick in the common case: when no bracket, inside a string or not, could reach that depth,
-    the answer comes from counting brackets alone.
+    Brackets in strings do not count. Quick in the common case: when no bracket, inside a
+    string or not, could reach that depth, the answer comes from counting brackets alone.
     """
     brackets = _NOT_BRACKET.sub("", text)
     if len(brackets) <= cap or max(itertools.accumulate(map(_STEP.__getitem__, brackets)),

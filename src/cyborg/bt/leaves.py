@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing_extensions import override
+
 from cyborg.bt.node import Action
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
@@ -9,6 +11,7 @@ from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 class Succeeder(Action):
     """Always SUCCESS."""
 
+    @override
     def tick(self) -> Status:
         return SUCCESS
 
@@ -16,6 +19,7 @@ class Succeeder(Action):
 class Failer(Action):
     """Always FAILURE."""
 
+    @override
     def tick(self) -> Status:
         return FAILURE
 
@@ -23,6 +27,7 @@ class Failer(Action):
 class Runner(Action):
     """Always RUNNING."""
 
+    @override
     def tick(self) -> Status:
         return RUNNING
 
@@ -30,6 +35,7 @@ class Runner(Action):
 class Error(Action):
     """Always ERROR."""
 
+    @override
     def tick(self) -> Status:
         return ERROR
 
@@ -44,14 +50,17 @@ class Wait(Action):
         self.milliseconds = milliseconds
 
     def check(self) -> list[str]:
+        """The action's problems, plus a negative ``milliseconds``."""
         problems = super().check()
         if self.milliseconds < 0:
             problems.append(f"milliseconds must be 0 or more, not {self.milliseconds}")
         return problems
 
     def on_start(self) -> None:
+        """Notes the activation's start (:attr:`now`) in ``memory["start"]``."""
         self.memory["start"] = self.now
 
+    @override
     def tick(self) -> Status:
         if self.ms_since() >= self.milliseconds:
             return SUCCESS

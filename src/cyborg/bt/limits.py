@@ -77,8 +77,10 @@ class Limits:
     @classmethod
     def resolve(cls, max_bytes: int | None = None, max_depth: int | None = None,
                 max_nodes: int | None = None, *, source: str = "<string>") -> Limits:
-        """The caps for one load: each parameter given, else its environment variable, else
-        this module's constant (read now, so a program may change them).
+        """The caps for one load, from the parameters, the environment or this module.
+
+        Each cap is the parameter given, else its environment variable, else this module's
+        constant (read now, so a program may change them).
 
         A variable that is not a positive whole number is a problem of the file ``source``
         (:class:`~cyborg.bt.problems.TreeLoadError`, naming the variable); a parameter that is
@@ -121,13 +123,16 @@ class Limits:
 
     @property
     def bytes_left(self) -> int:
+        """Bytes this load may still read: ``max_bytes`` less ``bytes_read``, at least 0."""
         return max(self.max_bytes - self.bytes_read, 0)
 
     @property
     def max_nesting(self) -> int:
-        """Deepest nesting of lists and objects a tree file's JSON may have: two levels per
-        tree level (a v1 node and its ``children`` list), the deepest property value, and a
-        few levels of the file's own frame."""
+        """Deepest nesting of lists and objects a tree file's JSON may have.
+
+        That is two levels per tree level (a v1 node and its ``children`` list), the deepest
+        property value, and a few levels of the file's own frame.
+        """
         return 2 * self.max_depth + MAX_VALUE_DEPTH + 16
 
 
@@ -140,8 +145,10 @@ def _from_environment(variable: str, source: str) -> int:
 
 
 def nesting_exceeds(value: Any, limit: int) -> bool:
-    """Whether lists and dicts in ``value`` nest more than ``limit`` levels (walked without
-    recursion, so any depth is measured safely)."""
+    """Whether lists and dicts in ``value`` nest more than ``limit`` levels.
+
+    ``value`` is walked without recursion, so any depth is measured safely.
+    """
     stack: list[tuple[Any, int]] = [(value, 0)]
     while stack:
         item, depth = stack.pop()

@@ -40,7 +40,7 @@ def load_tree(source: str | Path | ProjectSpec, *, tree: str | None = None,
               blackboard: Blackboard | None = None,
               stub_missing: Status | None = None, max_bytes: int | None = None,
               max_depth: int | None = None, max_nodes: int | None = None) -> Tree:
-    """Load a behavior3editor export (a path or a parsed project) into a runnable tree.
+    """Loads a behavior3editor export (a path or a parsed project) into a runnable tree.
 
     ``tree`` picks a tree by id or title (default: the file's selectedTree). ``registry``
     defaults to :func:`~cyborg.bt.registry.default_registry`. ``stub_missing`` stands a stub
@@ -81,8 +81,11 @@ def check_file(path: str | Path, *, tree: str | None = None,
                registry: NodeRegistry | None = None,
                stub_missing: Status | None = None, max_bytes: int | None = None,
                max_depth: int | None = None, max_nodes: int | None = None) -> list[Problem]:
-    """Every problem in a file, errors and warnings, checking *all* its trees (each within
-    the caps, as :func:`load_tree` would)."""
+    """Every problem in a file, errors and warnings, checking *all* its trees.
+
+    Each tree is built within the caps, as :func:`load_tree` would build it; a file that cannot
+    be read or parsed gives the problems that stopped it.
+    """
     try:
         limits = _limits(path, max_bytes, max_depth, max_nodes)
         project = read_project(path, limits=limits)

@@ -1,11 +1,11 @@
-"""The node base classes and the lifecycle every node follows.
+r"""The node base classes and the lifecycle every node follows.
 
 A node is ticked by its parent through :meth:`Node.execute`. One *activation* of a node spans
 from the tick in which it starts until the tick in which it returns something other than
 RUNNING, or until it is halted::
 
     idle --execute--> on_start() --> tick() --RUNNING--> (next tick) tick() ... --> on_end(status)
-                                          \\--not reached in a tick--> on_halt()   (exactly once)
+                                          \--not reached in a tick--> on_halt()   (exactly once)
 
 * :meth:`Node.on_start` runs once when an activation begins (behavior3's ``open``).
 * :meth:`Node.tick` runs on every tick and returns a :class:`~cyborg.bt.status.Status`.
@@ -60,8 +60,10 @@ class Category(StrEnum):
 
 
 class Node(ExtensionPoints):
-    """Base class of every node. Subclass :class:`Action`, :class:`Condition`,
-    :class:`Composite` or :class:`Decorator` rather than this class."""
+    """Base class of every node.
+
+    Subclass :class:`Action`, :class:`Condition`, :class:`Composite` or :class:`Decorator`.
+    """
 
     category: ClassVar[Category]
     """The node's category, fixed by the base class it derives from."""
@@ -131,7 +133,7 @@ class Node(ExtensionPoints):
         """Called once when an activation begins, before the first :meth:`tick`."""
 
     def tick(self) -> Status:
-        """Do one step of work and say how it went. Must be overridden."""
+        """Does one step of work and says how it went. Every node class overrides it."""
         raise NotImplementedError(f"{type(self).__name__} does not implement tick()")
 
     def on_end(self, status: Status) -> None:
@@ -142,14 +144,12 @@ class Node(ExtensionPoints):
 
     # ----------------------------------------------------------------- ports
     def read(self, port: str, default: Any = None) -> Any:
-        """The global blackboard value the file binds input ``port`` to; ``default`` when the
-        port is unbound or the key is not set."""
+        """The global blackboard value of input ``port``; ``default`` if unbound or unset."""
         key = self.ports.get(port)
         return default if key is None else self.blackboard.get(key, default)
 
     def write(self, port: str, value: Any) -> None:
-        """Set the global blackboard key output ``port`` is bound to (``None`` deletes it,
-        as behavior3 v1 does); nothing when the port is unbound."""
+        """Sets the global key of output ``port`` (unbound: no-op; ``None`` deletes it)."""
         key = self.ports.get(port)
         if key is None:
             return
@@ -165,12 +165,11 @@ class Node(ExtensionPoints):
         return self._record.now
 
     def ms_since(self, key: str = "start") -> float:
-        """Milliseconds from ``memory[key]`` (a time taken from :attr:`now`, usually in
-        ``on_start``) to now.
+        """Milliseconds from ``memory[key]`` (a time taken from :attr:`now`) to now.
 
-        When the clock went back past that time (a restarted simulation, a backward jump of
-        ``/clock``), the count restarts from now, as ROS 2 resets its timers on a backward
-        jump: a Wait never waits for time to pass its start again.
+        ``on_start`` usually takes that time. When the clock went back past it (a restarted
+        simulation, a backward jump of ``/clock``), the count restarts from now, as ROS 2 resets
+        its timers on a backward jump: a Wait never waits for time to pass its start again.
         """
         start = self.memory[key]
         now = self._record.now
@@ -179,7 +178,7 @@ class Node(ExtensionPoints):
         return elapsed_ms(now, start)
 
     def execute(self) -> Status:
-        """Tick this node once inside the tree's current tick. Parents call this, not tick().
+        """Ticks this node once inside the tree's current tick. Parents call this, not tick().
 
         Goes through the extension points when this node uses one (see
         :mod:`cyborg.bt.extension`); otherwise they cost the test below, and one test only
@@ -224,7 +223,7 @@ class Node(ExtensionPoints):
         return status
 
     def halt(self) -> None:
-        """Halt this node if it is RUNNING: its running descendants first, then itself.
+        """Halts this node if it is RUNNING: its running descendants first, then itself.
 
         Each halted node's :meth:`on_halt` runs exactly once and its status becomes ``None``.
         Composites and decorators call this on children they stop ticking; the tree calls it
@@ -245,13 +244,12 @@ class Node(ExtensionPoints):
             self._raised(exc, during="on_halt")
 
     def halt_children(self) -> None:
-        """Halt every RUNNING child (and their descendants)."""
+        """Halts every RUNNING child (and their descendants)."""
         for child in self.children:
             child.halt()
 
     def walk(self) -> Iterator[Node]:
-        """This node and its descendants, depth first, pre-order (with a stack of its own,
-        not recursion, so a tree of any depth can be walked)."""
+        """This node and its descendants, depth first, pre-order, at any depth (no recursion)."""
         pending = [self]
         while pending:
             node = pending.pop()
@@ -300,7 +298,7 @@ class Node(ExtensionPoints):
     def bind(self, *, uid: str, node_id: str, name: str, title: str, label: str,
              description: str, properties: dict[str, Any], tree_uid: str, subtree_depth: int,
              blackboard: Blackboard, record: TickRecord) -> None:
-        """Attach the node to a tree. Called by the builder right after construction."""
+        """Attaches the node to a tree. Called by the builder right after construction."""
         self.uid = uid
         self.node_id = node_id
         self.name = name
@@ -318,7 +316,7 @@ class Node(ExtensionPoints):
         self._rehook()  # a slot filled before the node was bound takes effect now
 
     def adopt(self, children: list[Node]) -> None:
-        """Attach ``children`` in order. Decorators also get :attr:`Decorator.child`."""
+        """Attaches ``children`` in order. Decorators also get :attr:`Decorator.child`."""
         self.children = children
         for child in children:
             child.parent = self
@@ -341,6 +339,7 @@ class Action(Node):
     category = Category.ACTION
 
     def check(self) -> list[str]:
+        """One problem if the action has children: a leaf takes none."""
         return _no_children(self)
 
 
@@ -350,6 +349,7 @@ class Condition(Node):
     category = Category.CONDITION
 
     def check(self) -> list[str]:
+        """One problem if the condition has children: a leaf takes none."""
         return _no_children(self)
 
 
@@ -366,11 +366,13 @@ class Decorator(Node):
     child: Node
 
     def adopt(self, children: list[Node]) -> None:
+        """Attaches ``children`` and makes the first one :attr:`child`."""
         super().adopt(children)
         if children:
             self.child = children[0]
 
     def check(self) -> list[str]:
+        """One problem unless exactly one child is attached."""
         if not self.children:
             return ["decorator has no child: connect one node below it in the editor"]
         if len(self.children) > 1:

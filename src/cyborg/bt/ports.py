@@ -33,7 +33,7 @@ def port_name(declared: str) -> str:
 
 def bind_ports(declared: Sequence[str], keys: Sequence[str],
                direction: str) -> tuple[dict[str, str], list[str], list[str]]:
-    """Match a file's ``keys`` to the ``declared`` ports by position.
+    """Matches a file's ``keys`` to the ``declared`` ports by position.
 
     Returns port name -> key for every bound port, the errors (a required port left unbound)
     and the warnings (a key with no port to go to: ignored, as the editor's build drops it).

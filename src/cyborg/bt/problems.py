@@ -14,6 +14,8 @@ from typing import Any
 
 
 class Severity(StrEnum):
+    """How bad a :class:`Problem` is: an error stops the load, a warning does not."""
+
     ERROR = "error"
     WARNING = "warning"
 
@@ -37,6 +39,7 @@ class Problem:
 
     @property
     def is_error(self) -> bool:
+        """Whether the problem is an error, one that stops the load."""
         return self.severity is Severity.ERROR
 
     def __str__(self) -> str:
@@ -57,8 +60,10 @@ class Problem:
 
 
 def printable(text: str) -> str:
-    """``text`` with any lone surrogate written as ``\\udcff``, so it can be encoded as UTF-8
-    (a file name with undecodable bytes holds some; printing it would raise)."""
+    r"""``text`` with any lone surrogate written as ``\udcff``, so it can be encoded as UTF-8.
+
+    A file name with undecodable bytes holds some; printing it would raise.
+    """
     if text.isascii():
         return text
     return text.encode("utf-8", "backslashreplace").decode("utf-8")
@@ -82,8 +87,11 @@ _SHORT.maxlevel = 3
 
 
 def shown(value: Any) -> str:
-    """``repr(value)`` cut short for a message: a value from a file may be megabytes long or
-    nested hundreds of levels deep (a plain ``repr`` would then exhaust the stack)."""
+    """``repr(value)`` cut short for a message.
+
+    A value from a file may be megabytes long or nested hundreds of levels deep (a plain
+    ``repr`` would then exhaust the stack).
+    """
     try:
         return _SHORT.repr(value)
     except ValueError:  # an int past Python's int-to-text limit

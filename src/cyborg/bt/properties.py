@@ -53,6 +53,7 @@ class Param:
 
     @property
     def required(self) -> bool:
+        """Whether the file must give the property: the keyword has no default."""
         return self.default is _MISSING
 
     @property
@@ -96,7 +97,7 @@ def camel_case(name: str) -> str:
 
 
 def signature_of(factory: Any) -> Signature:
-    """Read the properties of a node class (its ``__init__``) or factory function."""
+    """The properties a node class (its ``__init__``) or factory function takes."""
     target = factory.__init__ if inspect.isclass(factory) else factory
     if target is object.__init__:
         return Signature((), False)
@@ -122,7 +123,7 @@ def signature_of(factory: Any) -> Signature:
 
 
 def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
-    """Match editor ``properties`` against ``signature``; convert and check each value."""
+    """Matches editor ``properties`` against ``signature``, converting and checking each value."""
     by_name: dict[str, Param] = {}
     for param in signature.params:
         by_name[param.name] = param
@@ -156,7 +157,7 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
 
 
 def convert(value: Any, hint: Any, *, infinite: bool = False) -> Any:
-    """Check ``value`` against the type ``hint``, converting where the editor is loose.
+    """``value`` checked against the type ``hint``, converted where the editor is loose.
 
     Numbers must be finite; ``infinite`` lets a ``float`` (at the top level, or in a union)
     be ``inf`` or ``-inf`` too. Raises ValueError with a message that names the expected type

@@ -60,6 +60,7 @@ class NodeType:
 
     @property
     def category(self) -> Category:
+        """The node class's category (action, condition, composite or decorator)."""
         return self.cls.category
 
 
@@ -70,7 +71,11 @@ class NodeRegistry:
         self._types: dict[str, NodeType] = {}
 
     def add(self, cls: type[Node], name: str | None = None, *, origin: str = "") -> NodeType:
-        """Register ``cls`` under ``name`` (default: the class name). Replaces an older entry."""
+        """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
+
+        Returns the entry. Raises :class:`TypeError` for a class that is not a node of one of
+        the four categories, :class:`ValueError` for an empty name.
+        """
         if not (inspect.isclass(cls) and issubclass(cls, Node)):
             raise TypeError(f"{cls!r} is not a Node subclass")
         if not hasattr(cls, "category"):
@@ -85,6 +90,7 @@ class NodeRegistry:
         return node_type
 
     def get(self, name: str) -> NodeType | None:
+        """The node registered under ``name``, or ``None``."""
         return self._types.get(name)
 
     def __contains__(self, name: object) -> bool:
@@ -95,6 +101,7 @@ class NodeRegistry:
         return sorted(self._types)
 
     def types(self) -> list[NodeType]:
+        """All registered nodes, sorted by name."""
         return [self._types[name] for name in self.names()]
 
     def copy(self) -> NodeRegistry:
@@ -104,7 +111,7 @@ class NodeRegistry:
         return other
 
     def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> list[str]:
-        """Register the nodes of every installed entry point in ``group``.
+        """Registers the nodes of every installed entry point in ``group``.
 
         Returns a message for each entry point that could not be loaded (they are skipped).
         """
@@ -127,7 +134,7 @@ class NodeRegistry:
         return problems
 
     def import_modules(self, modules: Iterable[str]) -> None:
-        """Import modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``).
+        """Imports modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``).
 
         Raises :class:`NodeModuleError` naming the first module that cannot be imported.
         """
@@ -153,7 +160,7 @@ def register(name: N, /) -> N: ...
 @overload
 def register(name: str | None = None, /) -> Callable[[N], N]: ...
 def register(name: Any = None, /) -> Any:
-    """Class decorator: make a node available to trees under ``name`` (default: class name)."""
+    """Class decorator: makes a node available to trees under ``name`` (default: class name)."""
     if inspect.isclass(name) and issubclass(name, Node):
         _REGISTERED.add(name)
         return name
@@ -192,8 +199,11 @@ for _cls in STOCK_NODES:
 
 
 def default_registry(*, entry_points: bool = True) -> NodeRegistry:
-    """A new registry with the stock nodes, every ``@register``-ed node and (by default)
-    the nodes of installed entry points."""
+    """A new registry of every node a tree may use.
+
+    It holds the stock nodes, every ``@register``-ed node and, with ``entry_points``, the nodes
+    of installed entry points (one that cannot be loaded is logged and skipped).
+    """
     registry = _REGISTERED.copy()
     if entry_points:
         for problem in registry.load_entry_points():

@@ -51,6 +51,7 @@ class TickSnapshot:
 
     @property
     def visit_count(self) -> int:
+        """How many visits this tick made, without building :attr:`visited`."""
         return len(self._visits)
 
     # The id lists are built on first use only: most ticks' snapshots are never read in full.
@@ -63,14 +64,18 @@ class TickSnapshot:
 
     @property
     def timed(self) -> bool:
-        """Whether this tick's visits were timed (:attr:`Tree.timing
-        <cyborg.bt.tree.Tree.timing>`)."""
+        """Whether this tick's visits were timed.
+
+        They are while :attr:`Tree.timing <cyborg.bt.tree.Tree.timing>` is on.
+        """
         return bool(self._durations)
 
     @property
     def visit_durations(self) -> list[float]:
-        """Wall time of each visit in :attr:`visited` (the node and its subtree, breakpoint
-        waits excluded), in seconds; NaN for a visit that was not timed."""
+        """Wall time of each visit in :attr:`visited`, in seconds; NaN where it was not timed.
+
+        A visit's time covers the node and its subtree, breakpoint waits excluded.
+        """
         durations = self._durations
         nan = float("nan")
         return [durations.get(index, nan) for index in range(len(self._visits))]
@@ -84,8 +89,10 @@ class TickSnapshot:
 
     @property
     def active(self) -> list[str]:
-        """Ids of the nodes RUNNING after this tick, root first (the active path; with a
-        Parallel it is a subtree, listed depth first)."""
+        """Ids of the nodes RUNNING after this tick, root first: the active path.
+
+        With a Parallel it is a subtree, listed depth first.
+        """
         if self._active is None:
             self._active = [node.uid for node in sorted(self._running, key=_index)]
         return self._active
@@ -98,8 +105,10 @@ class TickSnapshot:
         return self._halted_ids
 
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict: ``{"tick", "time", "duration", "status", "visited", "active",
-        "halted"}`` with statuses as lower-case names."""
+        """The tick as a JSON-ready dict, with statuses as lower-case names.
+
+        Its keys: ``{"tick", "time", "duration", "status", "visited", "active", "halted"}``.
+        """
         return {
             "tick": self.tick,
             "time": self.time,
@@ -131,12 +140,16 @@ class TreeStructure:
 
     @classmethod
     def of(cls, tree: Tree) -> TreeStructure:
+        """The structure of ``tree``, its nodes walked without recursion."""
         return cls(_describe(tree.root), tree.tree_id, tree.title, tree.source, len(tree.nodes))
 
     def to_json(self) -> dict[str, Any]:
-        """``{"schema", "tree_id", "title", "source", "node_count", "root"}``; each node is
+        """The JSON form, schema ``cyborg.bt.structure/1``, as JSON-ready nested dicts.
+
+        ``{"schema", "tree_id", "title", "source", "node_count", "root"}``; each node is
         ``{"id", "node_id", "name", "title", "label", "category", "depth", "index",
-        "properties", "children"}`` and tree nodes add ``"tree_id"``."""
+        "properties", "children"}`` and tree nodes add ``"tree_id"``.
+        """
         return {
             "schema": SCHEMA,
             "tree_id": self.tree_id,

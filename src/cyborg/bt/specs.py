@@ -18,7 +18,7 @@ _PLACEHOLDER = re.compile(r"<(\w+)>")
 
 
 def render_title(title: str, properties: dict[str, Any]) -> str:
-    """Fill ``<prop>`` placeholders from ``properties``, as the editor displays titles.
+    """``title`` with ``<prop>`` placeholders filled from ``properties``, as the editor shows it.
 
     ``render_title("MoveTo <location>", {"location": "home"}) == "MoveTo home"``; placeholders
     without a matching property stay as they are.
@@ -60,6 +60,7 @@ class NodeSpec:
 
     @property
     def label(self) -> str:
+        """The title with its ``<property>`` placeholders filled in (:func:`render_title`)."""
         return render_title(self.title, self.properties)
 
 
@@ -79,6 +80,7 @@ class TreeSpec:
 
     @property
     def display_name(self) -> str:
+        """The name messages give the tree: its title, or its id if it has none."""
         return self.title or self.id
 
 
@@ -113,6 +115,7 @@ class ProjectSpec:
     """Warnings found while reading (errors raise :class:`TreeLoadError` instead)."""
 
     def tree_by_id(self) -> dict[str, TreeSpec]:
+        """A new dict of the project's trees by id."""
         return {tree.id: tree for tree in self.trees}
 
 

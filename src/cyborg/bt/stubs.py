@@ -9,6 +9,8 @@ comes from the file's ``custom_nodes`` entry, or from how the block was connecte
 
 from __future__ import annotations
 
+from typing_extensions import override
+
 from cyborg.bt.composites import Sequence
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec
 from cyborg.bt.node import Action, Condition, Decorator, Node
@@ -20,6 +22,7 @@ class StubLeaf(Action):
 
     result: Status = Status.SUCCESS
 
+    @override
     def tick(self) -> Status:
         return self.result
 
@@ -29,6 +32,7 @@ class StubCondition(Condition):
 
     result: Status = Status.SUCCESS
 
+    @override
     def tick(self) -> Status:
         return self.result
 
@@ -36,6 +40,7 @@ class StubCondition(Condition):
 class StubDecorator(Decorator):
     """A decorator with no implementation: passes its child's status through."""
 
+    @override
     def tick(self) -> Status:
         return self.child.execute()
 
@@ -50,7 +55,8 @@ def stub_class(spec: NodeSpec, definition: NodeDefinition | None,
 
     How the block is connected wins where the two disagree (behavior3 v1 lets an action
     have a child and a decorator have none): a leaf with children stands in as their parent,
-    a decorator without a child as a leaf."""
+    a decorator without a child as a leaf.
+    """
     category = definition.category if definition and definition.category else spec.shape
     if spec.children and category in ("action", "condition"):
         category = spec.shape

@@ -29,11 +29,15 @@ log = logging.getLogger("cyborg.bt")
 
 Listener = Callable[[TickSnapshot], None]
 
+DEFAULT_RATE = 10.0
+"""Ticks per second unless told otherwise, as in 2018."""
+
 
 class TickLoop:
     """Ticks a :class:`~cyborg.bt.tree.Tree` at ``rate_hz`` (default 10 Hz, as in 2018)."""
 
-    def __init__(self, tree: Tree, *, rate_hz: float = 10.0, clock: Clock | None = None) -> None:
+    def __init__(self, tree: Tree, *, rate_hz: float = DEFAULT_RATE,
+                 clock: Clock | None = None) -> None:
         if not rate_hz > 0:
             raise ValueError(f"the tick rate must be more than 0 Hz, not {rate_hz}")
         self.tree = tree
@@ -49,7 +53,7 @@ class TickLoop:
 
     # ------------------------------------------------------------------ observers
     def add_listener(self, listener: Listener) -> Callable[[], None]:
-        """Call ``listener(snapshot)`` after every tick (in the ticking thread).
+        """Calls ``listener(snapshot)`` after every tick (in the ticking thread).
 
         Returns a function that removes the listener. A listener that raises is logged and
         kept; the tree keeps ticking.
@@ -59,15 +63,20 @@ class TickLoop:
 
     @property
     def paused(self) -> bool:
+        """Whether :meth:`pause` holds the loop (until :meth:`resume`)."""
         return self._paused
 
     @property
     def stopped(self) -> bool:
+        """Whether :meth:`stop` ended the loop, for good."""
         return self._stopped
 
     # ------------------------------------------------------------------ control
     def pause(self, *, halt: bool = False) -> None:
-        """Stop ticking. With ``halt`` also halt the RUNNING nodes (a moving robot stops)."""
+        """Stops ticking; with ``halt`` also halts the RUNNING nodes (a moving robot stops).
+
+        A tick waiting at a breakpoint is let go first, and ends before the pause.
+        """
         with self._state:
             self._paused = True
             self._wake.set()
@@ -77,17 +86,20 @@ class TickLoop:
                 self.tree.halt()
 
     def resume(self) -> None:
-        """Tick again at the set rate."""
+        """Ticks again at the set rate."""
         with self._state:
             self._paused = False
             self._state.notify_all()
 
     def step(self) -> TickSnapshot:
-        """Tick once now, in the calling thread; meant for a paused runner."""
+        """Ticks once now, in the calling thread; meant for a paused runner."""
         return self._tick()
 
     def stop(self, timeout: float | None = 5.0) -> None:
-        """End the loop and halt every RUNNING node. Waits for a background loop to end."""
+        """Ends the loop and halts every RUNNING node. Waits for a background loop to end.
+
+        ``timeout`` caps the wait, in seconds (``None``: no cap).
+        """
         with self._state:
             self._stopped = True
             self._wake.set()
@@ -101,7 +113,7 @@ class TickLoop:
                 self.tree.halt()
 
     def replace_tree(self, tree: Tree) -> Tree:
-        """Tick ``tree`` from the next tick on, and return the old one, halted.
+        """Ticks ``tree`` from the next tick on, and returns the old one, halted.
 
         The old tree's RUNNING nodes are halted (their actions cancel) and its hooks move to
         the new tree where the node ids still exist. Used to reload a tree file in place.
@@ -119,7 +131,7 @@ class TickLoop:
 
     # ------------------------------------------------------------------ loops
     def start(self, *, max_ticks: int | None = None, until_done: bool = False) -> None:
-        """Run :meth:`run` in a daemon thread."""
+        """Runs :meth:`run` in a daemon thread; :class:`RuntimeError` if started already."""
         if self._thread is not None:
             raise RuntimeError("the runner is already started")
         self._thread = threading.Thread(target=self.run, name=f"bt:{self.tree.title}",
@@ -128,13 +140,16 @@ class TickLoop:
         self._thread.start()
 
     def join(self, timeout: float | None = None) -> None:
-        """Wait for a background loop to end."""
+        """Waits for a background loop to end, at most ``timeout`` seconds if given."""
         if self._thread is not None:
             self._thread.join(timeout)
 
     def run(self, *, max_ticks: int | None = None, until_done: bool = False) -> None:
-        """Tick until stopped, ``max_ticks`` ticks are done, or (with ``until_done``) the root
-        returns something other than RUNNING. RUNNING nodes are halted on the way out."""
+        """Ticks at the set rate, in the calling thread, until the loop ends.
+
+        It ends when stopped, once ``max_ticks`` ticks are done, or (with ``until_done``) when
+        the root returns something other than RUNNING. RUNNING nodes are halted on the way out.
+        """
         period = 1.0 / self.rate_hz
         clock = self.clock
         anchor = now = clock.now()  # ticks are due at anchor + slot * period (no drift)

@@ -66,9 +66,11 @@ class Tree:
 
     @property
     def timing(self) -> bool:
-        """Whether ticks time every visit (the node and its subtree, breakpoint waits and
-        other :attr:`Node.pre_tick <cyborg.bt.node.Node.pre_tick>` time left out) into their
-        snapshots, for monitors. Off by default: it makes a tick three to four times as slow.
+        """Whether ticks time every visit into their snapshots, for monitors.
+
+        A visit's time covers the node and its subtree, breakpoint waits and other
+        :attr:`Node.pre_tick <cyborg.bt.node.Node.pre_tick>` time left out. Off by default: it
+        makes a tick three to four times as slow.
 
         Setting it takes effect when the next tick begins (never inside a tick); reading it
         gives the setting, and :attr:`TickSnapshot.timed
@@ -91,7 +93,7 @@ class Tree:
         return list(self._running)
 
     def tick(self) -> TickSnapshot:
-        """Tick the root once, halt what was abandoned, and return the tick's snapshot."""
+        """Ticks the root once, halts what was abandoned, and returns the tick's snapshot."""
         if self._timing_wanted is not self._timing:
             self._apply_timing()
         record = self._record
@@ -124,7 +126,7 @@ class Tree:
         return snapshot
 
     def halt(self) -> list[Node]:
-        """Halt every RUNNING node, deepest first; returns the nodes halted."""
+        """Halts every RUNNING node, deepest first; returns the nodes halted."""
         record = self._record
         halted: list[Node] = []
         record.halted = halted
@@ -133,8 +135,11 @@ class Tree:
         return halted
 
     def missing_resources(self) -> dict[str, list[Node]]:
-        """Resource key -> the nodes that need it (:attr:`Node.requires`) but find none in the
-        blackboard's resources; empty when every node has what it needs."""
+        """Resource key -> the nodes that need it but find none in the blackboard's resources.
+
+        A node needs the keys of its :attr:`Node.requires <cyborg.bt.node.Node.requires>`. The
+        dict is empty when every node has what it needs.
+        """
         missing: dict[str, list[Node]] = {}
         for node in self.nodes:
             for key in node.requires:

@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import math
 
+from typing_extensions import override
+
 from cyborg.bt.node import Action, Composite, Decorator
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 from cyborg.bt.v1_data import array_input, oneof
@@ -40,17 +42,21 @@ def _exactly(node: Composite, *counts: int) -> list[str]:
 
 
 class IfElse(Composite):
-    """Tick child 1 (the condition) until it finishes; on SUCCESS run child 2, on FAILURE
-    child 3 (FAILURE when there is none, as in behavior3lua), and return that branch's status.
+    """Ticks child 1 (the condition) until it finishes, then the branch it chose.
 
-    A RUNNING branch is resumed without testing the condition again."""
+    SUCCESS chooses child 2, FAILURE child 3 (none: FAILURE, as in behavior3lua); the branch's
+    status is returned. A RUNNING branch is resumed without testing the condition again.
+    """
 
     def check(self) -> list[str]:
+        """One problem unless there are 2 or 3 children: condition, SUCCESS and FAILURE branch."""
         return _exactly(self, 2, 3)
 
     def on_start(self) -> None:
+        """Starts the activation at the condition."""
         self.memory["branch"] = 0
 
+    @override
     def tick(self) -> Status:
         children = self.children
         branch: int = self.memory["branch"]
@@ -65,16 +71,18 @@ class IfElse(Composite):
 
 
 class ParallelAll(Composite):
-    """behavior3 v1's Parallel: tick every unfinished child each tick; SUCCESS once all have
-    finished, whatever their results; RUNNING until then.
+    """behavior3 v1's Parallel: ticks every unfinished child each tick, until all finish.
 
-    (cyborg's own Parallel counts successes and failures against thresholds; a v1
-    ``Parallel`` is this node.)"""
+    Then SUCCESS, whatever their results; RUNNING until then. (cyborg's own Parallel counts
+    successes and failures against thresholds; a v1 ``Parallel`` is this node.)
+    """
 
     def on_start(self) -> None:
+        """Marks every child unfinished for the new activation."""
         self.memory["finished"] = [False] * len(self.children)
 
     def tick(self) -> Status:
+        """Ticks the unfinished children; a child's ERROR halts the others and is returned."""
         finished: list[bool] = self.memory["finished"]
         for index, child in enumerate(self.children):
             if finished[index]:
@@ -88,13 +96,14 @@ class ParallelAll(Composite):
 
 
 class Race(Composite):
-    """Tick every child still in the race each tick: the first SUCCESS wins (the others are
-    halted) and is returned; a child that fails drops out; FAILURE when all have failed."""
+    """Ticks every child still in the race each tick; the first SUCCESS wins and is returned."""
 
     def on_start(self) -> None:
+        """Puts every child back in the race."""
         self.memory["failed"] = [False] * len(self.children)
 
     def tick(self) -> Status:
+        """A SUCCESS (or ERROR) halts the others; a child that fails drops out; all out: FAILURE."""
         failed: list[bool] = self.memory["failed"]
         for index, child in enumerate(self.children):
             if failed[index]:
@@ -111,9 +120,11 @@ class Case(Composite):
     """A condition (child 1) and a branch (child 2), run by the :class:`Switch` above it.
 
     It ticks the condition until it finishes; on SUCCESS it is :attr:`matched` and ticks the
-    branch, returning the branch's status; on FAILURE it returns FAILURE unmatched."""
+    branch, returning the branch's status; on FAILURE it returns FAILURE unmatched.
+    """
 
     def check(self) -> list[str]:
+        """One problem unless there are exactly 2 children: the condition and the branch."""
         return _exactly(self, 2)
 
     @property
@@ -122,9 +133,11 @@ class Case(Composite):
         return bool(self.memory.get("matched"))
 
     def on_start(self) -> None:
+        """Starts the activation unmatched, at the condition."""
         self.memory["matched"] = False
 
     def tick(self) -> Status:
+        """Raises :class:`RuntimeError` (ERROR) unless the parent is a :class:`Switch`."""
         if not isinstance(self.parent, Switch):
             raise RuntimeError(f"a Case runs only as a child of a Switch, not of "
                                f"{type(self.parent).__name__}")
@@ -137,18 +150,23 @@ class Case(Composite):
 
 
 class Switch(Composite):
-    """Try the :class:`Case` children in order: the first whose condition succeeds runs its
-    branch, whose status is returned; FAILURE when no condition succeeds. A RUNNING condition
-    or branch is resumed on the next tick, the earlier Cases not tried again."""
+    """Tries the :class:`Case` children in order; the first whose condition succeeds runs.
+
+    Its branch's status is returned; FAILURE when no condition succeeds. A RUNNING condition or
+    branch is resumed on the next tick, the earlier Cases not tried again.
+    """
 
     def check(self) -> list[str]:
+        """One problem for each child that is not a :class:`Case`."""
         return [f"Switch takes only Case children; child {number} is a "
                 f"{type(child).__name__}" for number, child in enumerate(self.children, 1)
                 if not isinstance(child, Case)]
 
     def on_start(self) -> None:
+        """Starts the activation at the first Case."""
         self.memory["case"] = 0
 
+    @override
     def tick(self) -> Status:
         children = self.children
         for index in range(self.memory["case"], len(children)):
@@ -163,15 +181,18 @@ class Switch(Composite):
 
 
 class Watchdog(Composite):
-    """Check a guard (child 1) on every tick while a branch (child 2) runs.
+    """Checks a guard (child 1) on every tick while a branch (child 2) runs.
 
     Guard SUCCESS: tick or resume the branch and return its status. Guard FAILURE: halt the
     branch, give the fallback (child 3) one tick (halting whatever it leaves running) and
-    return FAILURE. The guard must finish in one tick; a RUNNING guard raises (ERROR)."""
+    return FAILURE. The guard must finish in one tick; a RUNNING guard raises (ERROR).
+    """
 
     def check(self) -> list[str]:
+        """One problem unless there are exactly 3 children: the guard, branch and fallback."""
         return _exactly(self, 3)
 
+    @override
     def tick(self) -> Status:
         guard, branch, fallback = self.children
         status = guard.execute()
@@ -191,10 +212,13 @@ class Watchdog(Composite):
 
 
 class Once(Decorator):
-    """Run the child to completion once: that completion (SUCCESS or FAILURE) returns SUCCESS,
-    and every later tick returns FAILURE without ticking it. Being halted before the child
-    finished does not count; the mark lasts until the tree is rebuilt."""
+    """Runs the child to completion once; that completion (SUCCESS or FAILURE) returns SUCCESS.
 
+    Every later tick returns FAILURE without ticking the child. Being halted before the child
+    finished does not count; the mark lasts until the tree is rebuilt.
+    """
+
+    @override
     def tick(self) -> Status:
         if self.memory.get("done"):
             return FAILURE
@@ -206,19 +230,20 @@ class Once(Decorator):
 
 
 class AlwaysRunning(Decorator):
-    """Tick the child and return RUNNING, whatever it returns (ERROR excepted)."""
+    """Ticks the child and returns RUNNING, whatever it returns (ERROR excepted)."""
 
+    @override
     def tick(self) -> Status:
         return ERROR if self.child.execute() is ERROR else RUNNING
 
 
 class Assert(Decorator):
-    """Return the child's SUCCESS or RUNNING; anything else raises AssertionError with
-    ``message`` (the node returns ERROR and the message is logged)."""
+    """Passes the child's SUCCESS or RUNNING; else raises AssertionError(``message``): ERROR."""
 
     def __init__(self, message: str = "") -> None:
         self.message = message
 
+    @override
     def tick(self) -> Status:
         status = self.child.execute()
         if status is SUCCESS or status is RUNNING:
@@ -228,11 +253,11 @@ class Assert(Decorator):
 
 
 class Repeat(Decorator):
-    """Run the child ``count`` times in a row (none: without end); SUCCESS after the last.
+    """Runs the child ``count`` times in a row (none: without end); SUCCESS after the last.
 
-    A FAILURE (or ERROR) of the child stops the loop and is returned. A child that finishes
-    at once is run again in the same tick, up to :data:`MAX_LOOPS_PER_TICK` times. ``count``
-    is the arg, or the ``count`` input when bound (oneof)."""
+    A FAILURE (or ERROR) of the child stops the loop and is returned. ``count`` is the arg, or
+    the ``count`` input when bound (oneof).
+    """
 
     inputs = ("count?",)
 
@@ -240,9 +265,11 @@ class Repeat(Decorator):
         self.count = count
 
     def on_start(self) -> None:
+        """Starts the activation's count of runs at 0."""
         self.memory["done"] = 0
 
     def tick(self) -> Status:
+        """Reruns a child that succeeds at once, up to :data:`MAX_LOOPS_PER_TICK` times a tick."""
         count = oneof(self, "count", self.count, math.inf)
         memory = self.memory
         for _ in range(MAX_LOOPS_PER_TICK):
@@ -256,12 +283,12 @@ class Repeat(Decorator):
 
 
 class RetryUntilSuccess(Decorator):
-    """Try the child until it succeeds (SUCCESS), at most ``count`` tries (none: without
-    end); FAILURE when the last try did not succeed.
+    """Tries the child until it succeeds (SUCCESS), at most ``count`` tries (none: no end).
 
-    A try that ends at once is followed by the next try on the next tick; a try that ran for
-    several ticks is followed by the next one in the tick it ended, as in behavior3-ts.
-    ``count`` is the arg, or the ``count`` input when bound."""
+    FAILURE when the last try did not succeed. A try that ends at once is followed by the next
+    try on the next tick; a try that ran for several ticks is followed by the next one in the
+    tick it ended, as in behavior3-ts. ``count`` is the arg, or the ``count`` input when bound.
+    """
 
     inputs = ("count?",)
     _goal: Status = SUCCESS
@@ -270,6 +297,7 @@ class RetryUntilSuccess(Decorator):
         self.count = count
 
     def on_start(self) -> None:
+        """Starts the activation's count of tries at 0."""
         self.memory["tries"] = 0
 
     def _outcome(self, status: Status) -> Status:
@@ -277,6 +305,7 @@ class RetryUntilSuccess(Decorator):
             return status
         return SUCCESS if status is self._goal else RUNNING  # RUNNING: try again
 
+    @override
     def tick(self) -> Status:
         memory, child = self.memory, self.child
         if memory["tries"] == 0:
@@ -293,23 +322,24 @@ class RetryUntilSuccess(Decorator):
 
 
 class RetryUntilFailure(RetryUntilSuccess):
-    """Try the child until it fails (then SUCCESS), at most ``count`` tries; FAILURE when the
-    last try succeeded. Otherwise as :class:`RetryUntilSuccess`."""
+    """As :class:`RetryUntilSuccess`, but a try succeeds when the child fails (SUCCESS)."""
 
     _goal = FAILURE
 
 
 class ForEach(Decorator):
-    """For each element of the ``array`` input, write it to ``item`` (and its index to
-    ``index``) and run the child to completion; SUCCESS after the last element. A FAILURE (or
-    ERROR) of the child stops the loop and is returned. Both outputs are deleted when the loop
-    ends, as behavior3-ts does. Children that finish at once run in the same tick, up to
-    :data:`MAX_LOOPS_PER_TICK` elements."""
+    """Runs the child to completion for each element of the ``array`` input, in order.
+
+    The element goes to ``item`` (its index to ``index``) first; SUCCESS after the last one. A
+    FAILURE (or ERROR) of the child stops the loop and is returned. Both outputs are deleted
+    when the loop ends, as behavior3-ts does.
+    """
 
     inputs = ("array",)
     outputs = ("item", "index?")
 
     def on_start(self) -> None:
+        """Starts the activation at the first element."""
         self.memory["next"] = 0
 
     def _finish(self, status: Status) -> Status:
@@ -318,6 +348,7 @@ class ForEach(Decorator):
         return status
 
     def tick(self) -> Status:
+        """Runs elements the child finishes at once, up to :data:`MAX_LOOPS_PER_TICK` a tick."""
         array, memory = array_input(self, "array"), self.memory
         for _ in range(MAX_LOOPS_PER_TICK):
             index = memory["next"]
@@ -336,21 +367,23 @@ class ForEach(Decorator):
 
 
 class Filter(Decorator):
-    """Run the child once per element of the ``array`` input, the element in ``item``; write
-    the elements it succeeded on, in order, to ``result`` as a new list. SUCCESS when that
-    list is not empty, else FAILURE; ``item`` is deleted at the end.
+    """Runs the child once per element of the ``array`` input, the element in ``item``.
 
-    (behavior3-ts restarts from the first element after a RUNNING child, keeping what it had
-    collected; cyborg resumes at the element that was running.)"""
+    The elements it succeeded on go, in order, to ``result`` as a new list; SUCCESS if there
+    are any, else FAILURE; ``item`` is deleted at the end. After a RUNNING child, cyborg resumes
+    at that element (behavior3-ts restarts from the first, keeping what it had collected).
+    """
 
     inputs = ("array",)
     outputs = ("item", "result")
 
     def on_start(self) -> None:
+        """Starts the activation at the first element, with nothing kept."""
         self.memory["next"] = 0
         self.memory["kept"] = []
 
     def tick(self) -> Status:
+        """Runs elements the child finishes at once, up to :data:`MAX_LOOPS_PER_TICK` a tick."""
         array, memory = array_input(self, "array"), self.memory
         kept: list[object] = memory["kept"]
         for _ in range(MAX_LOOPS_PER_TICK):
@@ -377,8 +410,10 @@ class WaitForCount(Action):
         self.ticks = tick
 
     def on_start(self) -> None:
+        """Starts the activation's count of ticks at 0."""
         self.memory["ticked"] = 0
 
+    @override
     def tick(self) -> Status:
         self.memory["ticked"] += 1
         return SUCCESS if self.memory["ticked"] > max(self.ticks, 1) else RUNNING

@@ -33,6 +33,8 @@ import weakref
 from collections.abc import Mapping, MutableMapping, Sequence
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number, js_text, read_member, strict_equal, truthy
 from cyborg.bt.node import Action, Condition, Node
@@ -76,8 +78,10 @@ def fresh(value: Any) -> Any:
 
 
 def array_input(node: Node, port: str, *, to_change: bool = False) -> Sequence[Any]:
-    """The array (a list, or a tuple when it is only read) in input ``port``; TypeError naming
-    the port when it holds something else."""
+    """The array in input ``port``: a list, or also a tuple unless ``to_change``.
+
+    Raises TypeError naming the port when it holds something else.
+    """
     value = node.read(port)
     if not isinstance(value, list if to_change else list | tuple):
         raise TypeError(f"input {port!r} ({node.ports.get(port)!r}) must hold an array (a "
@@ -88,34 +92,38 @@ def array_input(node: Node, port: str, *, to_change: bool = False) -> Sequence[A
 class Check(Condition):
     """SUCCESS when the expression ``value`` is truthy, else FAILURE.
 
-    ``value`` reads blackboard variables by name: ``hp > 50 && target != null``."""
+    ``value`` reads blackboard variables by name: ``hp > 50 && target != null``.
+    """
 
     def __init__(self, value: str) -> None:
         self.expression = Expression(value)
 
+    @override
     def tick(self) -> Status:
         return SUCCESS if truthy(self.expression.evaluate(self.blackboard.globals)) \
             else FAILURE
 
 
 class Calculate(Action):
-    """Evaluate the expression ``value`` into the ``result`` output; SUCCESS."""
+    """Evaluates the expression ``value`` into the ``result`` output; SUCCESS."""
 
     outputs = ("result",)
 
     def __init__(self, value: str) -> None:
         self.expression = Expression(value)
 
+    @override
     def tick(self) -> Status:
         self.write("result", self.expression.evaluate(self.blackboard.globals))
         return SUCCESS
 
 
 class Let(Action):
-    """Copy a value into the ``variable`` output; SUCCESS.
+    """Copies a value into the ``variable`` output; SUCCESS.
 
     The value is the ``existing`` input's variable when the file binds it, else the JSON arg
-    ``value``; none (or null) deletes the output variable."""
+    ``value``; none (or null) deletes the output variable.
+    """
 
     inputs = ("existing?",)
     outputs = ("variable",)
@@ -123,37 +131,43 @@ class Let(Action):
     def __init__(self, value: Any = None) -> None:
         self.value = value
 
+    @override
     def tick(self) -> Status:
         self.write("variable", oneof(self, "existing", fresh(self.value), None))
         return SUCCESS
 
 
 class Now(Action):
-    """Write the tree clock's time, in seconds, to the ``time`` output; SUCCESS."""
+    """Writes the tree clock's time, in seconds, to the ``time`` output; SUCCESS."""
 
     outputs = ("time",)
 
+    @override
     def tick(self) -> Status:
         self.write("time", self.now)
         return SUCCESS
 
 
 class Clear(Action):
-    """Delete the ``variable`` output's variable (behavior3lua and the editor's sample); SUCCESS."""
+    """Deletes the ``variable`` output's variable; SUCCESS (behavior3lua, the editor's sample)."""
 
     outputs = ("variable",)
 
+    @override
     def tick(self) -> Status:
         self.write("variable", None)
         return SUCCESS
 
 
 class Includes(Condition):
-    """SUCCESS when the ``array`` input holds ``element`` (compared as JavaScript's ``===``),
-    FAILURE when it does not or ``element`` is unset; an ``array`` that is not one raises."""
+    """SUCCESS when the ``array`` input holds ``element``, compared as JavaScript's ``===``.
+
+    FAILURE when it does not or ``element`` is unset; an ``array`` that is not one raises.
+    """
 
     inputs = ("array", "element")
 
+    @override
     def tick(self) -> Status:
         array, element = array_input(self, "array"), self.read("element")
         if element is None:
@@ -162,10 +176,11 @@ class Includes(Condition):
 
 
 class Push(Action):
-    """Append ``element`` to the ``array`` input's list, in place; SUCCESS."""
+    """Appends ``element`` to the ``array`` input's list, in place; SUCCESS."""
 
     inputs = ("array", "element")
 
+    @override
     def tick(self) -> Status:
         array = array_input(self, "array", to_change=True)
         assert isinstance(array, list)
@@ -174,20 +189,23 @@ class Push(Action):
 
 
 class Concat(Action):
-    """Write a new list, ``first`` followed by ``second``, to the ``result`` output; SUCCESS."""
+    """Writes a new list, ``first`` followed by ``second``, to the ``result`` output; SUCCESS."""
 
     inputs = ("first", "second")
     outputs = ("result",)
 
+    @override
     def tick(self) -> Status:
         self.write("result", [*array_input(self, "first"), *array_input(self, "second")])
         return SUCCESS
 
 
 class Index(Action):
-    """Write ``array[index]`` (0-based) to the ``value`` output: SUCCESS, or FAILURE (and the
-    output deleted) when there is no such element. ``index`` is the arg, or the ``index``
-    input when bound (oneof)."""
+    """Writes ``array[index]`` (0-based) to the ``value`` output; SUCCESS.
+
+    FAILURE (and the output deleted) when there is no such element; an index that is not a
+    whole number raises. ``index`` is the arg, or the ``index`` input when bound (oneof).
+    """
 
     inputs = ("array", "index?")
     outputs = ("value",)
@@ -195,6 +213,7 @@ class Index(Action):
     def __init__(self, index: int | None = None) -> None:
         self.at = index  # not self.index: every node's index is its place in the tree
 
+    @override
     def tick(self) -> Status:
         array = array_input(self, "array")
         index = oneof(self, "index", self.at)
@@ -224,8 +243,11 @@ def _object(node: Node, *, to_change: bool = False) -> Any:
 
 
 class GetField(Action):
-    """Write ``object[field]`` to the ``value`` output: SUCCESS, or FAILURE (and the output
-    deleted) when the field is unset. ``field`` is the arg or the bound input (oneof)."""
+    """Writes ``object[field]`` to the ``value`` output; SUCCESS.
+
+    FAILURE (and the output deleted) when the field is unset. ``field`` is the arg or the bound
+    input (oneof).
+    """
 
     inputs = ("object", "field?")
     outputs = ("value",)
@@ -233,6 +255,7 @@ class GetField(Action):
     def __init__(self, field: str | None = None) -> None:
         self.field = field
 
+    @override
     def tick(self) -> Status:
         value = read_member(_object(self), _field(self, self.field))
         self.write("value", value)
@@ -240,10 +263,11 @@ class GetField(Action):
 
 
 class SetField(Action):
-    """Set ``object[field] = value`` in place; a null value deletes the field. SUCCESS.
+    """Sets ``object[field] = value`` in place; a null value deletes the field. SUCCESS.
 
     ``field`` and ``value`` are args, each replaced by its input when bound (oneof). On an
-    array, ``field`` is an index (one past the end appends)."""
+    array, ``field`` is an index (one past the end appends).
+    """
 
     inputs = ("object", "field?", "value?")
 
@@ -251,6 +275,7 @@ class SetField(Action):
         self.field = field
         self.value = value
 
+    @override
     def tick(self) -> Status:
         target = _object(self, to_change=True)
         field = _field(self, self.field)
@@ -277,13 +302,15 @@ class SetField(Action):
 
 
 class RandomIndex(Action):
-    """Pick a random element of the ``array`` input: write it to ``value`` and its index to
-    ``index``; SUCCESS. An empty array (or a null element drawn) gives FAILURE, outputs
-    deleted."""
+    """Writes a random element of the ``array`` input to ``value``, its index to ``index``.
+
+    SUCCESS; an empty array (or a null element drawn) gives FAILURE, the outputs deleted.
+    """
 
     inputs = ("array",)
     outputs = ("value", "index?")
 
+    @override
     def tick(self) -> Status:
         array = array_input(self, "array")
         drawn = random.randrange(len(array)) if array else None

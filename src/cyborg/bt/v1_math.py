@@ -14,6 +14,8 @@ import random
 from collections.abc import Callable
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number
 from cyborg.bt.node import Action, Condition
@@ -78,14 +80,15 @@ def _number(value: Any) -> float:
 
 
 class Math(Action):
-    """Apply ``op`` to numbers and write the result to ``result``; SUCCESS.
+    """Applies ``op`` to numbers and writes the result to ``result``; SUCCESS.
 
     The numbers are ``value1`` and ``value2`` where set, else the inputs in order (unset
     ones skipped); inputs beyond the second are added for min, max, sum, average and product.
     Ops: abs, ceil, floor, round, sign, sin, cos, tan, sqrt, log (one number); atan2, pow,
     randInt, randFloat (two); min, max, sum, average, product (one or more); random (none).
     A wrong count of numbers, or randInt/randFloat with min above max, gives FAILURE (output
-    deleted); a NaN result raises, as behavior3-ts reports it as an error."""
+    deleted); a NaN result raises, as behavior3-ts reports it as an error.
+    """
 
     inputs = ("values...",)
     outputs = ("result",)
@@ -106,6 +109,7 @@ class Math(Action):
                        key=position)
         return [_number(value) for value in map(self.read, ports) if value is not None]
 
+    @override
     def tick(self) -> Status:
         given = self._inputs()
         first = [self.value1] if self.value1 is not None else given[:1]
@@ -141,11 +145,12 @@ _COMPARISONS: tuple[tuple[str, Callable[[float, float], bool]], ...] = (
 
 
 class Cmp(Condition):
-    """Compare a number with the first of ``gt``, ``ge``, ``eq``, ``lt``, ``le`` that is set:
-    SUCCESS when it holds, else FAILURE (behavior3lua).
+    """Compares a number with the first of ``gt``, ``ge``, ``eq``, ``lt``, ``le`` that is set.
 
-    The number is the ``value`` input when bound, else the expression ``value``; an unset
-    number gives FAILURE, anything else that is not a number raises."""
+    SUCCESS when the comparison holds, else FAILURE (behavior3lua); none set raises. The number
+    is the ``value`` input when bound, else the expression ``value``; an unset number gives
+    FAILURE, anything else that is not a number raises.
+    """
 
     inputs = ("value?",)
 
@@ -160,6 +165,7 @@ class Cmp(Condition):
             if bound is not None and self.test is None:
                 self.test = (test, bound)
 
+    @override
     def tick(self) -> Status:
         if self.test is None:
             raise ValueError("Cmp needs one of the args gt, ge, eq, lt, le")
@@ -176,9 +182,11 @@ class Cmp(Condition):
 
 
 class Random(Action):
-    """Write a random number from ``min`` up to ``max`` to ``value`` (rounded down when
-    ``floor``); SUCCESS (behavior3lua). The ``min``/``max`` inputs, when set, win over the
-    args."""
+    """Writes a random number from ``min`` up to ``max`` to ``value``; SUCCESS (behavior3lua).
+
+    The number is rounded down when ``floor``. The ``min``/``max`` inputs, when set, win over
+    the args; either not being a number raises.
+    """
 
     inputs = ("min?", "max?")
     outputs = ("value",)
@@ -187,6 +195,7 @@ class Random(Action):
                  floor: bool = False) -> None:
         self.low, self.high, self.floor = min, max, floor
 
+    @override
     def tick(self) -> Status:
         low, high = self.read("min", self.low), self.read("max", self.high)
         if not (is_number(low) and is_number(high)):

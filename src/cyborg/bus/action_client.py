@@ -19,7 +19,8 @@ from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Generic
 
 from cyborg.bus.actions import STATUS_QOS, ActionError, GoalStatus, goal_uuid, stamp
-from cyborg.bus.msgs.action_msgs.msg import GoalInfo
+from cyborg.bus.msgs.action_msgs.msg import GoalInfo, GoalStatusArray
+from cyborg.bus.msgs.action_msgs.srv import CancelGoal
 from cyborg.bus.services import ServiceError
 from cyborg.bus.typed import FeedbackT, GoalT, ResultT
 
@@ -51,7 +52,7 @@ class ClientGoal(Generic[ResultT, FeedbackT]):
             try:
                 response = self.client._get_result.call(request, timeout=3600.0)
             except ServiceError as exc:
-                if self.client._closed:
+                if self.client.closed:
                     self._result.set_exception(ActionError(f"{self.client.name}: client closed"))
                     return
                 log.debug("get_result of %s: %s; retrying", self.client.name, exc)
@@ -62,6 +63,7 @@ class ClientGoal(Generic[ResultT, FeedbackT]):
 
     @property
     def done(self) -> bool:
+        """Whether the goal has ended and its result is here (or fetching it failed)."""
         return self._result.done()
 
     def result(self, timeout: float | None = None) -> tuple[GoalStatus, ResultT]:
@@ -70,6 +72,11 @@ class ClientGoal(Generic[ResultT, FeedbackT]):
 
     def add_done_callback(self, callback: Callable[[ClientGoal[ResultT, FeedbackT]], object]
                           ) -> None:
+        """Call ``callback(goal)`` once the goal has ended.
+
+        It runs on the thread that fetched the result (a worker of the context's), or at once
+        on the calling thread if the goal has ended already.
+        """
         self._result.add_done_callback(lambda _future: callback(self))
 
     def cancel(self, timeout: float = 5.0) -> bool:
@@ -78,8 +85,11 @@ class ClientGoal(Generic[ResultT, FeedbackT]):
 
 
 class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
-    """Sends goals to an action server and follows them (feedback and status arrive on the
-    node's thread)."""
+    """Sends goals to an action server and follows them.
+
+    Feedback and status arrive on the node's thread; each goal's result is fetched on a worker
+    thread of the context's.
+    """
 
     def __init__(self, node: Node, name: str, action_type: str) -> None:
         types = node.types
@@ -87,22 +97,23 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             raise KeyError(f"{name}: unknown action type {action_type!r}")
         self.node, self.types, self.name, self.action_type = node, types, name, action_type
         self._goals: dict[bytes, ClientGoal[ResultT, FeedbackT]] = {}
+        # The parts this action type adds (SendGoal, GetResult) have no class in an
+        # ActionType: they are named after the action type, which comes as a name.
         self._send_goal_request = types.message_class(f"{action_type}_SendGoal_Request")
         self._get_result_request = types.message_class(f"{action_type}_GetResult_Request")
-        self._cancel_request = types.message_class("action_msgs/srv/CancelGoal_Request")
         self._statuses: dict[bytes, GoalStatus] = {}
         self._closed = False
         base = f"{name}/_action/"
         self._send = node.create_client(base + "send_goal", f"{action_type}_SendGoal")
-        self._cancel_client = node.create_client(base + "cancel_goal",
-                                                 "action_msgs/srv/CancelGoal")
+        self._cancel_client = node.create_client(base + "cancel_goal", CancelGoal)
         self._get_result = node.create_client(base + "get_result", f"{action_type}_GetResult")
         self._feedback_sub = node.create_subscription(
             base + "feedback", f"{action_type}_FeedbackMessage", self._on_feedback)
         self._status_sub = node.create_subscription(
-            base + "status", "action_msgs/msg/GoalStatusArray", self._on_status, STATUS_QOS)
+            base + "status", GoalStatusArray, self._on_status, STATUS_QOS)
 
     def wait_for_server(self, timeout: float = 5.0) -> bool:
+        """Whether the action's server is in the graph within ``timeout`` seconds (blocks)."""
         return self._send.wait_for_service(timeout)
 
     def send_goal(self, goal: GoalT, feedback: Callable[[FeedbackT], object] | None = None,
@@ -123,8 +134,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
 
     def _cancel(self, goal: ClientGoal[ResultT, FeedbackT], timeout: float) -> bool:
         info = GoalInfo(goal_id=goal_uuid(goal.id), stamp=stamp(0.0))
-        request = self._cancel_request(goal_info=info)
-        response = self._cancel_client.call(request, timeout)
+        response = self._cancel_client.call(CancelGoal.Request(goal_info=info), timeout)
         return int(response.return_code) == 0 and bool(response.goals_canceling)
 
     def _on_feedback(self, message: Any) -> None:
@@ -135,7 +145,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if goal.on_feedback is not None:
             goal.on_feedback(message.feedback)
 
-    def _on_status(self, message: Any) -> None:
+    def _on_status(self, message: GoalStatusArray) -> None:
         self._statuses = {bytes(entry.goal_info.goal_id.uuid): GoalStatus(entry.status)
                           for entry in message.status_list}
         for goal_id, status in self._statuses.items():
@@ -143,7 +153,13 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             if goal is not None and not goal.done:
                 goal.status = status
 
+    @property
+    def closed(self) -> bool:
+        """Whether the action client was destroyed."""
+        return self._closed
+
     def destroy(self) -> None:
+        """Withdraw the client's service clients and subscriptions from the bus."""
         self._closed = True
         for entity in (self._send, self._cancel_client, self._get_result, self._feedback_sub,
                        self._status_sub):

@@ -37,6 +37,7 @@ import numpy as np
 from cyborg.bus.conversion import new_message
 from cyborg.bus.msgs.action_msgs.msg import GoalInfo, GoalStatusArray
 from cyborg.bus.msgs.action_msgs.msg import GoalStatus as GoalStatusMessage
+from cyborg.bus.msgs.action_msgs.srv import CancelGoal, CancelGoal_Request, CancelGoal_Response
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.unique_identifier_msgs.msg import UUID
 from cyborg.bus.services import Responder
@@ -70,6 +71,7 @@ class GoalStatus(IntEnum):
 
     @property
     def terminal(self) -> bool:
+        """Whether the goal has ended: SUCCEEDED, CANCELED or ABORTED."""
         return self >= GoalStatus.SUCCEEDED
 
 
@@ -104,18 +106,26 @@ class ServerGoal(Generic[GoalT, FeedbackT]):
 
     @property
     def cancel_requested(self) -> bool:
+        """Whether the goal is to stop: a cancel was granted, or the server is being destroyed.
+
+        ``execute`` should watch it, then stop and call :meth:`canceled`.
+        """
         return self._cancel.is_set()
 
     def publish_feedback(self, feedback: FeedbackT) -> None:
+        """Send ``feedback`` to the clients following this goal (from any thread)."""
         self.server._feedback(self, feedback)
 
     def abort(self) -> None:
+        """End the goal as ABORTED when ``execute`` returns, whatever it returns."""
         self._ending = GoalStatus.ABORTED
 
     def canceled(self) -> None:
+        """End the goal as CANCELED when ``execute`` returns (after a cancel request)."""
         self._ending = GoalStatus.CANCELED
 
     def succeed(self) -> None:
+        """End the goal as SUCCEEDED when ``execute`` returns, as returning does anyway."""
         self._ending = GoalStatus.SUCCEEDED
 
 
@@ -147,21 +157,20 @@ class ActionServer(Generic[GoalT, ResultT, FeedbackT]):
         self._accepted = 0
         self._closed = False
         base = f"{name}/_action/"
+        # The parts this action type adds (SendGoal, GetResult, FeedbackMessage) have no
+        # class in an ActionType: they are named after the action type, which comes as a name.
         self._send_goal_response = types.message_class(f"{action_type}_SendGoal_Response")
         self._result_class = types.message_class(f"{action_type}_Result")
         self._get_result_response = types.message_class(f"{action_type}_GetResult_Response")
         self._feedback_message = types.message_class(f"{action_type}_FeedbackMessage")
-        self._cancel_response = types.message_class("action_msgs/srv/CancelGoal_Response")
         self._entities: list[Any] = [
             node.create_service(base + "send_goal", f"{action_type}_SendGoal", self._on_goal),
-            node.create_service(base + "cancel_goal", "action_msgs/srv/CancelGoal",
-                                self._on_cancel),
+            node.create_service(base + "cancel_goal", CancelGoal, self._on_cancel),
             node.create_service(base + "get_result", f"{action_type}_GetResult",
                                 self._on_get_result, deferred=True)]
         self._feedback_pub = node.create_publisher(
             base + "feedback", f"{action_type}_FeedbackMessage")
-        self._status_pub = node.create_publisher(
-            base + "status", "action_msgs/msg/GoalStatusArray", STATUS_QOS)
+        self._status_pub = node.create_publisher(base + "status", GoalStatusArray, STATUS_QOS)
         self._publish_status()
 
     def _on_goal(self, request: Any) -> Any:
@@ -250,7 +259,7 @@ class ActionServer(Generic[GoalT, ResultT, FeedbackT]):
             return
         responder.reply(self._result_response(*finished))
 
-    def _on_cancel(self, request: Any) -> Any:
+    def _on_cancel(self, request: CancelGoal_Request) -> CancelGoal_Response:
         wanted = bytes(request.goal_info.goal_id.uuid)
         before = request.goal_info.stamp.sec + request.goal_info.stamp.nanosec * 1e-9
         with self._lock:
@@ -267,7 +276,7 @@ class ActionServer(Generic[GoalT, ResultT, FeedbackT]):
         code = 0 if canceling or not candidates else 1
         if any(wanted) and not candidates:
             code = 3 if wanted in self._goals else 2
-        return self._cancel_response(return_code=code, goals_canceling=[
+        return CancelGoal.Response(return_code=code, goals_canceling=[
             GoalInfo(goal_id=goal_uuid(g.id), stamp=stamp(g.accepted_at)) for g in canceling])
 
     def _feedback(self, goal: ServerGoal[GoalT, FeedbackT], feedback: FeedbackT) -> None:
@@ -297,7 +306,16 @@ class ActionServer(Generic[GoalT, ResultT, FeedbackT]):
             if not self._closed:
                 raise
 
+    @property
+    def closed(self) -> bool:
+        """Whether the action server was destroyed."""
+        return self._closed
+
     def destroy(self) -> None:
+        """Withdraw the action from the bus and ask every running goal to stop.
+
+        Running goals see :attr:`ServerGoal.cancel_requested`; their threads are not waited for.
+        """
         with self._lock:
             goals = list(self._goals.values())
             self._closed = True

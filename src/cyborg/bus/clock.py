@@ -64,7 +64,11 @@ Report = tuple[int, str, tuple[Any, ...]]  # a log record to emit once the lock 
 
 
 class SimClock:
-    """Simulated time, from ``/clock`` messages received by ``node`` (see the module doc)."""
+    """Simulated time, from ``/clock`` messages received by ``node`` (see the module doc).
+
+    ``topic`` is the clock topic; ``jump_limit`` and ``stall_timeout`` are seconds, as
+    :data:`JUMP_LIMIT` and :data:`STALL_TIMEOUT` (ValueError unless positive).
+    """
 
     def __init__(self, node: Node, topic: str = CLOCK_TOPIC, *, jump_limit: float = JUMP_LIMIT,
                  stall_timeout: float = STALL_TIMEOUT) -> None:
@@ -219,4 +223,5 @@ class SimClock:
                     self._source_name, self.ignored)
 
     def destroy(self) -> None:
+        """Stop following ``/clock``: the time stays where it is."""
         self._subscription.destroy()

@@ -91,8 +91,11 @@ def _standard_module(package: str, kind: str, names: list[str]) -> str:
 
 def _generated_module(package: str, kind: str, names: list[str], types: MessageTypes,
                       standard: set[str], interfaces: list[str]) -> str:
-    """A module of classes for ``names``, their short aliases, and a descriptor for each
-    service or action of ``interfaces``."""
+    """The text of one module of generated classes.
+
+    It holds a class for each of ``names``, their short aliases, and a descriptor for each
+    service or action of ``interfaces``.
+    """
     fielddefs = types.store.fielddefs
     referenced = sorted({ref for name in names for ref in _references(fielddefs[name][1])}
                         - set(names))
@@ -187,6 +190,7 @@ def differences(files: dict[str, str], root: Path = PACKAGE) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Regenerate the package, or with ``--check`` only report stale files; the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else "")
     parser.add_argument("--check", action="store_true",
                         help="only say whether the package is up to date (exit 1 if not)")

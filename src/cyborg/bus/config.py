@@ -69,7 +69,7 @@ class BusConfig:
         return cls(connect=endpoints, config_file=config_file, overrides=overrides)
 
     @classmethod
-    def router(cls, listen: Sequence[str] = ("tcp/127.0.0.1:7447",),
+    def router(cls, listen: Sequence[str] = (DEFAULT_ROUTER,),
                connect: Sequence[str] = ()) -> BusConfig:
         """A router listening on ``listen`` (all interfaces: ``tcp/[::]:7447``)."""
         return cls(mode="router", connect=tuple(connect), listen=tuple(listen))

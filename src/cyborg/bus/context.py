@@ -59,9 +59,11 @@ getattr(threading, "_register_atexit", atexit.register)(_close_open_contexts)
 
 
 def host_id() -> str:
-    """Identifies this machine (and boot) and user, so shared memory is only offered to local
-    peers of the same user: slot files are private to their owner (mode 0600), and a reader
-    refuses other users' files."""
+    """A 16-hex-digit hash that identifies this machine (and boot) and user.
+
+    Shared memory is only offered to local peers of the same user: slot files are private to
+    their owner (mode 0600), and a reader refuses other users' files.
+    """
     boot = Path("/proc/sys/kernel/random/boot_id")
     text = socket.gethostname() + (boot.read_text().strip() if boot.exists() else "") + \
         f"/uid{os.geteuid()}"
@@ -69,7 +71,12 @@ def host_id() -> str:
 
 
 class Context:
-    """A process's connection to the bus. Close it (or use ``with``) to leave cleanly."""
+    """A process's connection to the bus. Close it (or use ``with``) to leave cleanly.
+
+    ``config`` says how to connect (default :meth:`BusConfig.from_environment`), ``types`` holds
+    the message types (default a fresh :class:`MessageTypes`), and ``domain`` is the ROS domain
+    (default from ``ROS_DOMAIN_ID``, :func:`~cyborg.bus.wire.domain_id`).
+    """
 
     def __init__(self, config: BusConfig | None = None, *, types: MessageTypes | None = None,
                  domain: int | None = None) -> None:
@@ -148,8 +155,10 @@ class Context:
                     del self._shm_readers[topic]
 
     def shm_readers(self, topic: str) -> tuple[tuple[str, int], ...]:
-        """(session id, entity id) of the subscriptions of other sessions on this machine that
-        take ``topic`` through shared memory."""
+        """The subscriptions of other local sessions that take ``topic`` through shared memory.
+
+        Each is a (session id, entity id) pair; sessions of other users or machines never count.
+        """
         with self._lock:
             return tuple(r for r in self._shm_readers.get(topic, ()) if r[0] != self.zid)
 
@@ -158,6 +167,11 @@ class Context:
         return len(self.shm_readers(topic))
 
     def shm_token(self, entity_id: int, topic: str) -> str:
+        """The liveliness key by which subscription ``entity_id`` takes ``topic`` through shm.
+
+        Publishers on this machine find it through :meth:`shm_readers` and send that
+        subscription large messages as slot references.
+        """
         return f"{SHM_PREFIX}/{self.domain}/{self.host}/{self.zid}/{entity_id}/" + \
             topic.replace("/", "%")
 
@@ -173,6 +187,7 @@ class Context:
             return list(self._latched.get(topic, ()))
 
     def remove_local(self, topic: str, subscription: Any) -> None:
+        """Unregister an in-process subscription; nothing happens if it is not registered."""
         with self._lock:
             subscribers = self._local.get(topic, [])
             if subscription in subscribers:
@@ -181,6 +196,7 @@ class Context:
                 self._local.pop(topic, None)
 
     def local_subscriptions(self, topic: str) -> tuple[Any, ...]:
+        """The in-process subscriptions on ``topic`` now, as a snapshot safe to iterate."""
         with self._lock:
             return tuple(self._local.get(topic, ()))
 
@@ -191,6 +207,7 @@ class Context:
             self._latched[topic] = [*entries, (publisher, delivery)]
 
     def unlatch(self, topic: str, publisher: Any) -> None:
+        """Forget the last message of ``publisher`` on ``topic`` (it is being destroyed)."""
         with self._lock:
             entries = [d for d in self._latched.get(topic, []) if d[0] is not publisher]
             if entries:
@@ -200,10 +217,11 @@ class Context:
 
     # ------------------------------------------------------------------ dropped input
     def drop(self, reason: str, detail: str = "") -> None:
-        """Count one dropped input, and say so: the first of each kind at once, then at most
-        once every ``DROP_REPORT_INTERVAL`` seconds with the number dropped since.
+        """Count one dropped input in :attr:`dropped`, and log it.
 
-        ``reason`` names where (the topic or service) and what; ``detail`` says why.
+        The first drop of each kind is logged at once, later ones at most once every
+        ``DROP_REPORT_INTERVAL`` seconds with the number dropped since. ``reason`` names where
+        (the topic or service) and what; ``detail`` says why. Safe to call from any thread.
         """
         now = time.monotonic()
         with self._lock:
@@ -223,16 +241,19 @@ class Context:
 
     # ------------------------------------------------------------------ lifetime
     def register_node(self, node: Any) -> None:
+        """Keep ``node`` to be destroyed by :meth:`close`; each node calls it when created."""
         with self._lock:
             self._nodes.append(node)
 
     def forget_node(self, node: Any) -> None:
+        """Stop keeping ``node`` (destroyed on its own); nothing happens if it is unknown."""
         with self._lock:
             if node in self._nodes:
                 self._nodes.remove(node)
 
     @property
     def closed(self) -> bool:
+        """Whether :meth:`close` has run: its nodes are destroyed and its session is closed."""
         return self._closed
 
     def close(self) -> None:

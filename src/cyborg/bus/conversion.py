@@ -71,6 +71,7 @@ def new_message(types: MessageTypes, type_name: str, data: dict[str, Any] | None
                                     f"(fields: {', '.join(sorted(known))})")
     values = {name: _value(types, spec, data.get(name), _join(path, name))
               for name, spec in fields}
+    # by name: the type is chosen at run time (the command line, a field's definition)
     return types.message_class(type_name)(**values)
 
 

@@ -59,6 +59,7 @@ def supported() -> bool:
 
 
 def encode(entity_id: int, attachment: bytes, reference: bytes) -> bytes:
+    """One datagram for subscription ``entity_id``, the inverse of :func:`decode`."""
     return _HEAD.pack(entity_id, len(attachment)) + attachment + reference
 
 
@@ -84,7 +85,12 @@ def sender_uid(ancillary: list[tuple[int, int, bytes]]) -> int | None:
 
 
 class Doorbell:
-    """One session's doorbell: rings others' (:meth:`ring`), answers its own on a thread."""
+    """One session's doorbell: rings others' (:meth:`ring`), answers its own on a thread.
+
+    ``domain`` and ``zid`` (the session's Zenoh id) name its socket; ``drop(reason, detail)``
+    counts a rejected datagram (:meth:`Context.drop <cyborg.bus.context.Context.drop>`).
+    Raises OSError if the socket cannot be bound, e.g. when the name is taken.
+    """
 
     def __init__(self, domain: int, zid: str,
                  drop: Callable[[str, str], None]) -> None:
@@ -108,10 +114,12 @@ class Doorbell:
 
     # ------------------------------------------------------------------ receiving
     def register(self, entity_id: int, handler: Handler) -> None:
+        """Hand datagrams for subscription ``entity_id`` to ``handler``, on the doorbell thread."""
         with self._lock:
             self._handlers[entity_id] = handler
 
     def unregister(self, entity_id: int) -> None:
+        """Drop the handler of ``entity_id``; its later datagrams are ignored."""
         with self._lock:
             self._handlers.pop(entity_id, None)
 

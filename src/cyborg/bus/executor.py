@@ -31,11 +31,15 @@ _STOP = object()
 
 
 class CallbackThread:
-    """Runs submitted callables in order on one daemon thread."""
+    """Runs submitted callables in order on one daemon thread.
+
+    ``name`` (the node's full name) names the thread, ``cyborg-node<name>``, and the log lines.
+    """
 
     def __init__(self, name: str) -> None:
         self.name = name
         self.errors = 0
+        """Callbacks that raised so far."""
         self._reported: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._busy = threading.Lock()  # held while one of this node's callbacks runs
@@ -45,8 +49,11 @@ class CallbackThread:
         self._thread.start()
 
     def route(self, owner: object, thread: CallbackThread) -> None:
-        """Run the callbacks ``owner`` submits here (its bound methods, as a service server
-        submits its handler) on ``thread`` instead, in their order, one at a time."""
+        """Run the callbacks ``owner`` submits here on ``thread`` instead.
+
+        The callbacks are ``owner``'s bound methods (as a service server submits its handler);
+        they run in their order, one at a time.
+        """
         self._routes[id(owner)] = (owner, thread)
 
     def _routed(self, function: Callable[..., object]) -> CallbackThread | None:
@@ -55,6 +62,7 @@ class CallbackThread:
         return entry[1] if entry is not None and entry[0] is owner else None
 
     def submit(self, function: Callable[..., object], *args: Any) -> None:
+        """Queue ``function(*args)`` to run on this thread (or its owner's route); any thread."""
         thread = self._routed(function) if self._routes else None
         if thread is not None:
             thread.submit(function, *args)
@@ -62,6 +70,7 @@ class CallbackThread:
         self._queue.put((function, args))
 
     def in_thread(self) -> bool:
+        """Whether the caller is running on this thread."""
         return threading.current_thread() is self._thread
 
     def _run(self) -> None:
@@ -74,8 +83,10 @@ class CallbackThread:
                 self.call(function, *args)
 
     def flush(self, timeout: float = 5.0) -> bool:
-        """Wait until every callback queued here before this call has run; False if that
-        takes more than ``timeout`` seconds.
+        """Wait until every callback queued here before this call has run.
+
+        Returns False if that takes more than ``timeout`` seconds; raises RuntimeError when
+        called on this thread itself, which would wait forever.
 
         A message published in this process is queued to the subscribing node's thread, so
         once ``subscriber_node.callbacks.flush()`` returns True its callback has seen it (a

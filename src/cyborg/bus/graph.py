@@ -83,7 +83,8 @@ def parse_token(key: str) -> GraphEntity | None:
 class Graph:
     """The live tokens of one domain, with queries in the style of ``ros2 node/topic list``.
 
-    Thread-safe: tokens arrive on Zenoh threads, queries come from anywhere.
+    Thread-safe: tokens arrive on Zenoh threads, queries come from anywhere. Tokens of other
+    domains than ``domain`` are ignored.
     """
 
     def __init__(self, domain: int) -> None:
@@ -100,6 +101,7 @@ class Graph:
 
     # ------------------------------------------------------------------ updates
     def add(self, key: str) -> None:
+        """Record a token that appeared; keys that are not tokens of this domain are ignored."""
         entity = parse_token(key)
         if entity is None or entity.domain != self.domain:
             return
@@ -112,6 +114,7 @@ class Graph:
         self._notify()
 
     def remove(self, key: str) -> None:
+        """Forget a token that vanished, then tell the departure and change listeners."""
         with self._changed:
             entity = self._drop(key)
             if entity is None:
@@ -142,8 +145,10 @@ class Graph:
         return lambda: self._listeners.remove(listener) if listener in self._listeners else None
 
     def on_departure(self, listener: Callable[[GraphEntity], None]) -> None:
-        """Call ``listener(entity)`` (on a Zenoh thread) for each entity that leaves the graph,
-        e.g. to forget what was kept about a publisher."""
+        """Call ``listener(entity)`` (on a Zenoh thread) for each entity that leaves the graph.
+
+        For example, to forget what was kept about a publisher.
+        """
         self._departures.append(listener)
 
     def _notify(self) -> None:
@@ -157,6 +162,7 @@ class Graph:
 
     # ------------------------------------------------------------------ queries
     def entities(self, kinds: Iterable[EntityKind] | None = None) -> list[GraphEntity]:
+        """The live entities of ``kinds`` (default: all), in no particular order."""
         wanted = set(kinds) if kinds is not None else None
         with self._lock:
             return [e for e in self._entities.values() if wanted is None or e.kind in wanted]
@@ -180,6 +186,7 @@ class Graph:
         return result
 
     def endpoints(self, topic: str, kind: EntityKind) -> list[GraphEntity]:
+        """The live endpoints of ``kind`` on ``topic`` (or service name); a cheap index lookup."""
         with self._lock:
             return list(self._by_endpoint.get((topic, kind), {}).values())
 
@@ -188,5 +195,6 @@ class Graph:
         return sum(1 for e in self.endpoints(topic, kind) if e.zid != exclude_zid)
 
     def node_endpoints(self, node_name: str) -> list[GraphEntity]:
+        """The endpoints (not the node tokens) of nodes named ``node_name``, ``/ns/node``."""
         return [e for e in self.entities() if e.node_name == node_name
                 and e.kind is not EntityKind.NODE]

@@ -141,8 +141,11 @@ class MessageTypes:
             self._use_static_class(name)
 
     def _use_static_class(self, type_name: str) -> None:
-        """Put the class generated into :mod:`cyborg.bus.msgs` for ``type_name`` in place of
-        the one rosbags just made, if there is one and it matches field for field."""
+        """Put the class generated for ``type_name`` in place of the one rosbags just made.
+
+        Only if :mod:`cyborg.bus.msgs` has one and it matches field for field. The module is
+        found by the type's name: this runs for whatever interface files were read.
+        """
         package, kind, short = type_name.split("/")
         try:
             module = importlib.import_module(f"cyborg.bus.msgs.{package}.{kind}")
@@ -199,7 +202,7 @@ class MessageTypes:
 
     @staticmethod
     def _parse(text: str, name: str, package: str) -> Any:
-        """rosbags' definition of one message part; unqualified names resolve to ``package``."""
+        """The rosbags definition of one message part; unqualified names resolve to ``package``."""
         as_message = f"{package}/msg/{name.rsplit('/', 1)[-1]}"
         consts, fields = get_types_from_msg(text, as_message)[as_message]
         if not fields:  # ROS gives an empty struct one uint8 member, on the wire too
@@ -232,7 +235,12 @@ class MessageTypes:
         return rihs01(type_name, self.fields)
 
     def message_class(self, type_name: str) -> type:
-        """The Python class (a dataclass) for a message type."""
+        """The Python class (a dataclass) for a message type given by name; KeyError if unknown.
+
+        For a type known only at run time (the command line, a definition's field, an endpoint
+        made from a name). Where the type is fixed, import its class from
+        :mod:`cyborg.bus.msgs` instead: it is the same class, and mypy knows it.
+        """
         try:
             cls: type = self.store.types[type_name]
         except KeyError:
@@ -240,8 +248,10 @@ class MessageTypes:
         return cls
 
     def type_name(self, message_type: type[Any] | str) -> str:
-        """The type name of ``message_type``, given by name or as a class; a class must be
-        this store's own (from :mod:`cyborg.bus.msgs`), or TypeError."""
+        """The type name of ``message_type``, given by name or as a class.
+
+        A class must be this store's own (from :mod:`cyborg.bus.msgs`), or TypeError.
+        """
         name = message_type_name(message_type)
         if not isinstance(message_type, str) and self.store.types.get(name) is not message_type:
             raise TypeError(f"{message_type!r} is not the class of {name} here; import message "
@@ -249,8 +259,10 @@ class MessageTypes:
         return name
 
     def service_name(self, service_type: ServiceType[Any, Any] | str) -> str:
-        """The name of a service type, given by name or as a checked
-        :class:`~cyborg.bus.typed.ServiceType`."""
+        """The name of a service type, given by name or as a :class:`~cyborg.bus.typed.ServiceType`.
+
+        A ServiceType's classes must be this store's own, or TypeError.
+        """
         name = service_type_name(service_type)
         if isinstance(service_type, ServiceType):
             self.type_name(service_type.Request)
@@ -258,8 +270,10 @@ class MessageTypes:
         return name
 
     def action_name(self, action_type: ActionType[Any, Any, Any] | str) -> str:
-        """The name of an action type, given by name or as a checked
-        :class:`~cyborg.bus.typed.ActionType`."""
+        """The name of an action type, given by name or as an :class:`~cyborg.bus.typed.ActionType`.
+
+        An ActionType's classes must be this store's own, or TypeError.
+        """
         name = action_type_name(action_type)
         if isinstance(action_type, ActionType):
             for part in (action_type.Goal, action_type.Result, action_type.Feedback):
@@ -310,8 +324,10 @@ class MessageTypes:
         return (name, np.dtype(_SMALL_ELEMENTS[element])) if element in _SMALL_ELEMENTS else None
 
     def _large_tail(self, message: Any, type_name: str) -> tuple[str, np.ndarray] | None:
-        """The last field's name and value if it is a large sequence of small
-        numbers held as a contiguous native array; None otherwise."""
+        """The last field's name and value if it is a large sequence of small numbers.
+
+        Only when it is held as a contiguous native array; None otherwise.
+        """
         if type_name not in self._tails:
             self._tails[type_name] = self._tail_field(type_name)
         described = self._tails[type_name]

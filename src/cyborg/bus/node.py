@@ -27,7 +27,7 @@ from __future__ import annotations
 import re
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Literal, TypeVar, overload
+from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar, overload
 
 from cyborg.bus.context import Context
 from cyborg.bus.executor import CallbackThread
@@ -45,7 +45,18 @@ if TYPE_CHECKING:
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _NAMESPACE = re.compile(r"^(/[A-Za-z][A-Za-z0-9_]*)*/?$")
 
-_E = TypeVar("_E")
+
+
+class _Entity(Protocol):
+    """What a node keeps of each endpoint it made: whether it is gone, and how to end it."""
+
+    @property
+    def closed(self) -> bool: ...
+
+    def destroy(self) -> None: ...
+
+
+_E = TypeVar("_E", bound=_Entity)
 _M = TypeVar("_M")
 _Req = TypeVar("_Req")
 _Resp = TypeVar("_Resp")
@@ -67,7 +78,12 @@ def default_context() -> Context:
 
 
 class Node:
-    """A ROS-style node: publishers, subscriptions, services, actions, parameters, timers."""
+    """A ROS-style node: publishers, subscriptions, services, actions, parameters, timers.
+
+    ``name`` and ``namespace`` make its full name, ``/ns/name`` (ValueError if either is not a
+    ROS name); ``context`` defaults to :func:`default_context`; ``parameters`` overrides the
+    defaults of parameters the node declares later (:class:`~cyborg.bus.parameters.Parameters`).
+    """
 
     def __init__(self, name: str, namespace: str = "/", *, context: Context | None = None,
                  parameters: dict[str, Any] | None = None) -> None:
@@ -83,7 +99,7 @@ class Node:
         self.id = self.context.next_id()
         self.callbacks = CallbackThread(self.fq_name)
         self._callback_threads: list[CallbackThread] = []
-        self._entities: list[Any] = []
+        self._entities: list[_Entity] = []
         self._kept_after_prune = 16
         self._timers: list[Timer] = []
         self._destroyed = False
@@ -100,6 +116,7 @@ class Node:
 
     @property
     def types(self) -> MessageTypes:
+        """The message types of the node's context."""
         return self.context.types
 
     # ------------------------------------------------------------------ topics
@@ -112,8 +129,11 @@ class Node:
 
     def create_publisher(self, topic: str, message_type: type[Any] | str,
                          qos: Qos | None = None) -> Publisher[Any]:
-        """A publisher of ``message_type`` (a class from :mod:`cyborg.bus.msgs`, or a type
-        name); ``Qos.latched()`` keeps the last message for late subscribers."""
+        """A publisher of ``message_type``: a class from :mod:`cyborg.bus.msgs`, or a type name.
+
+        ``Qos.latched()`` keeps the last message for late subscribers; the default QoS is
+        reliable with a depth of 10.
+        """
         return self._keep(Publisher, topic, self.types.type_name(message_type),
                           qos or Qos(depth=10))
 
@@ -177,8 +197,11 @@ class Node:
         return server
 
     def callback_thread(self, name: str) -> CallbackThread:
-        """Another thread for some of this node's callbacks (like a ROS 2 callback group with
-        an executor of its own); it stops with the node."""
+        """Another thread for some of this node's callbacks; it stops with the node.
+
+        It is like a ROS 2 callback group with an executor of its own; ``name`` tells it apart
+        in thread names and logs. Raises RuntimeError once the node is destroyed.
+        """
         if self._destroyed:
             raise RuntimeError(f"node {self.fq_name} was destroyed")
         thread = CallbackThread(f"{self.fq_name}[{name}]")
@@ -254,7 +277,7 @@ class Node:
         if len(self._entities) >= 2 * self._kept_after_prune:
             # entities destroyed one by one (a viewer's subscriptions, a reload's clients) are
             # forgotten here, so a node that lives for days does not hold them all
-            self._entities = [e for e in self._entities if not getattr(e, "_closed", False)]
+            self._entities = [e for e in self._entities if not e.closed]
             self._kept_after_prune = max(16, len(self._entities))
         return entity
 
@@ -282,7 +305,11 @@ class Node:
 
 
 class Timer:
-    """A periodic callback on the node's thread; ticks that would pile up are skipped."""
+    """A periodic callback on the node's thread; ticks that would pile up are skipped.
+
+    Made by :meth:`Node.create_timer`: ``callback()`` every ``period`` seconds of wall time
+    (ValueError unless positive), timed on a thread of its own.
+    """
 
     def __init__(self, node: Node, period: float, callback: Callable[[], object]) -> None:
         if period <= 0:
@@ -308,9 +335,11 @@ class Timer:
 
     @property
     def cancelled(self) -> bool:
+        """Whether :meth:`cancel` has been called."""
         return self._stop.is_set()
 
     def cancel(self) -> None:
+        """Stop the timer: no call starts after this returns. Safe to call twice."""
         self._stop.set()
         if threading.current_thread() is not self._thread:
             self._thread.join(1.0)

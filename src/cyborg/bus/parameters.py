@@ -22,8 +22,36 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from cyborg.bus.msgs.rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ListParametersResult,
+    ParameterDescriptor,
+    ParameterValue,
+    SetParametersResult,
+)
+from cyborg.bus.msgs.rcl_interfaces.srv import (
+    DescribeParameters,
+    DescribeParameters_Request,
+    DescribeParameters_Response,
+    GetParameters,
+    GetParameters_Request,
+    GetParameters_Response,
+    GetParameterTypes,
+    GetParameterTypes_Request,
+    GetParameterTypes_Response,
+    ListParameters,
+    ListParameters_Request,
+    ListParameters_Response,
+    SetParameters,
+    SetParameters_Request,
+    SetParameters_Response,
+    SetParametersAtomically,
+    SetParametersAtomically_Request,
+    SetParametersAtomically_Response,
+)
+
 if TYPE_CHECKING:
-    from cyborg.bus.message_types import MessageTypes
     from cyborg.bus.node import Node
 
 NOT_SET, BOOL, INTEGER, DOUBLE, STRING = 0, 1, 2, 3, 4
@@ -62,8 +90,11 @@ def type_of(value: Any) -> int:
                      "or a list of one of them)")
 
 
-def to_message(types: MessageTypes, value: Any, kind: int | None = None) -> Any:
-    """A Python value as ``rcl_interfaces/msg/ParameterValue`` (``kind`` for empty lists)."""
+def to_message(value: Any, kind: int | None = None) -> ParameterValue:
+    """A Python value as ``rcl_interfaces/msg/ParameterValue`` (``kind`` for empty lists).
+
+    Raises ValueError for a value no parameter can hold (see :func:`type_of`).
+    """
     code = type_of(value) if kind is None else kind
     fields: dict[str, Any] = {"type": code, "bool_value": False, "integer_value": 0,
                               "double_value": 0.0, "string_value": "",
@@ -76,7 +107,7 @@ def to_message(types: MessageTypes, value: Any, kind: int | None = None) -> Any:
         fields[_FIELDS[code]] = list(value)
     elif code != NOT_SET:
         fields[_FIELDS[code]] = value
-    return types.message_class("rcl_interfaces/msg/ParameterValue")(**fields)
+    return ParameterValue(**fields)
 
 
 def from_message(message: Any) -> Any:
@@ -95,11 +126,14 @@ def from_message(message: Any) -> Any:
 
 @dataclass
 class Declared:
+    """One declared parameter: its value now and what was declared with it."""
+
     name: str
     value: Any
     description: str = ""
     read_only: bool = False
     limits: tuple[float, float] | None = None
+    """Lowest and highest value of a number parameter, inclusive; None: any."""
     kind: int = NOT_SET
     """The ParameterType, fixed by the default (an empty list can be any array type)."""
 
@@ -109,19 +143,19 @@ class Parameters:
 
     def __init__(self, node: Node, overrides: dict[str, Any]) -> None:
         self._node = node
-        self._types = node.types
         self._declared: dict[str, Declared] = {}
         self._overrides = dict(overrides)
         self._checks: list[Callable[[Changes], object]] = []
         self._listeners: list[Callable[[Changes], object]] = []
         self._lock = threading.RLock()
         prefix = f"{node.fq_name}/"
-        for name, handler in (("list_parameters", self._list), ("get_parameters", self._get),
-                              ("set_parameters", self._set),
-                              ("set_parameters_atomically", self._set_atomically),
-                              ("describe_parameters", self._describe),
-                              ("get_parameter_types", self._get_types)):
-            node.create_service(prefix + name, f"rcl_interfaces/srv/{_camel(name)}", handler)
+        node.create_service(prefix + "list_parameters", ListParameters, self._list)
+        node.create_service(prefix + "get_parameters", GetParameters, self._get)
+        node.create_service(prefix + "set_parameters", SetParameters, self._set)
+        node.create_service(prefix + "set_parameters_atomically", SetParametersAtomically,
+                            self._set_atomically)
+        node.create_service(prefix + "describe_parameters", DescribeParameters, self._describe)
+        node.create_service(prefix + "get_parameter_types", GetParameterTypes, self._get_types)
 
     # ------------------------------------------------------------------ Python API
     def declare(self, name: str, default: Any, description: str = "", *,
@@ -151,6 +185,7 @@ class Parameters:
         return name in self._declared
 
     def names(self) -> list[str]:
+        """The declared parameters' names, sorted."""
         return sorted(self._declared)
 
     def on_set(self, check: Callable[[Changes], object]) -> None:
@@ -199,35 +234,34 @@ class Parameters:
         return list(value) if isinstance(value, tuple) else value
 
     # ------------------------------------------------------------------ services
-    def _response(self, service: str, **fields: Any) -> Any:
-        return self._types.message_class(f"rcl_interfaces/srv/{service}_Response")(**fields)
+    @staticmethod
+    def _result(error: str | None) -> SetParametersResult:
+        return SetParametersResult(successful=error is None, reason=error or "")
 
-    def _result(self, error: str | None) -> Any:
-        return self._types.message_class("rcl_interfaces/msg/SetParametersResult")(
-            successful=error is None, reason=error or "")
-
-    def _list(self, request: Any) -> Any:
+    def _list(self, request: ListParameters_Request) -> ListParameters_Response:
         prefixes: Sequence[str] = request.prefixes
         names = [n for n in self.names() if not prefixes or any(
             n == p or n.startswith(p + ".") for p in prefixes)]
-        result = self._types.message_class("rcl_interfaces/msg/ListParametersResult")(
+        result = ListParametersResult(
             names=names, prefixes=sorted({n.rsplit(".", 1)[0] for n in names if "." in n}))
-        return self._response("ListParameters", result=result)
+        return ListParameters.Response(result=result)
 
-    def _get(self, request: Any) -> Any:
-        values = [to_message(self._types, self._declared[n].value, self._declared[n].kind)
-                  if n in self._declared else to_message(self._types, None)
+    def _get(self, request: GetParameters_Request) -> GetParameters_Response:
+        values = [to_message(self._declared[n].value, self._declared[n].kind)
+                  if n in self._declared else to_message(None)
                   for n in request.names]
-        return self._response("GetParameters", values=values)
+        return GetParameters.Response(values=values)
 
-    def _get_types(self, request: Any) -> Any:
+    def _get_types(self, request: GetParameterTypes_Request) -> GetParameterTypes_Response:
         codes = [self._declared[n].kind if n in self._declared else NOT_SET
                  for n in request.names]
-        return self._response("GetParameterTypes", types=np.array(codes, dtype=np.uint8))
+        return GetParameterTypes.Response(types=np.array(codes, dtype=np.uint8))
 
-    def _set(self, request: Any) -> Any:
-        """One result per parameter, in order; a value that cannot be read is refused in its
-        result (as a wrong type is), never raised."""
+    def _set(self, request: SetParameters_Request) -> SetParameters_Response:
+        """One result per parameter, in order, each set on its own.
+
+        A value that cannot be read is refused in its result (as a wrong type is), never raised.
+        """
         results = []
         for parameter in request.parameters:
             try:
@@ -235,16 +269,17 @@ class Parameters:
             except ValueError as exc:
                 error = f"parameter {parameter.name!r}: {exc}"
             results.append(self._result(error))
-        return self._response("SetParameters", results=results)
+        return SetParameters.Response(results=results)
 
-    def _set_atomically(self, request: Any) -> Any:
+    def _set_atomically(self, request: SetParametersAtomically_Request
+                        ) -> SetParametersAtomically_Response:
         try:
             changes = {p.name: from_message(p.value) for p in request.parameters}
         except ValueError as exc:
             error: str | None = str(exc)
         else:
             error = self._try_set(changes)
-        return self._response("SetParametersAtomically", result=self._result(error))
+        return SetParametersAtomically.Response(result=self._result(error))
 
     def _try_set(self, changes: Changes) -> str | None:
         try:
@@ -253,27 +288,20 @@ class Parameters:
             return str(exc)
         return None
 
-    def _describe(self, request: Any) -> Any:
-        descriptor = self._types.message_class("rcl_interfaces/msg/ParameterDescriptor")
-        double_range = self._types.message_class("rcl_interfaces/msg/FloatingPointRange")
-        integer_range = self._types.message_class("rcl_interfaces/msg/IntegerRange")
+    def _describe(self, request: DescribeParameters_Request) -> DescribeParameters_Response:
         descriptors = []
         for name in request.names:
             declared = self._declared.get(name, Declared(name, None))
             code = declared.kind
             floats, integers = [], []
             if declared.limits and code == DOUBLE:
-                floats = [double_range(from_value=float(declared.limits[0]),
+                floats = [FloatingPointRange(from_value=float(declared.limits[0]),
                                        to_value=float(declared.limits[1]), step=0.0)]
             if declared.limits and code == INTEGER:
-                integers = [integer_range(from_value=int(declared.limits[0]),
+                integers = [IntegerRange(from_value=int(declared.limits[0]),
                                           to_value=int(declared.limits[1]), step=0)]
-            descriptors.append(descriptor(
+            descriptors.append(ParameterDescriptor(
                 name=name, type=code, description=declared.description,
                 additional_constraints="", read_only=declared.read_only, dynamic_typing=False,
                 floating_point_range=floats, integer_range=integers))
-        return self._response("DescribeParameters", descriptors=descriptors)
-
-
-def _camel(snake: str) -> str:
-    return "".join(part.capitalize() for part in snake.split("_"))
+        return DescribeParameters.Response(descriptors=descriptors)

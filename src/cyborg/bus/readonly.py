@@ -28,6 +28,7 @@ class ReadonlyCopier:
         self._plans: dict[str, Plan] = {}
 
     def copy(self, message: Any, type_name: str) -> Any:
+        """A copy of ``message`` (of ``type_name``) for one subscriber; see the module doc."""
         plan = self._plans.get(type_name)
         if plan is None:
             plan = self._plans[type_name] = self._plan(type_name)

@@ -41,7 +41,10 @@ the publisher has restarted."""
 
 
 class SequenceTable:
-    """The last delivered sequence number of each publisher GID, bounded. Thread-safe."""
+    """The last delivered sequence number of each publisher GID, bounded. Thread-safe.
+
+    ``capacity`` and ``window`` are as the module doc describes them (ValueError below 1).
+    """
 
     def __init__(self, capacity: int = MAX_PUBLISHERS, window: int = DUPLICATE_WINDOW) -> None:
         if capacity < 1 or window < 1:

@@ -97,8 +97,10 @@ _MAX_ERROR = 300  # characters of an error text that travel
 
 
 def _one_line(text: str, limit: int = _MAX_ERROR) -> str:
-    """The first line of ``text``, control characters escaped, at most ``limit`` characters:
-    what may travel between a server and a caller's terminal (never a traceback)."""
+    """The first line of ``text``, control characters escaped, at most ``limit`` characters.
+
+    That is what may travel between a server and a caller's terminal (never a traceback).
+    """
     first = text.strip().split("\n", 1)[0].strip()
     first = "".join(char if char.isprintable() else f"\\x{ord(char):02x}"
                     if ord(char) < 256 else f"\\u{ord(char):04x}" for char in first)
@@ -107,8 +109,11 @@ def _one_line(text: str, limit: int = _MAX_ERROR) -> str:
 
 def field_problem(types: MessageTypes, type_name: str, message: Any,
                   path: str = "") -> str | None:
-    """Where ``message`` does not fit ``type_name``, as ``"goal.x: expected a number, got
-    '1'"``; None where it fits. Names the first field that is wrong, however deep."""
+    """Where ``message`` does not fit ``type_name``; None where it fits.
+
+    Names the first field that is wrong, however deep: ``"goal.x: expected a number, got '1'"``.
+    """
+    # by name: the type of each nested field is known only from the definition, at run time
     if not isinstance(message, types.message_class(type_name)):
         return f"{path or 'the message'}: expected a {type_name}, got {_shown(message)}"
     for name, (kind, detail) in types.store.fielddefs[type_name][1]:
@@ -179,10 +184,17 @@ class _ServiceEndpoint:
                                         kind, node.namespace, node.name, self.name,
                                         service_type, type_hash, SERVICE_QOS)
         self.gid = gid(self.token_key)
+        # by name: the endpoint serves whatever type its creator gave (Node checked a
+        # ServiceType's classes against these when it named it)
         self.request_class = context.types.message_class(f"{service_type}_Request")
         self.response_class = context.types.message_class(f"{service_type}_Response")
         self._token = context.session.liveliness().declare_token(self.token_key)
         self._closed = False
+
+    @property
+    def closed(self) -> bool:
+        """Whether this endpoint was destroyed (or its context closed under it)."""
+        return self._closed
 
     def _undeclare(self) -> bool:
         if self._closed or self.context.closed:
@@ -203,13 +215,19 @@ class Responder(Generic[ResponseT]):
 
     @property
     def caller_gid(self) -> bytes:
-        """The calling client's 16-byte GID (from the request's attachment): which client
-        asked, e.g. to release what it set up once its liveliness token is gone."""
+        """The calling client's 16-byte GID, from the request's attachment.
+
+        It says which client asked, e.g. to release what it set up once its liveliness token is
+        gone.
+        """
         return self._attachment.gid
 
     def reply(self, response: ResponseT) -> None:
-        """Send ``response``; one that does not fit the response type becomes an error reply
-        naming the field (and an error in the server's log), sent at once."""
+        """Send ``response`` (from any thread); a second answer to the request is dropped.
+
+        A response that does not fit the response type becomes an error reply naming the field
+        (and an error in the server's log), sent at once.
+        """
         server = self._server
         response_type = f"{server.service_type}_Response"
         if not isinstance(response, server.response_class):
@@ -234,8 +252,11 @@ class Responder(Generic[ResponseT]):
         self._query.drop()
 
     def fail(self, error: BaseException) -> None:
-        """Answer with an error: ``bad request: ...`` for a :class:`RequestError`, else the
-        exception's type and the first line of its message."""
+        """Answer with an error instead of a response (from any thread).
+
+        The caller gets ``bad request: ...`` for a :class:`RequestError`, else the exception's
+        type and the first line of its message.
+        """
         if isinstance(error, RequestError):
             self._send_error(_BAD_REQUEST + error.detail)
         else:
@@ -319,6 +340,7 @@ class ServiceServer(_ServiceEndpoint, Generic[RequestT, ResponseT]):
             responder.fail(exc)
 
     def destroy(self) -> None:
+        """Withdraw the service from the bus; requests arriving later get no answer from it."""
         if self._undeclare():
             self._queryable.undeclare()
 
@@ -331,16 +353,24 @@ class ServiceClient(_ServiceEndpoint, Generic[RequestT, ResponseT]):
         self._sequence = itertools.count(1)
 
     def service_is_ready(self) -> bool:
+        """Whether a server for this service is in the graph now."""
         return self.context.graph.count(self.name, EntityKind.SERVICE_SERVER) > 0
 
     def wait_for_service(self, timeout: float = 5.0) -> bool:
-        """Wait until a server for this service is in the graph."""
+        """Whether a server for this service is in the graph within ``timeout`` seconds.
+
+        Blocks the calling thread until it is or the time is up.
+        """
         return self.context.graph.wait_for(lambda graph: self.service_is_ready(), timeout)
 
     def call(self, request: RequestT, timeout: float = 5.0) -> ResponseT:
-        """Send ``request`` and return the response; raise :class:`ServiceError` on failure:
-        :class:`RequestError` for a request that does not fit the request type (nothing is
-        sent) or that the server refused, :class:`ServiceTimeoutError` without a reply."""
+        """Send ``request`` and return the response, blocking the calling thread for it.
+
+        Raises :class:`ServiceError` on failure: :class:`RequestError` for a request that does
+        not fit the request type (nothing is sent) or that the server refused,
+        :class:`ServiceTimeoutError` without a reply within ``timeout`` seconds, TypeError for a
+        request of another class.
+        """
         if not isinstance(request, self.request_class):
             raise TypeError(f"call {self.name}: expected {self.service_type}_Request, "
                             f"got {type(request).__name__}")
@@ -386,4 +416,5 @@ class ServiceClient(_ServiceEndpoint, Generic[RequestT, ResponseT]):
         return self.context.calls.submit(self.call, request, timeout)
 
     def destroy(self) -> None:
+        """Withdraw the client from the bus graph."""
         self._undeclare()

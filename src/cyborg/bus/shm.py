@@ -71,6 +71,7 @@ class SlotRef:
     length: int
 
     def encode(self) -> bytes:
+        """The reference as bytes, as :meth:`decode` reads it."""
         raw = self.path.encode()
         return _REF.pack(self.generation, self.length, len(raw)) + raw
 
@@ -94,9 +95,11 @@ would need a larger one inline instead."""
 
 
 class SlotRejectedError(Exception):
-    """A slot reference names something that is not one of this user's slots: a FIFO, device,
-    socket or directory, a symbolic link, another user's file, or a file too short or too big.
-    Nothing was opened that could block; the message is dropped."""
+    """A slot reference names something that is not one of this user's slots.
+
+    That is a FIFO, device, socket or directory, a symbolic link, another user's file, or a file
+    too short or too big. Nothing was opened that could block; the message is dropped.
+    """
 
 
 _KINDS = {stat.S_IFIFO: "FIFO", stat.S_IFCHR: "character device", stat.S_IFBLK: "block device",
@@ -179,9 +182,12 @@ class _Slot:
 
 
 class SlotWriter:
-    """One publisher's slots. The slot written last is reused first while no reader holds
-    it, so its pages are still in the CPU cache; a leased slot, or one written within
-    ``REUSE_GRACE``, is skipped, and a new one is made (up to ``max_slots``) when all are."""
+    """One publisher's slots, reused so that their pages stay in the CPU cache.
+
+    The slot written last is reused first while no reader holds it; a leased slot, or one
+    written within ``reuse_grace`` seconds (default ``REUSE_GRACE``), is skipped, and a new one
+    is made (up to ``max_slots``) when all are. Creating a writer removes stale slot files.
+    """
 
     def __init__(self, max_slots: int = 16, reuse_grace: float = REUSE_GRACE) -> None:
         self.max_slots = max_slots
@@ -193,8 +199,11 @@ class SlotWriter:
         remove_stale_slots()
 
     def write(self, length: int, fill: Callable[[memoryview], object]) -> SlotRef | None:
-        """Fill ``length`` bytes of a free slot with ``fill(view)``; None if none is free, or
-        if the message is too big for a slot readers accept (``MAX_SLOT_SIZE``)."""
+        """Fill ``length`` bytes of a free slot with ``fill(view)``; the reference to send.
+
+        Returns None if no slot is free, or if the message is too big for a slot readers accept
+        (``MAX_SLOT_SIZE``).
+        """
         if _HEADER.size + _capacity(length) > MAX_SLOT_SIZE:
             return None
         slot = self._free_slot(length)
@@ -309,7 +318,10 @@ class _MappedSlot:
 
 
 class SlotReader:
-    """Maps publishers' slots (read-only) and leases them for as long as views live."""
+    """Maps publishers' slots (read-only) and leases them for as long as views live.
+
+    The ``cache_size`` slots used last stay mapped; older ones close when their leases end.
+    """
 
     def __init__(self, cache_size: int = 64) -> None:
         self._slots: OrderedDict[str, _MappedSlot] = OrderedDict()
@@ -347,6 +359,7 @@ class SlotReader:
             return opened
 
     def close(self) -> None:
+        """Let go of every slot; each one's file closes once the views leased from it are gone."""
         with self._lock:
             for slot in self._slots.values():
                 slot.retire()

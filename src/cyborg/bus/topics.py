@@ -81,6 +81,11 @@ class _Endpoint:
         self._token: zenoh.LivelinessToken | None = None
         self._closed = False
 
+    @property
+    def closed(self) -> bool:
+        """Whether this endpoint was destroyed (or its context closed under it)."""
+        return self._closed
+
     def _announce(self) -> None:
         self._token = self.context.session.liveliness().declare_token(self.token_key)
 
@@ -97,10 +102,13 @@ class _Endpoint:
 class Publisher(_Endpoint, Generic[MessageT]):
     """Publishes messages of one type on one topic. Create with :meth:`Node.create_publisher`.
 
-    ``Publisher[String]`` takes ``String`` messages only: mypy checks it, :meth:`publish` too."""
+    ``Publisher[String]`` takes ``String`` messages only: mypy checks it, :meth:`publish` too.
+    """
 
     def __init__(self, node: Node, topic: str, type_name: str, qos: Qos) -> None:
         super().__init__(node, topic, type_name, qos, EntityKind.PUBLISHER)
+        # by name: the topic's type is whatever its creator gave (Node checked a class against
+        # this one when it named it)
         self._class = self.context.types.message_class(type_name)
         self._sequence = 0
         self._graph_version, self._remote_count = -1, 0
@@ -129,8 +137,12 @@ class Publisher(_Endpoint, Generic[MessageT]):
         self._announce()
 
     def publish(self, message: MessageT) -> None:
-        """Send ``message`` to every subscriber, choosing the cheapest path for each; those
-        of this process get it queued to their nodes' threads (see :class:`Subscription`)."""
+        """Send ``message`` to every subscriber, choosing the cheapest path for each.
+
+        Those of this process get it queued to their nodes' threads (see
+        :class:`Subscription`). Raises TypeError for a message of another class, RuntimeError
+        once the publisher was destroyed.
+        """
         if not isinstance(message, self._class):
             raise TypeError(f"publish on {self.topic}: expected {self.type_name}, "
                             f"got {type(message).__name__}")
@@ -191,6 +203,7 @@ class Publisher(_Endpoint, Generic[MessageT]):
         return local + remote
 
     def destroy(self) -> None:
+        """Withdraw the publisher from the bus (and its latched message); safe to call twice."""
         # under the lock: a publish on another thread (a node's callback, while the node is
         # being destroyed) may be using the Zenoh publishers, which cannot be undeclared then
         with self._lock:
@@ -390,6 +403,7 @@ class Subscription(_Endpoint, Generic[MessageT]):
         self._deliver_now(message, info)
 
     def destroy(self) -> None:
+        """Withdraw the subscription from the bus; messages still queued are not delivered."""
         if not self._withdraw():
             return
         self.context.remove_local(self.topic, self)

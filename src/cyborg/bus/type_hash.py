@@ -51,6 +51,7 @@ def field_type(type_id: int, *, capacity: int = 0, string_capacity: int = 0,
 
 
 def nested(type_name: str) -> FieldType:
+    """The ``type`` entry of a field holding one message of ``type_name``."""
     return field_type(NESTED, nested=type_name)
 
 

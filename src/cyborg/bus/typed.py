@@ -47,8 +47,11 @@ __all__ = ["ActionType", "FeedbackT", "GoalT", "MessageT", "RequestT", "Response
 
 @dataclass(frozen=True)
 class ServiceType(Generic[RequestT, ResponseT]):
-    """A service type: its name (``std_srvs/srv/SetBool``) and its request and response
-    classes, as rclpy's ``SetBool.Request``. Pass it where a service type name goes."""
+    """A service type: its name and its request and response classes.
+
+    The name is like ``std_srvs/srv/SetBool``; the classes are as rclpy's ``SetBool.Request``.
+    Pass it where a service type name goes.
+    """
 
     name: str
     Request: type[RequestT]
@@ -57,8 +60,10 @@ class ServiceType(Generic[RequestT, ResponseT]):
 
 @dataclass(frozen=True)
 class ActionType(Generic[GoalT, ResultT, FeedbackT]):
-    """An action type: its name (``cyborg_msgs/action/MoveToGoal``) and its goal, result and
-    feedback classes. Pass it where an action type name goes."""
+    """An action type: its name and its goal, result and feedback classes.
+
+    The name is like ``cyborg_msgs/action/MoveToGoal``. Pass it where an action type name goes.
+    """
 
     name: str
     Goal: type[GoalT]
@@ -67,7 +72,10 @@ class ActionType(Generic[GoalT, ResultT, FeedbackT]):
 
 
 def message_type_name(message_type: type[Any] | str) -> str:
-    """``std_msgs/msg/String`` for that name or for its class (from ``__msgtype__``)."""
+    """``std_msgs/msg/String`` for that name or for its class (from ``__msgtype__``).
+
+    Raises TypeError for a class that is not a message class.
+    """
     if isinstance(message_type, str):
         return message_type
     name = getattr(message_type, "__msgtype__", None)

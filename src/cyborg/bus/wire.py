@@ -65,20 +65,27 @@ def mangle(part: str) -> str:
 
 
 def unmangle(part: str) -> str:
+    """The inverse of :func:`mangle`: ``%`` alone becomes empty, any other ``%`` a ``/``."""
     return "" if part == "%" else part.replace("%", "/")
 
 
 class Reliability(IntEnum):
+    """QoS reliability, numbered as in rmw_zenoh's QoS string."""
+
     RELIABLE = 1
     BEST_EFFORT = 2
 
 
 class Durability(IntEnum):
+    """QoS durability, numbered as in rmw_zenoh's QoS string; transient-local is latched."""
+
     TRANSIENT_LOCAL = 1
     VOLATILE = 2
 
 
 class History(IntEnum):
+    """QoS history, numbered as in rmw_zenoh's QoS string."""
+
     KEEP_LAST = 1
     KEEP_ALL = 2
 
@@ -129,6 +136,8 @@ class Qos:
 
 
 class EntityKind(StrEnum):
+    """The kind of a graph entity, as its liveliness token spells it."""
+
     NODE = "NN"
     PUBLISHER = "MP"
     SUBSCRIPTION = "MS"
@@ -170,6 +179,7 @@ class Attachment:
     gid: bytes
 
     def encode(self) -> bytes:
+        """The 33-byte wire form; raises ValueError unless ``gid`` has 16 bytes."""
         if len(self.gid) != 16:
             raise ValueError(f"a GID has 16 bytes, not {len(self.gid)}")
         return _ATTACHMENT.pack(self.sequence, self.timestamp_ns, 16, self.gid)

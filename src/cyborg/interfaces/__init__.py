@@ -5,26 +5,28 @@ actions under a namespace, the message type of each, whether a topic is latched,
 namespace, and the constants that travel in the messages (hook codes, dock states, outcomes).
 When the two sides spell these apart, a renamed topic or a new code breaks one side silently —
 the client waits for a topic nobody publishes. Here each is written once and both sides import
-it, so a rename is a one-line edit and tests/interfaces/test_contracts.py checks, on a live bus, that
-every client endpoint finds its server.
+it, so a rename is a one-line edit and tests/interfaces/test_contracts.py checks, on a live bus,
+that every client endpoint finds its server.
 
 * :mod:`~cyborg.interfaces.contract` — the descriptors :class:`Topic`, :class:`Service` and
-  :class:`Action` (name, type, QoS; they create either side's endpoint on a node), name
-  and name resolution;
+  :class:`Action` (name, message class or service or action type, QoS; they create either
+  side's endpoint on a node, typed by that class), and name resolution;
 * :mod:`~cyborg.interfaces.robot` — the robot's ARNL-like interface (simulator ↔ BusRobot);
 * :mod:`~cyborg.interfaces.tree_runner` — the tree runner's topics and services (runner ↔
   monitor, command line);
 * :mod:`~cyborg.interfaces.detector` — the camera's and the detector's topics.
 
 **Adding to a contract.** Declare the endpoint in the module of the program that serves it,
-e.g. ``BUMPERS = Topic("bumper_state", "cyborg_msgs/msg/BumperState", latched=True)``, use the
-descriptor on both sides (``BUMPERS.publisher(node)`` / ``BUMPERS.subscription(node, on_bumpers,
-namespace)``), add it to the module's ``TOPICS`` or ``SERVICES`` tuple, and extend the test
-that starts both sides. A constant the message carries belongs in the message definition
-(``uint8 FORCE=2`` in the .srv; constants do not change the type hash or the wire format):
-declare it there, regenerate :mod:`cyborg.bus.msgs` (``python3 -m cyborg.bus.codegen``) and
-take it from the class (``ControlNode_Request.FORCE``), never retype it. Only values no
-message defines (ARNL's path states sent as a string) are written here.
+e.g. ``BUMPERS = Topic("bumper_state", BumperState, latched=True)`` with ``BumperState``
+imported from :mod:`cyborg.bus.msgs.cyborg_msgs.msg`, use the descriptor on both sides
+(``BUMPERS.publisher(node)`` / ``BUMPERS.subscription(node, on_bumpers, namespace)``: a
+``Publisher[BumperState]`` and a callback that mypy checks), add it to the module's ``TOPICS``
+or ``SERVICES`` tuple, and extend the test that starts both sides. A constant the message
+carries belongs in the message definition (``uint8 FORCE=2`` in the .srv; constants do not
+change the type hash or the wire format): declare it there, regenerate :mod:`cyborg.bus.msgs`
+(``python3 -m cyborg.bus.codegen``) and take it from the class (``ControlNode_Request.FORCE``),
+never retype it. Only values no message defines (ARNL's path states sent as a string) are
+written here.
 
 This package imports only itself and :mod:`cyborg.bus`; every layer above may import it.
 """

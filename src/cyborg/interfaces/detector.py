@@ -1,6 +1,7 @@
-"""The camera's and the detector's interfaces: what :class:`~cyborg.vision.CameraNode` (or a
-ZED driver on the robot) publishes, what :class:`~cyborg.vision.DetectorNode` reads and
-publishes, and what their consumers subscribe to.
+"""The camera's and the detector's interfaces, between them and their users.
+
+What :class:`~cyborg.vision.CameraNode` (or a ZED driver on the robot) publishes, what
+:class:`~cyborg.vision.DetectorNode` reads and publishes, and what their consumers subscribe to.
 
 Camera, under its namespace (:data:`CAMERA_NAMESPACE`, ``/cyborg/camera`` by default):
 
@@ -28,26 +29,29 @@ The detector reads the camera topics named by its parameters, by default
 
 from __future__ import annotations
 
+from cyborg.bus.msgs.cyborg_msgs.msg import Predictions
+from cyborg.bus.msgs.sensor_msgs.msg import Image
+from cyborg.bus.msgs.vision_msgs.msg import Detection2DArray
 from cyborg.interfaces.contract import Topic
 
 CAMERA_NAMESPACE = "/cyborg/camera"
 DETECTOR_NAMESPACE = "/cyborg/detector"
 
 # ---------------------------------------------------------------------- the camera
-IMAGE = Topic("left/image_raw", "sensor_msgs/msg/Image", depth=2)
-RIGHT_IMAGE = Topic("right/image_raw", "sensor_msgs/msg/Image", depth=2)
-DEPTH = Topic("depth/depth_registered", "sensor_msgs/msg/Image", depth=2)
-CAMERA_STREAMS = {"image": IMAGE, "depth": DEPTH, "right": RIGHT_IMAGE}
+IMAGE = Topic("left/image_raw", Image, depth=2)
+RIGHT_IMAGE = Topic("right/image_raw", Image, depth=2)
+DEPTH = Topic("depth/depth_registered", Image, depth=2)
+CAMERA_STREAMS: dict[str, Topic[Image]] = {"image": IMAGE, "depth": DEPTH, "right": RIGHT_IMAGE}
 """The camera's topics by the stream name a detector pairs them under."""
 
 DEFAULT_IMAGE_TOPIC = IMAGE.full_name(CAMERA_NAMESPACE)
 DEFAULT_DEPTH_TOPIC = DEPTH.full_name(CAMERA_NAMESPACE)
 
 # ---------------------------------------------------------------------- the detector
-PREDICTIONS = Topic("predictions", "cyborg_msgs/msg/Predictions", latched=True)
-DETECTIONS = Topic("detections", "vision_msgs/msg/Detection2DArray", depth=5)
-DETECTION_IMAGE = Topic("detection_image", "sensor_msgs/msg/Image", depth=1)
-DETECTOR_TOPICS = (PREDICTIONS, DETECTIONS, DETECTION_IMAGE)
+PREDICTIONS = Topic("predictions", Predictions, latched=True)
+DETECTIONS = Topic("detections", Detection2DArray, depth=5)
+DETECTION_IMAGE = Topic("detection_image", Image, depth=1)
+DETECTOR_TOPICS: tuple[Topic, ...] = (PREDICTIONS, DETECTIONS, DETECTION_IMAGE)
 
 # ---------------------------------------------------------------------- the detector's parameters
 CONFIDENCE_THRESHOLD = "confidence_threshold"

@@ -1,5 +1,7 @@
-"""The robot's ARNL-like interface: what the simulator (or a bridge to the real robot) serves
-and :class:`~cyborg.robot.bus_robot.BusRobot` uses.
+"""The robot's ARNL-like interface, between the simulator and the robot client.
+
+What the simulator (or a bridge to the real robot) serves and
+:class:`~cyborg.robot.bus_robot.BusRobot` uses.
 
 Under the robot's namespace (:data:`NAMESPACE`, ``/cyborg`` by default), from a node named
 ``arnl`` (the simulator's; rosarnl's in 2018):
@@ -35,40 +37,55 @@ from __future__ import annotations
 
 from enum import IntEnum, StrEnum
 
-from cyborg.bus.clock import CLOCK_TOPIC, CLOCK_TYPE
-from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal_Result
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus
+from cyborg.bus.clock import CLOCK_TOPIC
+from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal, MoveToGoal_Result
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState
+from cyborg.bus.msgs.cyborg_msgs.srv import (
+    AvailableGoals,
+    ClosestGoal,
+    DistanceToGoal,
+    LoadMapFile,
+    MakePlan,
+)
+from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.nav_msgs.msg import Odometry, Path
+from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
+from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
+from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.bus.msgs.std_srvs.srv import Trigger
 from cyborg.interfaces.contract import Action, Service, Topic
 
 NAMESPACE = "/cyborg"
 """The robot's namespace unless told otherwise."""
 
 # ---------------------------------------------------------------------- topics
-CLOCK = Topic(CLOCK_TOPIC, CLOCK_TYPE)
-POSE = Topic("pose", "geometry_msgs/msg/Pose2D")
-ODOM = Topic("odom", "nav_msgs/msg/Odometry")
-SCAN = Topic("scan", "sensor_msgs/msg/LaserScan")
-BUMPER_STATE = Topic("bumper_state", "cyborg_msgs/msg/BumperState", latched=True)
-BATTERY_STATUS = Topic("battery_status", "cyborg_msgs/msg/BatteryStatus", latched=True)
-PATH_STATE = Topic("arnl_path_state", "std_msgs/msg/String", latched=True)
-PATH = Topic("path", "nav_msgs/msg/Path", latched=True)
-TOPICS = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE, PATH)
+CLOCK = Topic(CLOCK_TOPIC, Clock)
+POSE = Topic("pose", Pose2D)
+ODOM = Topic("odom", Odometry)
+SCAN = Topic("scan", LaserScan)
+BUMPER_STATE = Topic("bumper_state", BumperState, latched=True)
+BATTERY_STATUS = Topic("battery_status", BatteryStatus, latched=True)
+PATH_STATE = Topic("arnl_path_state", String, latched=True)
+PATH = Topic("path", Path, latched=True)
+TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
+                             PATH)
 
 # ---------------------------------------------------------------------- services and the action
-DOCK = Service("dock", "std_srvs/srv/Trigger")
-UNDOCK = Service("undock", "std_srvs/srv/Trigger")
-STOP = Service("stop", "std_srvs/srv/Trigger")
-AVAILABLE_GOALS = Service("nav/get_available_goals", "cyborg_msgs/srv/AvailableGoals")
-DISTANCE_TO_GOAL = Service("nav/get_distance_to_goal", "cyborg_msgs/srv/DistanceToGoal")
-CLOSEST_GOAL = Service("nav/get_closest_goal", "cyborg_msgs/srv/ClosestGoal")
-MAKE_PLAN = Service("make_plan", "cyborg_msgs/srv/MakePlan")
-LOAD_MAP_FILE = Service("load_map_file", "cyborg_msgs/srv/LoadMapFile")
-SERVICES = (DOCK, UNDOCK, STOP, AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL, MAKE_PLAN,
-            LOAD_MAP_FILE)
-NAVIGATION_SERVICES = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL, MAKE_PLAN, LOAD_MAP_FILE)
+DOCK = Service("dock", Trigger)
+UNDOCK = Service("undock", Trigger)
+STOP = Service("stop", Trigger)
+AVAILABLE_GOALS = Service("nav/get_available_goals", AvailableGoals)
+DISTANCE_TO_GOAL = Service("nav/get_distance_to_goal", DistanceToGoal)
+CLOSEST_GOAL = Service("nav/get_closest_goal", ClosestGoal)
+MAKE_PLAN = Service("make_plan", MakePlan)
+LOAD_MAP_FILE = Service("load_map_file", LoadMapFile)
+SERVICES: tuple[Service, ...] = (DOCK, UNDOCK, STOP, AVAILABLE_GOALS, DISTANCE_TO_GOAL,
+                                  CLOSEST_GOAL, MAKE_PLAN, LOAD_MAP_FILE)
+NAVIGATION_SERVICES: tuple[Service, ...] = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL,
+                                             MAKE_PLAN, LOAD_MAP_FILE)
 """The services of :mod:`cyborg.nav.services`, answered on the map in use."""
 
-MOVE_TO_GOAL = Action("move_to_goal", "cyborg_msgs/action/MoveToGoal")
+MOVE_TO_GOAL = Action("move_to_goal", MoveToGoal)
 
 # ---------------------------------------------------------------------- values in the messages
 
@@ -120,4 +137,5 @@ class PathState(StrEnum):
 
     @property
     def finished(self) -> bool:
+        """Whether the path is over, reached or not: every state but planning and moving."""
         return self not in (PathState.PLANNING_PATH, PathState.MOVING_TO_GOAL)

@@ -1,5 +1,7 @@
-"""The tree runner's interface: what :mod:`cyborg.runner.tree_runner` (with
-:mod:`cyborg.runner.tree_control`) serves and the monitor (:mod:`cyborg.monitor.source`) uses.
+"""The tree runner's interface, between the runner and the monitor.
+
+What :mod:`cyborg.runner.tree_runner` (with :mod:`cyborg.runner.tree_control`) serves and the
+monitor (:mod:`cyborg.monitor.source`) uses.
 
 Under the runner's namespace (:data:`NAMESPACE`, ``/cyborg/bt`` by default, as in 2018):
 
@@ -28,28 +30,41 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-from cyborg.bus.msgs.cyborg_msgs.srv import ControlNode_Request
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BehaviorTree,
+    BehaviorTreeHooks,
+    BehaviorTreeNodes,
+    BehaviorTreeStatus,
+)
+from cyborg.bus.msgs.cyborg_msgs.srv import (
+    ControlNode,
+    ControlNode_Request,
+    GetBlackboard,
+    ReloadTree,
+)
+from cyborg.bus.msgs.std_msgs.msg import Bool
+from cyborg.bus.msgs.std_srvs.srv import SetBool, Trigger
 from cyborg.interfaces.contract import Service, Topic
 
 NAMESPACE = "/cyborg/bt"
 """The tree runner's namespace unless told otherwise."""
 
 # ---------------------------------------------------------------------- topics
-STRUCTURE = Topic("behavior_tree", "cyborg_msgs/msg/BehaviorTree", latched=True)
-ACTIVE_PATH = Topic("behavior_tree_updates", "cyborg_msgs/msg/BehaviorTreeNodes", latched=True)
-ENABLED = Topic("enabled", "std_msgs/msg/Bool", latched=True)
-STATUS = Topic("status", "cyborg_msgs/msg/BehaviorTreeStatus")
-HOOKS = Topic("hooks", "cyborg_msgs/msg/BehaviorTreeHooks", latched=True)
-TOPICS = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS)
+STRUCTURE = Topic("behavior_tree", BehaviorTree, latched=True)
+ACTIVE_PATH = Topic("behavior_tree_updates", BehaviorTreeNodes, latched=True)
+ENABLED = Topic("enabled", Bool, latched=True)
+STATUS = Topic("status", BehaviorTreeStatus)
+HOOKS = Topic("hooks", BehaviorTreeHooks, latched=True)
+TOPICS: tuple[Topic, ...] = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS)
 
 # ---------------------------------------------------------------------- services
-ENABLE = Service("enable", "std_srvs/srv/SetBool")
-RELOAD = Service("reload", "cyborg_msgs/srv/ReloadTree")
-CONTROL = Service("control", "cyborg_msgs/srv/ControlNode")
-RESUME = Service("resume", "std_srvs/srv/Trigger")
-STEP = Service("step", "std_srvs/srv/Trigger")
-GET_BLACKBOARD = Service("get_blackboard", "cyborg_msgs/srv/GetBlackboard")
-SERVICES = (ENABLE, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
+ENABLE = Service("enable", SetBool)
+RELOAD = Service("reload", ReloadTree)
+CONTROL = Service("control", ControlNode)
+RESUME = Service("resume", Trigger)
+STEP = Service("step", Trigger)
+GET_BLACKBOARD = Service("get_blackboard", GetBlackboard)
+SERVICES: tuple[Service, ...] = (ENABLE, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
 
 # ---------------------------------------------------------------------- values in the messages
 
@@ -77,8 +92,11 @@ class HookStatus(IntEnum):
 
 
 def runner_namespace(topic: str, type_name: str) -> str | None:
-    """The namespace of the runner that publishes ``topic`` of ``type_name``, if that is a
-    runner's structure topic (``/cyborg/bt/behavior_tree`` → ``/cyborg/bt``); else None."""
+    """The namespace of the runner that publishes ``topic`` of ``type_name``, or None.
+
+    Only a runner's structure topic names one (``/cyborg/bt/behavior_tree`` → ``/cyborg/bt``);
+    ``type_name`` is the topic's type as the bus graph shows it.
+    """
     suffix = "/" + STRUCTURE.name
     if type_name != STRUCTURE.type_name or not topic.endswith(suffix):
         return None

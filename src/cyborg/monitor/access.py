@@ -55,8 +55,11 @@ class TokenError(ValueError):
 
 
 def split_authority(value: str | None) -> tuple[str, int | None] | None:
-    """``(host, port)`` of a ``Host`` header (host lower-cased, IPv6 without brackets), or
-    None when it is not a plain ``host[:port]``."""
+    """``(host, port)`` of a ``Host`` header; None when it is not a plain ``host[:port]``.
+
+    The host comes lower-cased, without a trailing dot, an IPv6 address without its brackets;
+    the port is None when the header has none.
+    """
     match = _AUTHORITY.match(value or "")
     if match is None:
         return None
@@ -78,8 +81,11 @@ def _is_address(host: str) -> bool:
 
 
 def this_machine_names() -> set[str]:
-    """The names this machine goes by: its host name, ``NAME.local`` and its fully
-    qualified name (read from the resolver once; ``/etc/hosts`` usually answers)."""
+    """The names this machine goes by: its host name, ``NAME.local`` and its full name.
+
+    The fully qualified name is asked of the resolver (``/etc/hosts`` usually answers); a
+    resolver that fails leaves it out.
+    """
     host = socket.gethostname().lower()
     names = {host, f"{host}.local"}
     with contextlib.suppress(OSError):  # a resolver that fails outright
@@ -88,12 +94,14 @@ def this_machine_names() -> set[str]:
 
 
 class HostPolicy:
-    """Which ``Host`` headers the monitor answers; see the module docstring."""
+    """Which ``Host`` headers the monitor answers; see the module docstring.
+
+    ``allowed``: names the user adds (``.domain`` for a domain and its names, ``*`` for any);
+    ``own_names``: this machine's names (default: :func:`this_machine_names`).
+    """
 
     def __init__(self, allowed: Iterable[str] = (), *,
                  own_names: Iterable[str] | None = None) -> None:
-        """``allowed``: names the user adds (``.domain`` for a domain and its names, ``*``
-        for any); ``own_names``: this machine's names (default: :func:`this_machine_names`)."""
         extra = [name.strip().lower().rstrip(".") for name in allowed if name.strip()]
         self.any = "*" in extra
         self.names = {"localhost", *(own_names if own_names is not None
@@ -124,8 +132,11 @@ class HostPolicy:
 
 
 def own_origin(origin: str, scheme: str, host_header: str | None) -> bool:
-    """Whether a browser's ``Origin`` is the page the request is for: the same scheme
-    (``http`` for ``ws``, ``https`` for ``wss``), host and port as ``Host``."""
+    """Whether a browser's ``Origin`` is the page the request is for.
+
+    It is when it has the same scheme (``http`` for ``ws``, ``https`` for ``wss``), host and
+    port (default ports filled in) as the request's ``scheme`` and ``Host`` header.
+    """
     request = split_authority(host_header)
     if request is None or scheme not in DEFAULT_PORTS:
         return False
@@ -146,8 +157,11 @@ def own_origin(origin: str, scheme: str, host_header: str | None) -> bool:
 
 
 def same_secret(given: str | None, expected: str | None) -> bool:
-    """Constant-time comparison of two secrets as UTF-8 bytes (``hmac.compare_digest`` on
-    ``str`` refuses non-ASCII text). Either missing or empty: False."""
+    """Whether two secrets are equal, compared in constant time as UTF-8 bytes.
+
+    Bytes, because ``hmac.compare_digest`` on ``str`` refuses non-ASCII text. Either missing or
+    empty: False.
+    """
     if not given or not expected:
         return False
     return hmac.compare_digest(given.encode("utf-8", "surrogatepass"),
@@ -156,9 +170,12 @@ def same_secret(given: str | None, expected: str | None) -> bool:
 
 def read_token(token: str | None = None, token_file: str | Path | None = None, *,
                environ: Mapping[str, str] | None = None) -> str | None:
-    """The control token: ``token`` if given, else the first line of ``token_file``, else
-    ``$CYBORG_MONITOR_TOKEN``; None when there is none. A token file other users can read is
-    used, with a warning. :class:`TokenError` when the file cannot be read or is empty."""
+    """The control token; None when there is none.
+
+    It is ``token`` if given, else the first line of ``token_file``, else
+    ``$CYBORG_MONITOR_TOKEN``. A token file other users can read is used, with a warning.
+    Raises :class:`TokenError` when the file cannot be read or is empty.
+    """
     if token:
         return token
     if token_file:

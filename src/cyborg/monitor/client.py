@@ -54,6 +54,7 @@ class Client:
 
     @property
     def host(self) -> str | None:
+        """The peer's address as the server saw it; None when the transport did not say."""
         client = self.websocket.client
         return client.host if client is not None else None
 
@@ -79,6 +80,7 @@ class Client:
         self.queue.put_nowait(RESYNC)
 
     async def next_message(self) -> str:
+        """Waits for the next queued message, for the writer task; :data:`RESYNC` asks for one."""
         text = await self.queue.get()
         self.queued_bytes = max(0, self.queued_bytes - len(text))
         return text

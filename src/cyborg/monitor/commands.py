@@ -61,8 +61,11 @@ class CommandError(ValueError):
 
 
 async def receive(hub: Hub, client: Client, text: str | None) -> None:
-    """Read one message from ``client`` (``text``, or None for a binary frame), carry it out,
-    and answer any fault as a located error (see the module docstring)."""
+    """Reads one message from ``client``, carries it out, and answers any fault as an error.
+
+    ``text`` is None for a binary frame. The error names the message and field at fault (see
+    the module docstring). Runs on the server's event loop.
+    """
     client.received += 1
     command: Any = None
     try:

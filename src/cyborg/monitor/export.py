@@ -36,12 +36,18 @@ class ExportError(RuntimeError):
 
 @dataclass(frozen=True)
 class Export:
+    """A finished export: its bytes, their media type, and the file name to save them under."""
+
     content: bytes
     media_type: str
     filename: str
 
 
 def visible_leaves(node: dict[str, Any], collapsed: set[str]) -> int:
+    """Leaves drawn under ``node`` (a structure's node) when the ids in ``collapsed`` are folded.
+
+    A folded node counts as one leaf.
+    """
     children = node.get("children", [])
     if not children or node["id"] in collapsed:
         return 1

@@ -56,6 +56,7 @@ class LimitError(ValueError):
 
 
 def encode(message: dict[str, Any]) -> str:
+    """Compact JSON text of a message to the pages."""
     return json.dumps(message, separators=(",", ":"))
 
 
@@ -84,8 +85,10 @@ class Hub:
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
-        """The source following ``namespace`` (a checked name), created on first use;
-        ``pinned``: followed for good (the trees the monitor was started with)."""
+        """The source following ``namespace`` (a checked name), created on first use.
+
+        ``pinned``: followed for good (the trees the monitor was started with).
+        """
         found = self.sources.get(namespace)
         if found is None:
             found = self.sources[namespace] = self._make_source(namespace)
@@ -94,8 +97,11 @@ class Hub:
         return found
 
     def _release(self, namespace: str | None) -> bool:
-        """Stop following ``namespace`` if nothing needs it any more: not pinned, watched by
-        no page, its runner gone from the bus. Frees all kept for it; whether it was freed."""
+        """Stops following ``namespace`` if nothing needs it any more; whether it was freed.
+
+        Nothing needs it when it is not pinned, no page watches it and its runner has gone from
+        the bus; all kept for it is freed then.
+        """
         if namespace is None or namespace in self.pinned or self._watchers(namespace):
             return False
         source = self.sources.get(namespace)
@@ -114,10 +120,12 @@ class Hub:
         return True
 
     def watch(self, client: Client, namespace: Any) -> None:
-        """Make ``client`` watch ``namespace`` (any value: checked here) and send it the tree.
+        """Makes ``client`` watch ``namespace`` (any value: checked here) and sends it the tree.
+
         A namespace with no runner on the bus costs nothing: no source is made for it (the
         periodic look follows its runner once one appears). ``ValueError`` for a bad name,
-        :class:`LimitError` past :attr:`Limits.namespaces_per_connection`."""
+        :class:`LimitError` past :attr:`Limits.namespaces_per_connection`.
+        """
         namespace = check_namespace(namespace)
         found = False
         if namespace not in self.sources:
@@ -137,6 +145,7 @@ class Hub:
             self.broadcast(self.robots())
 
     def robots(self) -> dict[str, Any]:
+        """The ``robots`` message: every followed tree's description, and the seat's holder."""
         return {"t": "robots", "robots": [source.describe() for source in
                                           sorted(self.sources.values(),
                                                  key=lambda source: source.namespace)],
@@ -199,6 +208,7 @@ class Hub:
         return [client for client in self.clients if client.watching == namespace]
 
     def broadcast(self, message: dict[str, Any]) -> None:
+        """Queues ``message`` to every connected page, encoded once."""
         text = encode(message)
         for client in self.clients:
             client.send(text)
@@ -209,8 +219,12 @@ class Hub:
                 "paused_at": source.paused_at, "problem": source.problem}
 
     def send_tree(self, client: Client, namespace: str) -> None:
-        """Structure (unless the client shows this very tree now), snapshot, runner state,
-        timings; for a namespace no runner is in, that there is none."""
+        """Sends ``client`` everything about the tree under ``namespace``.
+
+        That is the runner's state, the structure (unless the client shows this very tree now),
+        a snapshot, the timings and the last blackboard; for a namespace no runner is in, that
+        there is none.
+        """
         source = self.sources.get(namespace)
         client.send(self._runner_message(source) if source is not None else
                     {"t": "runner", "ns": namespace, "alive": False, "enabled": None,
@@ -242,6 +256,7 @@ class Hub:
 
     # ------------------------------------------------------------------ clients
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Binds the hub to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
 
     def refusal(self, host: str | None) -> str | None:
@@ -257,16 +272,20 @@ class Hub:
         return None
 
     def connect(self, websocket: WebSocket, *, may_control: bool) -> Client:
-        """A new client for an accepted ``websocket``, numbered and registered in one step
-        (no other connection can come in between and get the same number)."""
+        """A new client for an accepted ``websocket``, numbered and registered in one step.
+
+        No other connection can come in between and get the same number.
+        """
         client = Client(next(self._numbers), websocket, may_control=may_control,
                         limits=self.limits)
         self.clients.add(client)
         return client
 
     def disconnect(self, client: Client) -> None:
-        """Forget ``client``; tell the others only what changed (the seat, the trees), so
-        pages that come and go cost the pages that stay nothing."""
+        """Forgets ``client`` and tells the others only what changed (the seat, the trees).
+
+        Pages that come and go thus cost the pages that stay nothing.
+        """
         self.clients.discard(client)
         if self.seat.disconnected(client.number):
             self.announce_seat()
@@ -275,8 +294,11 @@ class Hub:
             self.broadcast(self.robots())
 
     def seat_message(self, client: Client) -> dict[str, Any]:
-        """Who holds the seat (a connection number, which nobody can present); the seat's
-        secret only to its holder."""
+        """The ``seat`` message for ``client``: who holds it, and what ``client`` may do.
+
+        The holder is named by its connection number, which nobody can present; the seat's
+        secret goes only to its holder.
+        """
         message = {"t": "seat", "may_control": client.may_control,
                    "control": self.seat.holds(client.number),
                    "holder": self.seat.holder.client if self.seat.holder else None}
@@ -286,6 +308,7 @@ class Hub:
         return message
 
     def announce_seat(self) -> None:
+        """Tells every page who holds the seat now (each its own :meth:`seat_message`)."""
         for client in self.clients:
             client.send(self.seat_message(client))
 
@@ -336,8 +359,10 @@ class Hub:
         self.announce_seat()
 
     def _found(self, namespace: str) -> bool:
-        """A tree runner found on the bus: follow it while it is there or watched (at most
-        :data:`FOLLOW_LIMIT` at once). Whether it is new to the monitor."""
+        """Follows a tree runner found on the bus; whether it is new to the monitor.
+
+        It is followed while it is there or watched, at most :data:`FOLLOW_LIMIT` at once.
+        """
         if namespace in self.sources:
             return False
         try:

@@ -68,9 +68,11 @@ class MessageError(ValueError):
 
 
 def check_namespace(value: Any) -> str:
-    """``value`` if it is a namespace a tree runner can have: ``/`` and segments of letters,
-    digits and ``_`` (each starting with a letter), at most :data:`NAMESPACE_LIMIT`
-    characters. A single trailing ``/`` is dropped. ``ValueError`` otherwise."""
+    """``value`` if it is a namespace a tree runner can have; ``ValueError`` otherwise.
+
+    A namespace is ``/`` and segments of letters, digits and ``_`` (each starting with a
+    letter), at most :data:`NAMESPACE_LIMIT` characters. A single trailing ``/`` is dropped.
+    """
     if not isinstance(value, str):
         raise ValueError(f"a namespace is a string such as /cyborg/bt, not {_short(value)}")
     if len(value) > NAMESPACE_LIMIT:
@@ -84,8 +86,10 @@ def check_namespace(value: Any) -> str:
 
 
 def decode(text: str) -> Any:
-    """The JSON value of a message, within :data:`MESSAGE_LIMIT` and :data:`DEPTH_LIMIT`;
-    :class:`MessageError` (with the character position where known) otherwise."""
+    """The JSON value of a message, within :data:`MESSAGE_LIMIT` and :data:`DEPTH_LIMIT`.
+
+    Raises :class:`MessageError` (with the character position where known) otherwise.
+    """
     if len(text) > MESSAGE_LIMIT:
         raise MessageError(f"longer than {MESSAGE_LIMIT} characters ({len(text)})")
     _check_depth(text)
@@ -113,8 +117,11 @@ def _short(value: Any, limit: int = 60) -> str:
 
 
 class Bucket:
-    """A token bucket: :meth:`take` is True while the average stays under ``rate`` a second
-    after a burst of ``burst``."""
+    """A token bucket: at most ``burst`` messages at once, ``rate`` a second on average.
+
+    :meth:`take` is True while the average stays under ``rate`` a second after a burst of
+    ``burst``.
+    """
 
     def __init__(self, rate: float, burst: int) -> None:
         self.rate, self.burst = rate, float(burst)
@@ -122,6 +129,7 @@ class Bucket:
         self.last = time.monotonic()
 
     def take(self, now: float | None = None) -> bool:
+        """Whether one more message may go now (``time.monotonic()`` s by default); takes it."""
         now = time.monotonic() if now is None else now
         self.tokens = min(self.burst, self.tokens + (now - self.last) * self.rate)
         self.last = now

@@ -53,18 +53,19 @@ class MonitorError(RuntimeError):
 
 
 class Monitor:
-    """See the module docstring."""
+    """The monitor: follows tree runners through ``node`` and serves their page once started.
+
+    It follows the tree runners under ``namespaces`` (and any found later) and serves on
+    ``host:port`` (port 0: any free port); see the module docstring. Control from other
+    machines needs ``token`` (default: ``$CYBORG_MONITOR_TOKEN``); requests must name this
+    machine, or one of ``allow_hosts`` (see :class:`~cyborg.monitor.access.HostPolicy`);
+    ``limits`` bounds what viewers cost. ``ValueError`` for a namespace that is not one.
+    """
 
     def __init__(self, node: Node, *, namespaces: list[str] | None = None,
                  host: str = DEFAULT_HOST, port: int = DEFAULT_PORT,
                  token: str | None = None, allow_hosts: list[str] | tuple[str, ...] = (),
                  limits: Limits | None = None) -> None:
-        """Follow the tree runners under ``namespaces`` (and any found later) through
-        ``node``, and serve on ``host:port`` (port 0: any free port) once started. Control
-        from other machines needs ``token`` (default: ``$CYBORG_MONITOR_TOKEN``); requests
-        must name this machine, or one of ``allow_hosts`` (see
-        :class:`~cyborg.monitor.access.HostPolicy`). ``ValueError`` for a namespace that is
-        not one."""
         self.node = node
         self.host, self.requested_port = host, port
         namespaces = [check_namespace(namespace)
@@ -122,8 +123,11 @@ class Monitor:
             return False
 
     def exposure(self) -> str | None:
-        """For a monitor that listens beyond loopback: where, and whether other machines may
-        control (with the token) or only watch. None on loopback."""
+        """Where a monitor listening beyond loopback is exposed; None on loopback.
+
+        The text says where it listens, and whether other machines may control (with the
+        token) or only watch.
+        """
         if self.on_loopback:
             return None
         every = " (every interface)" if self.host in EVERY_INTERFACE else ""

@@ -1,7 +1,7 @@
-"""The monitor page's own files (``/`` and ``/static/...``): served from memory, with Starlette's
-:class:`~starlette.staticfiles.StaticFiles` as the documented fallback.
+"""The monitor page's own files (``/`` and ``/static/...``), served from memory.
 
-:func:`page_files` gives one or the other; both answer ``get_response(path, scope)`` with the
+Starlette's :class:`~starlette.staticfiles.StaticFiles` is the documented fallback;
+:func:`page_files` gives one or the other. Both answer ``get_response(path, scope)`` with the
 same bytes and media types (``tests/monitor/test_static.py`` checks it), an ETag that a reload
 revalidates (``304``), ``Cache-Control: no-cache`` (a page from an older monitor is never run
 from the browser's cache) and ``404`` for anything else, paths outside the folder included.
@@ -50,7 +50,9 @@ then refuses to run the page's modules)."""
 class PageSource(Protocol):
     """What the server asks of the page's files."""
 
-    async def get_response(self, path: str, scope: Scope) -> Response: ...
+    async def get_response(self, path: str, scope: Scope) -> Response:
+        """The answer to a request for ``path`` (relative to the folder), on the event loop."""
+        ...
 
 
 class PageCache:
@@ -66,6 +68,7 @@ class PageCache:
                     content, MEDIA_TYPES[path.suffix], etag)
 
     async def get_response(self, path: str, scope: Scope) -> Response:
+        """The file at ``path``: ``304`` when the request has its ETag, ``404`` when unknown."""
         found = self.files.get(path)
         if found is None:
             return PlainTextResponse(f"no such file: {path}", 404)
@@ -77,11 +80,15 @@ class PageCache:
 
 
 class PageFiles(StaticFiles):
-    """The fallback: Starlette's StaticFiles (ETag and Last-Modified, ``HEAD`` and ranges,
-    nothing outside the folder), always revalidated, with :data:`MEDIA_TYPES`."""
+    """The fallback: Starlette's StaticFiles, always revalidated, with :data:`MEDIA_TYPES`.
+
+    StaticFiles brings ETag and Last-Modified, ``HEAD`` and ranges, and nothing outside the
+    folder.
+    """
 
     def file_response(self, full_path: str | os.PathLike[str], stat_result: os.stat_result,
                       scope: Scope, status_code: int = 200) -> Response:
+        """StaticFiles' response, marked ``no-cache`` and typed by :data:`MEDIA_TYPES`."""
         response = super().file_response(full_path, stat_result, scope, status_code)
         response.headers["Cache-Control"] = "no-cache"
         media_type = MEDIA_TYPES.get(Path(full_path).suffix)
@@ -91,6 +98,9 @@ class PageFiles(StaticFiles):
 
 
 def page_files(folder: Path = STATIC, *, from_memory: bool = True) -> PageSource:
-    """The page's files in ``folder``: from memory (:class:`PageCache`), or with
-    ``from_memory=False`` from disk through Starlette's StaticFiles (:class:`PageFiles`)."""
+    """The page's files in ``folder``, from memory (:class:`PageCache`) by default.
+
+    With ``from_memory=False`` they come from disk through Starlette's StaticFiles
+    (:class:`PageFiles`).
+    """
     return PageCache(folder) if from_memory else PageFiles(directory=folder)

@@ -48,6 +48,8 @@ def is_loopback(host: str | None) -> bool:
 
 @dataclass
 class SeatHolder:
+    """The connection that holds the control seat, or held it and may come back."""
+
     client: int
     """The number of the connection holding the seat (given by the server, never by a page)."""
     secret: str = field(default_factory=lambda: secrets.token_urlsafe(SECRET_BYTES), repr=False)
@@ -59,8 +61,12 @@ class SeatHolder:
 
 
 class ControlSeat:
-    """See the module docstring. Clients are named by their connection numbers. Not
-    thread-safe: use it from the web server's event loop."""
+    """The control seat: who may hold it, and who does now; see the module docstring.
+
+    Clients are named by their connection numbers. ``token`` is the one the monitor was started
+    with; ``grace`` the seconds the seat stays kept for a holder that left. Not thread-safe:
+    use it from the web server's event loop.
+    """
 
     def __init__(self, token: str | None = None, *, grace: float = GRACE) -> None:
         self.token = token or None
@@ -68,8 +74,10 @@ class ControlSeat:
         self.holder: SeatHolder | None = None
 
     def may_control(self, host: str | None, token: str | None) -> bool:
-        """Whether a client at ``host`` presenting ``token`` may hold the seat (the caller
-        checks that a loopback client's page is the monitor's own)."""
+        """Whether a client at ``host`` presenting ``token`` may hold the seat.
+
+        The caller checks that a loopback client's page is the monitor's own.
+        """
         return is_loopback(host) or self.token_matches(token)
 
     def token_matches(self, token: str | None) -> bool:
@@ -77,8 +85,10 @@ class ControlSeat:
         return same_secret(token, self.token)
 
     def claim(self, client: int, *, force: bool = False) -> tuple[bool, int | None]:
-        """Give the seat to ``client``; returns (granted, the client it was taken from).
-        A seat that is held, or kept for a holder that left, goes only with ``force``."""
+        """Gives the seat to ``client``; returns (granted, the client it was taken from).
+
+        A seat that is held, or kept for a holder that left, goes only with ``force``.
+        """
         holder = self.holder
         if holder is not None and holder.client == client:
             return True, None
@@ -91,8 +101,11 @@ class ControlSeat:
         return True, holder.client
 
     def resume(self, client: int, secret: str) -> bool:
-        """Move the seat to ``client`` if ``secret`` is the holder's: the holder's page on a
-        new connection (a reload, a dropped link). The old connection loses the seat."""
+        """Moves the seat to ``client`` if ``secret`` is the holder's; whether it moved.
+
+        That is the holder's page on a new connection (a reload, a dropped link). The old
+        connection loses the seat.
+        """
         holder = self.holder
         if holder is None or not same_secret(secret, holder.secret):
             return False
@@ -100,6 +113,7 @@ class ControlSeat:
         return True
 
     def holds(self, client: int) -> bool:
+        """Whether ``client`` holds the seat now (not merely kept for it after it left)."""
         return self.holder is not None and self.holder.client == client and self.holder.connected
 
     def secret_for(self, client: int) -> str | None:
@@ -122,8 +136,10 @@ class ControlSeat:
         return False
 
     def expired(self, now: float | None = None) -> set[tuple[str, str]] | None:
-        """Free the seat of a holder gone longer than the grace and return the hooks it set
-        (to release); None when the seat did not change."""
+        """Frees the seat of a holder gone longer than the grace; the hooks it set, to release.
+
+        None when the seat did not change. ``now`` defaults to ``time.monotonic()``.
+        """
         holder = self.holder
         now = time.monotonic() if now is None else now
         if holder is None or holder.connected or now - holder.left_at < self.grace:

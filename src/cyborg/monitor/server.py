@@ -51,9 +51,12 @@ EXPORTS_AT_ONCE = 2
 
 def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
                files: PageSource | None = None) -> ASGIApp:
-    """The web application for ``hub``, answering only the names ``hosts`` allows (default:
-    this machine's names and addresses), with the page's ``files`` (default: from memory,
-    :func:`~cyborg.monitor.page_files.page_files`)."""
+    """The web application for ``hub``: the page, its WebSocket and its HTTP API.
+
+    It answers only the names ``hosts`` allows (default: this machine's names and addresses),
+    and serves the page's ``files`` (default: from memory,
+    :func:`~cyborg.monitor.page_files.page_files`).
+    """
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: Starlette) -> AsyncIterator[None]:
@@ -166,14 +169,17 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
 
 
 class HostGuard:
-    """ASGI middleware: ``403`` to every HTTP request and WebSocket whose ``Host`` header
-    :class:`HostPolicy` does not allow (with a denial response where the server supports it,
-    else a close before the handshake, which servers answer with 403)."""
+    """ASGI middleware: ``403`` to every request whose ``Host`` header ``hosts`` does not allow.
+
+    HTTP requests and WebSockets alike: a WebSocket gets a denial response where the server
+    supports it, else a close before the handshake, which servers answer with 403.
+    """
 
     def __init__(self, app: ASGIApp, hosts: HostPolicy) -> None:
         self.app, self.hosts = app, hosts
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        """Passes an allowed request (and lifespan events) on to the app; refuses the rest."""
         if scope["type"] not in ("http", "websocket"):
             await self.app(scope, receive, send)
             return

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from cyborg.bt.status import Status
-from cyborg.bus import Node, Qos, new_message
+from cyborg.bus import Node, Qos, Subscription, new_message
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import tree_runner
 from cyborg.interfaces.contract import Service
@@ -62,7 +62,7 @@ class TreeSource:
         self.problem = ""
         """Why the last structure could not be used, if it could not."""
         ns = self.namespace
-        self._subscriptions = [
+        self._subscriptions: list[Subscription] = [
             tree_runner.STRUCTURE.subscription(node, self._on_structure, ns),
             tree_runner.ACTIVE_PATH.subscription(node, self._on_active, ns),
             tree_runner.ENABLED.subscription(node, self._on_enabled, ns),
@@ -145,6 +145,10 @@ class TreeSource:
             raise ControlError(f"{self.namespace}/{service.name}: {exc}") from exc
 
     def set_enabled(self, on: bool) -> str:
+        """Enables or disables the tree, blocking up to :data:`SERVICE_TIMEOUT` s; the reply.
+
+        Raises :class:`ControlError` when the runner refuses or does not answer.
+        """
         response = self._call(tree_runner.ENABLE, data=on)
         if not response.success:
             raise ControlError(f"{self.namespace}/enable: {response.message}")
@@ -196,9 +200,11 @@ class TreeSource:
                 "problem": self.problem}
 
     def destroy(self) -> None:
-        """Withdraw the subscriptions and service clients, and let go of the tree (the bus
-        node may keep its withdrawn entities, and through them this object, until the node
-        itself is destroyed)."""
+        """Withdraws the subscriptions and service clients, and lets go of the tree.
+
+        The bus node may keep its withdrawn entities, and through them this object, until the
+        node itself is destroyed.
+        """
         self._remove_graph_listener()
         for subscription in self._subscriptions:
             subscription.destroy()

@@ -65,6 +65,7 @@ class TickEntry:
     active: tuple[int, ...]
 
     def to_json(self) -> list[Any]:
+        """``[tick, time (s), duration (ms), root status, visited, statuses, active]``."""
         return [self.tick, round(self.time, 4), round(self.duration * 1000.0, 4), self.root,
                 self.visited.tolist(), self.statuses.tolist(), list(self.active)]
 
@@ -132,8 +133,10 @@ class TreeState:
     def apply_tick(self, tick: int, time: float, duration: float, root: int,
                    visited_ids: list[str], statuses: np.ndarray, durations: np.ndarray,
                    active_ids: list[str]) -> None:
-        """Take one ``status`` message. Ids the structure does not know are ignored (a message
-        from before a reload)."""
+        """Takes one ``status`` message, on the bus node's thread (durations in s).
+
+        Ids the structure does not know are ignored (a message from before a reload).
+        """
         index_of = self.index_of
         pairs = [(index_of.get(uid, -1), position) for position, uid in enumerate(visited_ids)]
         known = [(index, position) for index, position in pairs if index >= 0]
@@ -166,8 +169,10 @@ class TreeState:
                                           new_status, active))
 
     def apply_active(self, active_ids: list[str]) -> None:
-        """Take a ``behavior_tree_updates`` message (the active path, also sent when the tree
-        is paused and no ticks come)."""
+        """Takes a ``behavior_tree_updates`` message: the active path, by node id.
+
+        The runner sends it also when the tree is paused and no ticks come.
+        """
         index_of = self.index_of
         with self._lock:
             self.active = tuple(index_of[uid] for uid in active_ids if uid in index_of)
@@ -210,9 +215,11 @@ class TreeState:
                 "dur": round(self.duration * 1000.0, 4), "root": self.root_status}
 
     def timings(self, *, all_nodes: bool = False) -> list[list[float]]:
-        """``[index, calls, last, mean, min, max (ms), status changes, since]`` for each node
-        whose timings changed since the last call without ``all_nodes`` (or, with it, every
-        timed node)."""
+        """``[index, calls, last, mean, min, max (ms), status changes, since]`` rows.
+
+        One row for each node whose timings changed since the last call without ``all_nodes``
+        (or, with it, every timed node).
+        """
         with self._lock:
             which = np.flatnonzero(self.calls > 0 if all_nodes else self._timed)
             if not all_nodes:  # a page's first full table leaves the others' deltas be
@@ -238,5 +245,6 @@ class TreeState:
                     for index, code in enumerate(self.status) if code}
 
     def active_ids(self) -> list[str]:
+        """Ids of the nodes on the active path, in the runner's order (for exports)."""
         with self._lock:
             return [self.ids[index] for index in self.active]

@@ -82,6 +82,7 @@ class ArnlMap:
         return [item for item in self.objects if item.is_goal or item.is_dock]
 
     def docks(self) -> list[MapObject]:
+        """The docks, in file order."""
         return [item for item in self.objects if item.is_dock]
 
     def goal(self, name: str) -> MapObject:
@@ -93,12 +94,15 @@ class ArnlMap:
         raise KeyError(f"{self.source}: no goal named {name!r} (goals: {known})")
 
     def homes(self) -> list[MapObject]:
+        """The ``RobotHome`` points and areas, in file order: where a robot may start."""
         return [item for item in self.objects if item.kind == "RobotHome"]
 
     def forbidden_lines(self) -> list[MapObject]:
+        """The lines the robot must not cross, in file order."""
         return [item for item in self.objects if item.is_forbidden_line]
 
     def forbidden_areas(self) -> list[MapObject]:
+        """The areas the robot must not enter, in file order."""
         return [item for item in self.objects if item.is_forbidden_area]
 
     def sim_obstacles(self) -> list[MapObject]:
@@ -125,8 +129,11 @@ class ArnlMap:
 
 # ---------------------------------------------------------------------- reading
 def read_map(path: str | Path, limits: MapLimits | None = None) -> ArnlMap:
-    """Read an ARNL map file; :class:`MapError` (file and line) if it is not one, or if it
-    exceeds a cap of ``limits`` (default: :func:`~cyborg.nav.map_limits.map_limits`)."""
+    """Read an ARNL map file.
+
+    Raises :class:`MapError` (naming file and line) if it is not one, or if it exceeds a cap of
+    ``limits`` (default: :func:`~cyborg.nav.map_limits.map_limits`).
+    """
     limits = limits or map_limits()
     raw = read_capped(path, limits.max_bytes)
     try:
@@ -221,8 +228,10 @@ def parse_map(text: str, source: str = "<map>", limits: MapLimits | None = None)
 
 def _header_line(result: ArnlMap, row: str, line: int, source: str, limits: MapLimits,
                  counts: dict[str, int]) -> None:
-    """One ``Key: values`` line; ``counts`` (Cairn, MapInfo, other header lines so far) are
-    held to the cap on objects."""
+    """Take in one ``Key: values`` line.
+
+    ``counts`` (Cairn, MapInfo, other header lines so far) are held to the cap on objects.
+    """
     key, colon, rest = row.partition(":")
     if not colon or not key or " " in key:
         raise MapError(source, line, f"expected 'Key: values', LINES or DATA, found {row[:60]!r}")
@@ -295,8 +304,10 @@ _ROWS_AT_ONCE = 65_536  # rows converted together: few temporary objects, whatev
 
 def _numbers(rows: list[str], width: int, lines: list[int], source: str,
              section: str) -> np.ndarray:
-    """Rows of ``width`` coordinates (mm) as an array; a bad row is named by its line, and a
-    number that is not finite or lies beyond the bound by its line and field too.
+    """Rows of ``width`` coordinates (mm) as an array.
+
+    A bad row is named by its line, and a number that is not finite or lies beyond the bound by
+    its line and field too.
 
     Rows are converted a block at a time, joined and split once per block: millions of
     per-row lists kept alive at once would cost seconds of garbage collection and gigabytes.

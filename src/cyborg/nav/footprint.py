@@ -15,7 +15,11 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Footprint:
-    """A rectangular robot body with cut corners, centred on the drive axle."""
+    """A rectangular robot body with cut corners, centred on the drive axle.
+
+    ``length`` (along x) and ``width`` are in metres; each corner is cut ``corner_cut`` metres
+    along both sides.
+    """
 
     length: float
     width: float
@@ -23,10 +27,12 @@ class Footprint:
 
     @property
     def inscribed_radius(self) -> float:
+        """Half the width, in m: the largest circle about the axle inside the body."""
         return self.width / 2
 
     @property
     def circumscribed_radius(self) -> float:
+        """Half the diagonal, in m: the smallest circle about the axle around the body."""
         return math.hypot(self.length / 2, self.width / 2)
 
     def polygon(self) -> np.ndarray:

@@ -5,7 +5,8 @@ is what a ground robot mostly needs (x, y, heading). :class:`Path` is a polyline
 the distance still to go from a position, and a point a given distance ahead ("carrot").
 
 ``from_message`` accepts any object with the ROS fields (a bus message or a plain namespace);
-``to_message(types)`` builds the bus message with a :class:`cyborg.bus.MessageTypes` registry.
+``to_message()`` builds the bus message, an instance of the class from :mod:`cyborg.bus.msgs`
+(``geometry_msgs.msg.Pose2D`` for :class:`Pose2D`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,11 @@ from typing import Any
 
 import numpy as np
 
+from cyborg.bus.msgs.builtin_interfaces import msg as builtin_interfaces
+from cyborg.bus.msgs.geometry_msgs import msg as geometry_msgs
+from cyborg.bus.msgs.nav_msgs import msg as nav_msgs
+from cyborg.bus.msgs.std_msgs import msg as std_msgs
+
 
 def normalize_angle(angle: float) -> float:
     """The same angle in [-pi, pi)."""
@@ -25,23 +31,30 @@ def normalize_angle(angle: float) -> float:
 
 @dataclass(frozen=True)
 class Point:
+    """A point in space, in metres."""
+
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
 
     def distance_to(self, other: Point) -> float:
+        """The straight-line distance to ``other`` in metres, in three dimensions."""
         return math.dist((self.x, self.y, self.z), (other.x, other.y, other.z))
 
     @classmethod
     def from_message(cls, message: Any) -> Point:
+        """From a ``geometry_msgs/Point`` or anything with ``x``, ``y`` and ``z``."""
         return cls(float(message.x), float(message.y), float(message.z))
 
-    def to_message(self, types: Any) -> Any:
-        return types.message_class("geometry_msgs/msg/Point")(x=self.x, y=self.y, z=self.z)
+    def to_message(self) -> geometry_msgs.Point:
+        """As ``geometry_msgs/Point``."""
+        return geometry_msgs.Point(x=self.x, y=self.y, z=self.z)
 
 
 @dataclass(frozen=True)
 class Quaternion:
+    """An orientation as a unit quaternion; the default is no rotation."""
+
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
@@ -61,11 +74,12 @@ class Quaternion:
 
     @classmethod
     def from_message(cls, message: Any) -> Quaternion:
+        """From a ``geometry_msgs/Quaternion`` or anything with ``x``, ``y``, ``z``, ``w``."""
         return cls(float(message.x), float(message.y), float(message.z), float(message.w))
 
-    def to_message(self, types: Any) -> Any:
-        return types.message_class("geometry_msgs/msg/Quaternion")(
-            x=self.x, y=self.y, z=self.z, w=self.w)
+    def to_message(self) -> geometry_msgs.Quaternion:
+        """As ``geometry_msgs/Quaternion``."""
+        return geometry_msgs.Quaternion(x=self.x, y=self.y, z=self.z, w=self.w)
 
 
 @dataclass(frozen=True)
@@ -77,9 +91,11 @@ class Pose2D:
     theta: float = 0.0
 
     def distance_to(self, other: Pose2D | Point) -> float:
+        """The distance in metres to ``other`` on the ground plane (heights are ignored)."""
         return math.hypot(self.x - other.x, self.y - other.y)
 
     def to_pose(self) -> Pose:
+        """The same pose in three dimensions: on the ground, turned about the vertical axis."""
         return Pose(Point(self.x, self.y), Quaternion.from_yaw(self.theta))
 
     @classmethod
@@ -89,28 +105,32 @@ class Pose2D:
             return Pose.from_message(message).to_pose2d()
         return cls(float(message.x), float(message.y), float(message.theta))
 
-    def to_message(self, types: Any) -> Any:
-        return types.message_class("geometry_msgs/msg/Pose2D")(
-            x=self.x, y=self.y, theta=self.theta)
+    def to_message(self) -> geometry_msgs.Pose2D:
+        """As ``geometry_msgs/Pose2D``."""
+        return geometry_msgs.Pose2D(x=self.x, y=self.y, theta=self.theta)
 
 
 @dataclass(frozen=True)
 class Pose:
+    """A position (metres) and an orientation in three dimensions, as ``geometry_msgs/Pose``."""
+
     position: Point = Point()
     orientation: Quaternion = Quaternion()
 
     def to_pose2d(self) -> Pose2D:
+        """The pose on the ground plane: x, y and the heading about the vertical axis."""
         return Pose2D(self.position.x, self.position.y, self.orientation.yaw)
 
     @classmethod
     def from_message(cls, message: Any) -> Pose:
+        """From a ``geometry_msgs/Pose`` or anything with its fields."""
         return cls(Point.from_message(message.position),
                    Quaternion.from_message(message.orientation))
 
-    def to_message(self, types: Any) -> Any:
-        return types.message_class("geometry_msgs/msg/Pose")(
-            position=self.position.to_message(types),
-            orientation=self.orientation.to_message(types))
+    def to_message(self) -> geometry_msgs.Pose:
+        """As ``geometry_msgs/Pose``."""
+        return geometry_msgs.Pose(position=self.position.to_message(),
+                                  orientation=self.orientation.to_message())
 
 
 class Path:
@@ -133,10 +153,12 @@ class Path:
 
     @property
     def start(self) -> Pose2D:
+        """The first waypoint, heading along the path (see :meth:`heading_at`)."""
         return Pose2D(float(self.points[0, 0]), float(self.points[0, 1]), self.heading_at(0.0))
 
     @property
     def goal(self) -> Pose2D:
+        """The last waypoint, with the final heading if there is one, else the last segment's."""
         heading = self.final_heading if self.final_heading is not None else self.heading_at(
             self.length)
         return Pose2D(float(self.points[-1, 0]), float(self.points[-1, 1]), heading)
@@ -205,18 +227,25 @@ class Path:
         result[-1] = self.goal
         return result
 
-    def to_message(self, types: Any, frame_id: str = "map", stamp: Any = None) -> Any:
-        """As ``nav_msgs/Path``."""
-        header = types.message_class("std_msgs/msg/Header")(
-            stamp=stamp if stamp is not None else types.message_class(
-                "builtin_interfaces/msg/Time")(sec=0, nanosec=0), frame_id=frame_id)
-        stamped = types.message_class("geometry_msgs/msg/PoseStamped")
-        return types.message_class("nav_msgs/msg/Path")(header=header, poses=[
-            stamped(header=header, pose=pose.to_pose().to_message(types))
+    def to_message(self, frame_id: str = "map",
+                   stamp: builtin_interfaces.Time | None = None) -> nav_msgs.Path:
+        """As ``nav_msgs/Path`` in ``frame_id``, stamped ``stamp`` (None: time zero).
+
+        The path and every pose in it share one header.
+        """
+        header = std_msgs.Header(
+            stamp=stamp if stamp is not None else builtin_interfaces.Time(sec=0, nanosec=0),
+            frame_id=frame_id)
+        return nav_msgs.Path(header=header, poses=[
+            geometry_msgs.PoseStamped(header=header, pose=pose.to_pose().to_message())
             for pose in self.poses()])
 
     @classmethod
     def from_message(cls, message: Any) -> Path:
+        """From a ``nav_msgs/Path``: its positions, and its last orientation as the final heading.
+
+        Raises ValueError for a path without poses.
+        """
         poses = [Pose.from_message(stamped.pose) for stamped in message.poses]
         if not poses:
             raise ValueError("nav_msgs/Path without poses")
@@ -225,6 +254,7 @@ class Path:
 
     @classmethod
     def through(cls, poses: Iterable[Pose2D]) -> Path:
+        """The path through the positions of ``poses``, ending with the last one's heading."""
         items = list(poses)
         return cls([(pose.x, pose.y) for pose in items], items[-1].theta if items else None)
 

@@ -37,7 +37,11 @@ class ClearPoint(NamedTuple):
 
 @dataclass
 class MapGrid:
-    """Walls and forbidden cells of a map at one resolution (metres per cell)."""
+    """Walls and forbidden cells of a map at one resolution (metres per cell).
+
+    ``origin_x`` and ``origin_y`` are the lower-left corner of cell (0, 0) in metres; ``walls``
+    and ``forbidden`` are boolean (rows, columns) layers. Usually made by :meth:`from_map`.
+    """
 
     origin_x: float
     origin_y: float
@@ -77,6 +81,7 @@ class MapGrid:
     # ------------------------------------------------------------------ coordinates
     @property
     def shape(self) -> tuple[int, int]:
+        """``(rows, columns)`` of the grid."""
         rows, columns = self.walls.shape
         return rows, columns
 
@@ -86,10 +91,12 @@ class MapGrid:
                 math.floor((x - self.origin_x) / self.resolution))
 
     def inside(self, row: int, column: int) -> bool:
+        """Whether the cell ``(row, column)`` lies on the grid."""
         rows, columns = self.shape
         return 0 <= row < rows and 0 <= column < columns
 
     def center(self, row: int, column: int) -> tuple[float, float]:
+        """``(x, y)`` in metres of the centre of cell ``(row, column)``."""
         return (self.origin_x + (column + 0.5) * self.resolution,
                 self.origin_y + (row + 0.5) * self.resolution)
 
@@ -102,13 +109,17 @@ class MapGrid:
 
     # ------------------------------------------------------------------ drawing
     def mark_points(self, layer: np.ndarray, points: np.ndarray) -> None:
+        """Mark the cells of ``layer`` holding an (N, 2) array of points (off-grid: the edge)."""
         if len(points):
             rows, columns = self.cells_of(points)
             layer[rows, columns] = True
 
     def mark_segments(self, layer: np.ndarray, segments: np.ndarray) -> None:
-        """Mark every cell an (N, 4) array of segments passes through (sampled finely, a
-        chunk of segments at a time so the samples never need more than a few MB)."""
+        """Mark the cells of ``layer`` that an (N, 4) array of segments passes through.
+
+        Segments are sampled finely, a chunk of them at a time, so the samples never need more
+        than a few MB.
+        """
         if len(segments) == 0:
             return
         counts = segment_samples(segments, self.resolution)
@@ -129,8 +140,11 @@ class MapGrid:
         self.mark_points(layer, samples)
 
     def fill_area(self, layer: np.ndarray, area: MapObject) -> None:
-        """Mark the cells whose centres lie inside an area object (rotation included), a band
-        of rows at a time."""
+        """Mark the cells of ``layer`` whose centres lie inside an area object.
+
+        The area's rotation is included; rows are filled a band at a time, and the outline is
+        drawn too, so thin areas stay closed. An object without an area marks nothing.
+        """
         corners = area.corners()
         if corners is None or len(corners) != 4:
             return
@@ -167,8 +181,10 @@ class MapGrid:
 
     def nearest_clear(self, clearance: np.ndarray, x: float, y: float, needed: float,
                       within: np.ndarray | None = None) -> ClearPoint | None:
-        """The centre of the cell nearest ``(x, y)`` whose ``clearance`` is at least ``needed``
-        metres (and that is in the ``within`` mask, if given); None if there is none.
+        """The centre of the cell nearest ``(x, y)`` with at least ``needed`` m of clearance.
+
+        ``clearance`` is what :meth:`clearance` returns; only cells in the ``within`` mask count,
+        if given. Returns None if no cell qualifies.
 
         Cells *enclosed* by the map win over cells outside its walls: free space that reaches
         the grid's border runs around the outside of the building, so a building shaped like

@@ -53,7 +53,11 @@ _VARIABLES = {"max_bytes": "CYBORG_MAP_MAX_BYTES", "max_cells": "CYBORG_MAP_MAX_
 
 @dataclass(frozen=True)
 class MapLimits:
-    """The caps of the module's table; :func:`map_limits` reads them from the environment."""
+    """The caps of the module's table; :func:`map_limits` reads them from the environment.
+
+    ``max_bytes`` caps the file size, ``max_cells`` the grid cells (and so the drawing work),
+    ``max_objects`` each kind of header line.
+    """
 
     max_bytes: int = 8 * 1024 * 1024
     max_cells: int = 10_000_000
@@ -61,7 +65,10 @@ class MapLimits:
 
 
 def map_limits() -> MapLimits:
-    """The caps in force: the defaults, or positive whole numbers from the environment."""
+    """The caps in force: the defaults, or positive whole numbers from the environment.
+
+    Raises MapError, naming the variable, when one is set to anything else.
+    """
     values: dict[str, int] = {}
     for name, variable in _VARIABLES.items():
         text = os.environ.get(variable, "").strip().replace("_", "")
@@ -120,12 +127,19 @@ class DrawnMap(Protocol):
     """What the grid caps look at in a map (an :class:`~cyborg.nav.arnl_map.ArnlMap`)."""
 
     @property
-    def source(self) -> str: ...
+    def source(self) -> str:
+        """Where the map comes from, to name it in errors."""
+
     @property
-    def lines(self) -> np.ndarray: ...
+    def lines(self) -> np.ndarray:
+        """The walls, an (N, 4) array of ``x1 y1 x2 y2`` in metres."""
+
     @property
-    def objects(self) -> list[MapObject]: ...
-    def bounds(self) -> tuple[float, float, float, float]: ...
+    def objects(self) -> list[MapObject]:
+        """The map's objects; its forbidden lines and areas and simulator boxes are drawn."""
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(min_x, min_y, max_x, max_y)`` of everything in the map, in metres."""
 
 
 def grid_shape(bounds: tuple[float, float, float, float], resolution: float,
@@ -140,8 +154,11 @@ def grid_shape(bounds: tuple[float, float, float, float], resolution: float,
 
 def check_grid(arnl_map: DrawnMap, resolution: float = DEFAULT_RESOLUTION,
                margin: float = GRID_MARGIN, limits: MapLimits | None = None) -> None:
-    """MapError (naming the map) unless a grid of ``arnl_map`` at ``resolution`` stays within
-    the cell cap, and drawing its walls, forbidden lines and areas within the drawing cap.
+    """Raise MapError (naming the map) if a grid of ``arnl_map`` would cost too much.
+
+    A grid at ``resolution`` (metres per cell), with ``margin`` metres around the map's extent,
+    must stay within the cell cap of ``limits`` (default: :func:`map_limits`), and drawing its
+    walls, forbidden lines and areas within the drawing cap.
 
     Runs before anything is allocated: on loading, at the default resolution, and again by
     :meth:`cyborg.nav.grid.MapGrid.from_map` at the resolution asked for.
@@ -176,8 +193,11 @@ def segment_samples(segments: np.ndarray, resolution: float) -> np.ndarray:
 
 
 def drawing_work(arnl_map: DrawnMap, resolution: float) -> int:
-    """Cells and samples visited drawing the map's lines and areas at ``resolution`` (an upper
-    bound: every area counts its bounding box and its outline, simulator boxes included)."""
+    """Cells and samples visited drawing the map's lines and areas at ``resolution``.
+
+    It is an upper bound: every area counts its bounding box and its outline, simulator boxes
+    included.
+    """
     work = int(segment_samples(arnl_map.lines, resolution).sum()) if len(arnl_map.lines) else 0
     for item in arnl_map.objects:
         corners = item.corners()

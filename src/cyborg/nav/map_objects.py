@@ -41,12 +41,17 @@ class MapType:
 
     @property
     def name(self) -> str:
+        """The declared type's name (its ``Name=`` setting); empty if it has none."""
         return self.settings.get("Name", "")
 
 
 @dataclass(frozen=True)
 class MapObject:
-    """A cairn, in metres and radians. ``region`` is ``(from_x, from_y, to_x, to_y)``."""
+    """A cairn, in metres and radians. ``region`` is ``(from_x, from_y, to_x, to_y)``.
+
+    ``kind`` is the word after ``Cairn:``, ``line`` the line in the file, and ``category`` what
+    the object means for navigation (see :meth:`classified`).
+    """
 
     kind: str
     x: float
@@ -62,10 +67,12 @@ class MapObject:
     # ------------------------------------------------------------------ kinds
     @property
     def is_goal(self) -> bool:
+        """Whether it is a goal, with or without heading (a dock is not)."""
         return self.category in (GOAL, GOAL_WITH_HEADING)
 
     @property
     def is_dock(self) -> bool:
+        """Whether it is a dock: ``Dock`` or a kind declared as a ``DockType``."""
         return self.category == DOCK
 
     @property
@@ -75,25 +82,34 @@ class MapObject:
 
     @property
     def is_forbidden_line(self) -> bool:
+        """Whether it is a ``ForbiddenLine``, a line the robot must not cross."""
         return self.category == FORBIDDEN_LINE
 
     @property
     def is_forbidden_area(self) -> bool:
+        """Whether it is a ``ForbiddenArea``, a rectangle the robot must not enter."""
         return self.category == FORBIDDEN_AREA
 
     @property
     def is_sim_obstacle(self) -> bool:
+        """Whether it is a box that only the simulator puts into the world (``Sim.*``)."""
         return self.category == SIM_OBSTACLE
 
     def classified(self, declared: Mapping[str, str]) -> MapObject:
-        """This object with its category, given the map's ``MapInfo`` declarations as
-        :func:`declared_categories` maps them (built once per map, not once per object)."""
+        """This object with its category, given the map's ``MapInfo`` declarations.
+
+        ``declared`` is what :func:`declared_categories` returns, built once per map rather
+        than once per object.
+        """
         return replace(self, category=_category(self.kind, self.region is not None, declared))
 
     # ------------------------------------------------------------------ geometry
     def corners(self) -> np.ndarray | None:
-        """The region's outline in metres: the two endpoints of a line, or the four corners of
-        an area (rotated by ``theta`` about the map origin, as ARIA does); None without one."""
+        """The region's outline in metres, as an (N, 2) array; None without a region.
+
+        That is the two endpoints of a line, or the four corners of an area (rotated by
+        ``theta`` about the map origin, as ARIA does).
+        """
         if self.region is None:
             return None
         fx, fy, tx, ty = self.region
@@ -118,8 +134,10 @@ class MapObject:
 
 
 def declared_categories(types: Iterable[MapType]) -> dict[str, str]:
-    """Declared type name → category (``GoalType``, ``DockType`` ...); a later declaration of
-    the same name wins."""
+    """Declared type name → category (``GoalType``, ``DockType`` ...).
+
+    A later declaration of the same name wins.
+    """
     return {declaration.name: declaration.category for declaration in types}
 
 

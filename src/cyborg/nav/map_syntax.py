@@ -1,4 +1,4 @@
-"""The small print of ARNL map lines: fields, quotes, numbers and their bounds.
+r"""The small print of ARNL map lines: fields, quotes, numbers and their bounds.
 
 A map line is split into fields as ARIA's ``ArArgumentBuilder`` splits it (with quotes
 "pre-compressed", as ``ArMap`` asks):
@@ -7,7 +7,7 @@ A map line is split into fields as ARIA's ``ArArgumentBuilder`` splits it (with 
   return: C's ``isspace``); nothing else separates them, not U+0085 nor U+00A0;
 * a field that *starts* with ``"`` runs to the first ``"`` that is followed by whitespace or
   ends the line, so it may hold spaces and even quotes (``"the 5"-wide door"``); the outer
-  quotes are dropped, backslashes are kept as they are (``"C:\\maps\\"``);
+  quotes are dropped, backslashes are kept as they are (``"C:\maps\"``);
 * any other field ends at whitespace, quotes and all (``Name=Goal``).
 
 :func:`split_fields` does this in one pass with compiled patterns, in time linear in the
@@ -77,8 +77,11 @@ def shown(token: str, limit: int = 30) -> str:
 
 def coordinate(token: str, what: str, field: str, source: str, line: int,
                unit: str = "millimetres") -> float:
-    """``token`` as a number within ±MAX_COORDINATE_MM; MapError naming ``what`` and ``field``
-    (e.g. ``Cairn Goal 'el5'`` and ``x``) otherwise. ``unit``: ``"degrees"`` for headings."""
+    """``token`` as a number within ±MAX_COORDINATE_MM.
+
+    Raises MapError naming ``what`` and ``field`` (e.g. ``Cairn Goal 'el5'`` and ``x``)
+    otherwise; ``unit`` is ``"degrees"`` for headings.
+    """
     try:
         value = float(token)
     except ValueError:

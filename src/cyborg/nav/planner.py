@@ -49,7 +49,11 @@ NONE, START_OCCUPIED, GOAL_OCCUPIED, NO_VALID_PATH, OUTSIDE_MAP = (
 
 @dataclass(frozen=True)
 class PlanResult:
-    """A path, or why there is none (``code`` and ``reason``); how long planning took."""
+    """A path, or why there is none (``code`` and ``reason``); how long planning took.
+
+    ``code`` is one of this module's result codes (Nav2's names), ``NONE`` when a path was
+    found; ``planning_time`` is in seconds.
+    """
 
     path: Path | None
     code: str = NONE
@@ -58,6 +62,7 @@ class PlanResult:
 
     @property
     def found(self) -> bool:
+        """Whether there is a path."""
         return self.path is not None
 
     @property
@@ -67,7 +72,12 @@ class PlanResult:
 
 
 class Planner:
-    """Plans paths on one map for one robot shape."""
+    """Plans paths on one map for one robot shape.
+
+    Building it rasterises ``arnl_map`` at ``settings.resolution`` and computes the clearance
+    and cost grids (default settings: :class:`PlannerSettings`); MapError if the map is too
+    large for the grid caps (:mod:`cyborg.nav.map_limits`).
+    """
 
     def __init__(self, arnl_map: ArnlMap, footprint: Footprint = PIONEER_LX,
                  settings: PlannerSettings | None = None) -> None:

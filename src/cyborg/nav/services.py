@@ -37,7 +37,28 @@ from typing import Any
 
 import numpy as np
 
-from cyborg.bus import Node, new_message
+from cyborg.bus import Node
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.cyborg_msgs.msg import GoalWithHeading
+from cyborg.bus.msgs.cyborg_msgs.srv import (
+    AvailableGoals,
+    AvailableGoals_Request,
+    AvailableGoals_Response,
+    ClosestGoal,
+    ClosestGoal_Request,
+    ClosestGoal_Response,
+    DistanceToGoal,
+    DistanceToGoal_Request,
+    DistanceToGoal_Response,
+    LoadMapFile,
+    LoadMapFile_Request,
+    LoadMapFile_Response,
+    MakePlan,
+    MakePlan_Request,
+    MakePlan_Response,
+)
+from cyborg.bus.msgs.nav_msgs.msg import Path as PathMessage
+from cyborg.bus.msgs.std_msgs.msg import Header
 from cyborg.bus.services import RequestError, Responder
 from cyborg.interfaces.robot import (
     AVAILABLE_GOALS,
@@ -45,7 +66,6 @@ from cyborg.interfaces.robot import (
     DISTANCE_TO_GOAL,
     LOAD_MAP_FILE,
     MAKE_PLAN,
-    NAVIGATION_SERVICES,
 )
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose, Pose2D
@@ -55,8 +75,12 @@ log = logging.getLogger("cyborg.nav")
 
 
 def require_finite(message: Any, path: str = "") -> None:
-    """RequestError naming the first number in ``message`` (a request, at any depth) that is
-    NaN or infinite, e.g. ``goal.position.x``: no pose, distance or heading can be one."""
+    """Refuses a request holding a NaN or an infinite number, at any depth.
+
+    Raises :class:`~cyborg.bus.services.RequestError` naming the first such number in
+    ``message`` (``goal.position.x``): no pose, distance or heading can be one. A service
+    server runs it, as one of its checks, before the handler.
+    """
     if isinstance(message, float | np.floating):
         if not math.isfinite(message):
             raise RequestError(path, f"{message!r} is not a finite number")
@@ -88,7 +112,8 @@ class NavigationMap:
         """Read and switch to another map; MapError leaves the current one in place.
 
         Listeners (the simulator) switch first: if one refuses the map, by raising, the
-        services keep the map the simulator still drives on."""
+        services keep the map the simulator still drives on.
+        """
         arnl_map = read_map(path)
         planner = Planner(arnl_map)
         for listener in list(self.listeners):
@@ -98,6 +123,11 @@ class NavigationMap:
         return arnl_map
 
     def plan(self, start: Pose2D, goal: Pose2D, use_heading: bool = False) -> PlanResult:
+        """A path from ``start`` to ``goal`` on the map in use; safe from any thread.
+
+        Without a path the result says why. ``use_heading``: the path's final heading is
+        ``goal``'s.
+        """
         with self._lock:
             planner = self.planner
         return planner.plan(start, goal, use_heading=use_heading)
@@ -109,16 +139,11 @@ class NavigationServices:
     def __init__(self, node: Node, maps: NavigationMap,
                  pose: Callable[[], Pose2D | None]) -> None:
         self.node, self.maps, self.pose = node, maps, pose
-        types = node.types
-        self._goal_type = types.message_class("cyborg_msgs/msg/GoalWithHeading")
-        self._classes = {service: types.message_class(service.response_type)
-                         for service in NAVIGATION_SERVICES}
         self._loading = threading.Lock()  # one map at a time
-        for service, handler in ((AVAILABLE_GOALS, self.available_goals),
-                                 (DISTANCE_TO_GOAL, self.distance_to_goal),
-                                 (CLOSEST_GOAL, self.closest_goal),
-                                 (MAKE_PLAN, self.make_plan)):
-            service.server(node, handler).checks.append(require_finite)
+        AVAILABLE_GOALS.server(node, self.available_goals).checks.append(require_finite)
+        DISTANCE_TO_GOAL.server(node, self.distance_to_goal).checks.append(require_finite)
+        CLOSEST_GOAL.server(node, self.closest_goal).checks.append(require_finite)
+        MAKE_PLAN.server(node, self.make_plan).checks.append(require_finite)
         LOAD_MAP_FILE.server(node, self.load_map_file, deferred=True)
 
     def _robot(self) -> Pose2D:
@@ -128,43 +153,57 @@ class NavigationServices:
         return pose
 
     # ------------------------------------------------------------------ handlers
-    def available_goals(self, _request: Any) -> Any:
-        goals = [self._goal_type(name=item.name, comment=item.description,
-                                 position=Pose2D(item.x, item.y, item.theta).to_message(
-                                     self.node.types), has_heading=item.has_heading)
+    def available_goals(self, _request: AvailableGoals_Request) -> AvailableGoals_Response:
+        """Every goal, goal with heading and dock of the map in use (headings in radians)."""
+        goals = [GoalWithHeading(name=item.name, comment=item.description,
+                                 position=Pose2D(item.x, item.y, item.theta).to_message(),
+                                 has_heading=item.has_heading)
                  for item in self.maps.map.goals()]
-        return self._classes[AVAILABLE_GOALS](goals=goals)
+        return AvailableGoals.Response(goals=goals)
 
-    def distance_to_goal(self, request: Any) -> Any:
+    def distance_to_goal(self, request: DistanceToGoal_Request) -> DistanceToGoal_Response:
+        """The planned path's length in metres from the robot to the goal; +inf without one.
+
+        Raises RuntimeError while the robot's pose is not known.
+        """
         goal = Pose.from_message(request.goal).to_pose2d()
         result = self.maps.plan(self._robot(), goal)
-        return self._classes[DISTANCE_TO_GOAL](distance=result.length)
+        return DistanceToGoal.Response(distance=result.length)
 
-    def closest_goal(self, _request: Any) -> Any:
+    def closest_goal(self, _request: ClosestGoal_Request) -> ClosestGoal_Response:
+        """The goal nearest to the robot by planned path length (metres), not straight line.
+
+        No reachable goal gives an empty name and +inf; raises RuntimeError while the robot's
+        pose is not known.
+        """
         robot = self._robot()
         best_name, best = "", math.inf
         for item in self.maps.map.goals():
             length = self.maps.plan(robot, Pose2D(item.x, item.y)).length
             if length < best:
                 best_name, best = item.name, length
-        return self._classes[CLOSEST_GOAL](name=best_name, distance=best)
+        return ClosestGoal.Response(name=best_name, distance=best)
 
-    def make_plan(self, request: Any) -> Any:
+    def make_plan(self, request: MakePlan_Request) -> MakePlan_Response:
+        """A path on the static map from ``start`` (or the robot) to ``goal``, as ARNL plans.
+
+        Without a path the reply says why and holds an empty path of +inf length.
+        """
         start = Pose2D.from_message(request.start) if request.use_start else self._robot()
         goal = Pose2D.from_message(request.goal)
         result = self.maps.plan(start, goal)
-        response = self._classes[MAKE_PLAN]
         if result.path is None:
-            empty = new_message(self.node.types, "nav_msgs/msg/Path",
-                                {"header": {"frame_id": "map"}})
-            return response(found=False, message=f"{result.code}: {result.reason}", path=empty,
-                            length=math.inf)
-        return response(found=True, message="", path=result.path.to_message(self.node.types),
-                        length=result.length)
+            empty = PathMessage(header=Header(stamp=Time(sec=0, nanosec=0), frame_id="map"),
+                                poses=[])
+            return MakePlan.Response(found=False, message=f"{result.code}: {result.reason}",
+                                     path=empty, length=math.inf)
+        return MakePlan.Response(found=True, message="", path=result.path.to_message(),
+                                 length=result.length)
 
-    def load_map_file(self, request: Any, responder: Responder) -> None:
+    def load_map_file(self, request: LoadMapFile_Request,
+                      responder: Responder[LoadMapFile_Response]) -> None:
         """Load on a thread of its own and answer from there (deferred), one map at a time."""
-        reply = self._classes[LOAD_MAP_FILE]
+        reply = LoadMapFile.Response
         path = request.path
         if not path.lower().endswith(".map"):
             responder.reply(reply(success=False, message=f"load_map_file: {path[:80]!r} is not "
@@ -177,10 +216,13 @@ class NavigationServices:
         threading.Thread(target=self._load, args=(path, responder), daemon=True,
                          name="cyborg-load-map").start()
 
-    def _load(self, path: str, responder: Responder) -> None:
-        """Load, free the one-at-a-time lock, then answer: a caller that asks again as soon
-        as it has its answer must find the lock free."""
-        reply = self._classes[LOAD_MAP_FILE]
+    def _load(self, path: str, responder: Responder[LoadMapFile_Response]) -> None:
+        """Load, free the one-at-a-time lock, then answer (the loading thread).
+
+        In that order: a caller that asks again as soon as it has its answer must find the
+        lock free.
+        """
+        reply = LoadMapFile.Response
         try:
             arnl_map = self.maps.load(path)
         except MapError as exc:

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import logging
 
+from typing_extensions import override
+
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Decorator, Status, register
 from cyborg.robot.interface import ROBOT, DockState, robot_of
 from cyborg.robot.rate_limited_log import RateLimitedLog
@@ -40,6 +42,7 @@ class CheckBattery(Decorator):
             raise ValueError(f"threshold is a percentage (0 to 100), not {threshold}")
         self.threshold = threshold
 
+    @override
     def tick(self) -> Status:
         battery = robot_of(self).battery
         low = battery is not None and battery.charge_percent < self.threshold
@@ -62,9 +65,11 @@ class Charge(Action):
         self._seen_docking = False
         self.reason = ""
 
+    @override
     def on_start(self) -> None:
         self._requested_at, self._seen_docking, self.reason = None, False, ""
 
+    @override
     def tick(self) -> Status:
         robot = robot_of(self)
         battery = robot.battery
@@ -97,6 +102,7 @@ class Charge(Action):
         return RUNNING
 
     def on_halt(self) -> None:
+        """Stops the robot if it is still driving to the dock that this node asked for."""
         battery = robot_of(self).battery
         if self._requested_at is not None and battery is not None and \
                 battery.dock_state is DockState.DOCKING:

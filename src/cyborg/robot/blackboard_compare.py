@@ -12,19 +12,29 @@ from __future__ import annotations
 
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.bt import FAILURE, Decorator, Status, register
 
 
 @register
 class BlackboardCompare(Decorator):
+    """Ticks its child only while the global blackboard entry ``key`` matches ``value``.
+
+    With ``equal`` false, only while it does not; otherwise it returns FAILURE and halts a
+    RUNNING child. Values compare as :func:`same` does; an empty ``key`` raises ValueError.
+    """
+
     def __init__(self, key: str, value: Any = "", equal: bool = True) -> None:
         if not key:
             raise ValueError("key is empty: name the blackboard entry to compare")
         self.key, self.value, self.equal = key, value, equal
 
     def matches(self) -> bool:
+        """Whether the entry now says what ``equal`` asks for (the child may run)."""
         return same(self.blackboard.get(self.key), self.value) == self.equal
 
+    @override
     def tick(self) -> Status:
         if self.matches():
             return self.child.execute()

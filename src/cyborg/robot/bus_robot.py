@@ -28,8 +28,6 @@ from cyborg.robot.rate_limited_log import RateLimitedLog
 log = logging.getLogger("cyborg.robot")
 limited = RateLimitedLog(log)
 
-GOAL = robot.MOVE_TO_GOAL.goal_type
-
 
 class BusMove:
     """A move_to_goal goal in progress."""
@@ -42,23 +40,29 @@ class BusMove:
         self._cancel_sent = False
 
     def on_feedback(self, feedback: Any) -> None:
+        """Keeps the goal's ``distance_remaining`` (m); called on the bus node's thread."""
         self._remaining = float(feedback.distance_remaining)
 
     @property
     def done(self) -> bool:
+        """Whether the goal has ended, or could not be sent at all."""
         return self._handle is None or self._handle.done
 
     @property
     def outcome(self) -> MoveOutcome | None:
+        """How the goal ended; None while it runs, FAILED when its result is out of reach."""
         return self._ended()[0]
 
     @property
     def message(self) -> str:
+        """The result's message, or the error that failed the goal; empty while it runs."""
         return self._ended()[1]
 
     def _ended(self) -> tuple[MoveOutcome | None, str]:
-        """``(outcome, message)``: ``(None, "")`` while the goal runs; a goal that could not
-        be sent or whose result could not be fetched counts as FAILED."""
+        """``(outcome, message)``: ``(None, "")`` while the goal runs.
+
+        A goal that could not be sent or whose result could not be fetched counts as FAILED.
+        """
         handle = self._handle
         if handle is None:
             return MoveOutcome.FAILED, self._error
@@ -75,9 +79,11 @@ class BusMove:
 
     @property
     def remaining(self) -> float:
+        """Metres left along the planned path, from the last feedback (inf before any)."""
         return self._remaining
 
     def cancel(self) -> None:
+        """Sends a cancel request once, on the bus's call pool; a failure is only logged."""
         handle = self._handle
         if handle is None or handle.done or self._cancel_sent:
             return
@@ -126,10 +132,12 @@ class BusRobot:
 
     @property
     def pose(self) -> Pose2D | None:
+        """The last ``pose`` message (m, rad); None before the first."""
         return self._pose
 
     @property
     def battery(self) -> BatteryReading | None:
+        """The last ``battery_status`` message; None before the first."""
         return self._battery
 
     def wait_until_ready(self, timeout: float = 10.0) -> bool:
@@ -149,6 +157,11 @@ class BusRobot:
             raise RobotError(str(exc)) from exc
 
     def goals(self, refresh: bool = False) -> dict[str, Goal]:
+        """The map's named goals, asked once and cached (``refresh`` asks again).
+
+        Blocks up to ``timeout`` s on the first call; raises RobotError if the robot does not
+        answer.
+        """
         with self._lock:
             if self._goals is None or refresh:
                 reply = self._call(robot.AVAILABLE_GOALS.name)
@@ -158,7 +171,9 @@ class BusRobot:
             return dict(self._goals)
 
     def move_to(self, goal: str) -> BusMove:
-        message = new_message(self.node.types, GOAL, {"goal_name": goal})
+        """Sends a move_to_goal goal; raises RobotError if it cannot be sent or is rejected."""
+        message = robot.MOVE_TO_GOAL.action_type.Goal(
+            goal_name=goal, pose=Pose2D().to_message(), use_heading=False)
         move = BusMove(None, goal)
         try:
             move._handle = self._action.send_goal(message, feedback=move.on_feedback,
@@ -172,15 +187,19 @@ class BusRobot:
         return bool(reply.success), str(reply.message)
 
     def dock(self) -> tuple[bool, str]:
+        """Calls ``dock``: ``(accepted, message)``; raises RobotError without an answer."""
         return self._trigger(robot.DOCK.name)
 
     def undock(self) -> tuple[bool, str]:
+        """Calls ``undock``: ``(accepted, message)``; raises RobotError without an answer."""
         return self._trigger(robot.UNDOCK.name)
 
     def stop(self) -> None:
+        """Calls ``stop`` and waits for the answer; raises RobotError without one."""
         self._trigger(robot.STOP.name)
 
     def distance_to(self, goal: Pose2D) -> Future[float]:
+        """A future of the planned path's length (m), asked on the call pool; inf without a path."""
         pose = goal.to_pose()
         fields = {"goal": {"position": {"x": pose.position.x, "y": pose.position.y},
                            "orientation": {"z": pose.orientation.z, "w": pose.orientation.w}}}
@@ -188,6 +207,7 @@ class BusRobot:
             lambda: float(self._call(robot.DISTANCE_TO_GOAL.name, **fields).distance))
 
     def closest_goal(self) -> Future[tuple[str, float]]:
+        """A future of the closest goal and its path length in m, asked on the call pool."""
         def ask() -> tuple[str, float]:
             reply = self._call(robot.CLOSEST_GOAL.name)
             return str(reply.name), float(reply.distance)

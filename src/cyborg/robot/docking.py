@@ -8,6 +8,8 @@ drive to the dock.
 
 from __future__ import annotations
 
+from typing_extensions import override
+
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
 from cyborg.robot.interface import ROBOT, DockState, robot_of
 
@@ -26,6 +28,7 @@ class _DockAction(Action):
         self._asked = False
 
     def request(self) -> tuple[bool, str]:
+        """Asks the robot for the change: ``(accepted, message)``."""
         raise NotImplementedError
 
     def on_start(self) -> None:
@@ -56,10 +59,12 @@ class Dock(_DockAction):
 
     wanted, on_the_way = DockState.DOCKED, DockState.DOCKING
 
+    @override
     def request(self) -> tuple[bool, str]:
         return robot_of(self).dock()
 
     def on_halt(self) -> None:
+        """Stops the robot if it is still driving to the dock that this node asked for."""
         battery = robot_of(self).battery
         if self._asked and battery is not None and battery.dock_state is DockState.DOCKING:
             robot_of(self).stop()
@@ -71,5 +76,6 @@ class Undock(_DockAction):
 
     wanted, on_the_way = DockState.UNDOCKED, DockState.UNDOCKING
 
+    @override
     def request(self) -> tuple[bool, str]:
         return robot_of(self).undock()

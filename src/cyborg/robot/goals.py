@@ -18,6 +18,8 @@ import math
 from concurrent.futures import Future
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Condition, Status, register
 from cyborg.robot.interface import ROBOT, robot_of
 
@@ -46,9 +48,11 @@ class ClosestGoal(Action, _Query):
             raise ValueError("key is empty: name the blackboard entry to write")
         self.key = key
 
+    @override
     def on_start(self) -> None:
         self.future = robot_of(self).closest_goal()
 
+    @override
     def tick(self) -> Status:
         answer = self.result()
         if answer is None:
@@ -73,12 +77,14 @@ class DistanceToGoal(Condition, _Query):
         self.below = below
 
     def on_start(self) -> None:
+        """Asks for the path to ``location``; raises KeyError when the map has no such goal."""
         robot = robot_of(self)
         goal = robot.goals().get(self.location) or robot.goals(refresh=True).get(self.location)
         if goal is None:
             raise KeyError(f"no goal named {self.location!r} on the map")
         self.future = robot.distance_to(goal.pose)
 
+    @override
     def tick(self) -> Status:
         distance = self.result()
         if distance is None:

@@ -55,13 +55,17 @@ class Move(Protocol):
     """A move in progress, polled by the node that started it."""
 
     @property
-    def done(self) -> bool: ...
+    def done(self) -> bool:
+        """Whether the move has ended, however it ended."""
+        ...
     @property
     def outcome(self) -> MoveOutcome | None:
         """How it ended; None while it runs."""
         ...
     @property
-    def message(self) -> str: ...
+    def message(self) -> str:
+        """The robot's word on how it ended (why it failed); empty while it runs."""
+        ...
     @property
     def remaining(self) -> float:
         """Metres left along the planned path, from the last feedback (inf before any)."""
@@ -91,7 +95,9 @@ class Robot(Protocol):
     def dock(self) -> tuple[bool, str]:
         """Ask the robot to drive to its dock and dock; ``(accepted, message)``."""
         ...
-    def undock(self) -> tuple[bool, str]: ...
+    def undock(self) -> tuple[bool, str]:
+        """Ask the robot to back off its dock; ``(accepted, message)``."""
+        ...
     def stop(self) -> None:
         """Abandon the current goal or docking."""
         ...

@@ -41,6 +41,8 @@ import logging
 import math
 from collections.abc import Hashable
 
+from typing_extensions import override
+
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
 from cyborg.robot.interface import (
     ROBOT,
@@ -105,6 +107,7 @@ class MoveTo(Action):
         self._next_try = -math.inf
 
     # ------------------------------------------------------------------ lifecycle
+    @override
     def on_start(self) -> None:
         self.move, self.goal, self.attempt, self.reason = None, None, 0, ""
         self._retry_at, self._failure = None, ("MoveTo failed", self.uid)
@@ -115,6 +118,7 @@ class MoveTo(Action):
             return
         self._start()
 
+    @override
     def tick(self) -> Status:
         self._after_clock_went_back()
         if self.move is None and self._retry_at is not None:
@@ -144,6 +148,7 @@ class MoveTo(Action):
             return self._retry(f"no progress along the path for {waited:g} s")
         return RUNNING
 
+    @override
     def on_end(self, status: Status) -> None:
         if self.move is not None:
             self.move.cancel()  # harmless when the move is over; stops the robot otherwise
@@ -151,14 +156,17 @@ class MoveTo(Action):
             limited.warning(self._failure, "MoveTo %s (%s) failed: %s", self.location, self.uid,
                             self.reason)
 
+    @override
     def on_halt(self) -> None:
         if self.move is not None:
             self.move.cancel()
 
     def _after_clock_went_back(self) -> None:
-        """A deadline further away than it can be set means the clock went back (a restarted
-        simulation, a backward /clock jump): count again from now, as ROS 2 resets its timers,
-        instead of waiting for time to pass the old start again."""
+        """Counts again from now if the clock went back (a restarted simulation, a /clock jump).
+
+        A deadline further away than it can be set means the clock went back: count again from
+        now, as ROS 2 resets its timers, instead of waiting for time to pass the old start again.
+        """
         now = self.now
         if self._deadline - now > max(self.progress_timeout, self.start_timeout):
             self._deadline = now + self.start_timeout

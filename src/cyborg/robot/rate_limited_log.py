@@ -51,8 +51,11 @@ class RateLimitedLog:
         return len(self._kinds)
 
     def log(self, level: int, key: Hashable, message: str, *args: object) -> bool:
-        """Log ``message % args`` at ``level`` unless one of kind ``key`` was logged less than
-        ``interval`` seconds ago (then count it). True when it was logged."""
+        """Logs ``message % args`` at ``level``, or only counts it if its kind is too recent.
+
+        It is counted instead when one of kind ``key`` was logged less than ``interval`` seconds
+        ago. True when it was logged. Safe to call from any thread.
+        """
         now = self.clock()
         with self._lock:
             shown, left_out = self._kinds.get(key, (-math.inf, 0))
@@ -71,9 +74,11 @@ class RateLimitedLog:
         return True
 
     def warning(self, key: Hashable, message: str, *args: object) -> bool:
+        """:meth:`log` at WARNING level; True when it was logged."""
         return self.log(logging.WARNING, key, message, *args)
 
     def info(self, key: Hashable, message: str, *args: object) -> bool:
+        """:meth:`log` at INFO level; True when it was logged."""
         return self.log(logging.INFO, key, message, *args)
 
     def _forget(self, now: float) -> None:

@@ -147,8 +147,10 @@ class BackgroundReloads:
                      "running")
 
     def _settle(self, job: _Reload, *, timed_out: bool = False) -> bool:
-        """Claim the right to answer ``job``: True for the first of its end, its timeout and
-        :meth:`close`. A timed-out job stays counted as stuck until its load ends."""
+        """Claims the right to answer ``job``; True for the first of its end, timeout and close.
+
+        A timed-out job stays counted as stuck until its load ends.
+        """
         with self._lock:
             if self._loading is job:
                 self._loading = None

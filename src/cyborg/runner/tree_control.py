@@ -38,6 +38,16 @@ import numpy as np
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Hook, HookError, HookMode, Tree
 from cyborg.bus import Node
 from cyborg.bus.executor import CallbackThread
+from cyborg.bus.msgs.cyborg_msgs.msg import BehaviorTreeHooks
+from cyborg.bus.msgs.cyborg_msgs.srv import (
+    ControlNode,
+    ControlNode_Request,
+    ControlNode_Response,
+    GetBlackboard,
+    GetBlackboard_Request,
+    GetBlackboard_Response,
+)
+from cyborg.bus.msgs.std_srvs.srv import Trigger, Trigger_Request, Trigger_Response
 from cyborg.bus.services import Responder
 from cyborg.bus.wire import EntityKind, gid
 from cyborg.interfaces import tree_runner
@@ -68,9 +78,6 @@ class TreeControl:
         self._owners: dict[str, str] = {}  # owner (client GID hex) -> its node's name
         self._lock = threading.Lock()
         self._hooks = tree_runner.HOOKS.publisher(node)
-        self._classes = {name: node.types.message_class(name) for name in (
-            tree_runner.HOOKS.type_name, tree_runner.CONTROL.response_type,
-            tree_runner.STEP.response_type, tree_runner.GET_BLACKBOARD.response_type)}
         tree_runner.CONTROL.server(node, self._on_control, deferred=True, callbacks=callbacks)
         tree_runner.RESUME.server(node, self._on_resume, callbacks=callbacks)
         tree_runner.STEP.server(node, self._on_step, callbacks=callbacks)
@@ -81,9 +88,14 @@ class TreeControl:
 
     # ------------------------------------------------------------------ hooks topic
     def publish(self) -> None:
+        """Publish the hooks set on the current tree, and where a tick waits, on ``hooks``.
+
+        Called again by the tree's hooks whenever they change (on whichever thread changed
+        them).
+        """
         hooks = self.current().hooks
         entries = hooks.hooks()
-        self._hooks.publish(self._classes[tree_runner.HOOKS.type_name](
+        self._hooks.publish(BehaviorTreeHooks(
             node_ids=[hook.node for hook in entries],
             actions=np.array([CODES[hook.mode] for hook in entries], np.uint8),
             statuses=np.array([int(hook.status) for hook in entries], np.uint8),
@@ -126,8 +138,9 @@ class TreeControl:
                              name)
 
     # ------------------------------------------------------------------ services
-    def _on_control(self, request: Any, responder: Responder) -> None:
-        response = self._classes[tree_runner.CONTROL.response_type]
+    def _on_control(self, request: ControlNode_Request,
+                    responder: Responder[ControlNode_Response]) -> None:
+        response = ControlNode.Response
         hooks = self.current().hooks
         uid, action = str(request.node_id), int(request.action)
         note = ""
@@ -160,29 +173,33 @@ class TreeControl:
             return
         responder.reply(response(success=True, message=f"{mode.value} set on {uid}{note}"))
 
-    def _trigger(self, success: bool, message: str) -> Any:
-        return self._classes[tree_runner.STEP.response_type](success=success, message=message)
+    @staticmethod
+    def _trigger(success: bool, message: str) -> Trigger_Response:
+        return Trigger.Response(success=success, message=message)
 
-    def _on_resume(self, _request: Any) -> Any:
+    def _on_resume(self, _request: Trigger_Request) -> Trigger_Response:
         resumed = self.current().hooks.resume()
         return self._trigger(resumed, "resumed" if resumed else "no tick is waiting")
 
-    def _on_step(self, _request: Any) -> Any:
+    def _on_step(self, _request: Trigger_Request) -> Trigger_Response:
         stepped = self.current().hooks.step()
         return self._trigger(stepped, "stepping" if stepped else "no tick is waiting")
 
-    def _on_blackboard(self, _request: Any) -> Any:
+    def _on_blackboard(self, _request: GetBlackboard_Request) -> GetBlackboard_Response:
         scopes = self.current().blackboard.as_dict()
-        return self._classes[tree_runner.GET_BLACKBOARD.response_type](
+        return GetBlackboard.Response(
             json=json.dumps(jsonable(scopes), sort_keys=True))
 
     def destroy(self) -> None:
+        """Stop following clients in the graph; the services go with the runner's node."""
         self._stop_watching()
 
 
 def jsonable(value: Any) -> Any:
-    """``value`` made into strict JSON: keys as strings, inf/nan as strings, other objects as
-    their repr, so any blackboard can be shown."""
+    """``value`` made into strict JSON, so that any blackboard can be shown.
+
+    Keys become strings, inf and nan strings too, other objects their repr.
+    """
     if isinstance(value, dict):
         return {str(key): jsonable(item) for key, item in value.items()}
     if isinstance(value, list | tuple | set | frozenset):

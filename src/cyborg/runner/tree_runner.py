@@ -71,7 +71,17 @@ from cyborg.bt import (
     load_tree,
 )
 from cyborg.bt.snapshot import TickSnapshot
+from cyborg.bt.tick_loop import DEFAULT_RATE
 from cyborg.bus import Node, SimClock
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BehaviorTree,
+    BehaviorTreeNodes,
+    BehaviorTreeStatus,
+)
+from cyborg.bus.msgs.cyborg_msgs.srv import ReloadTree, ReloadTree_Request, ReloadTree_Response
+from cyborg.bus.msgs.std_msgs.msg import Bool
+from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
 from cyborg.robot.interface import ROBOT, Robot
@@ -90,12 +100,15 @@ class TreeRunnerNode:
     """Runs one tree file on the bus; see the module docstring."""
 
     def __init__(self, node: Node, path: str | Path, *, tree: str | None = None,
-                 rate_hz: float = 10.0, clock: Clock | None = None, robot: Robot | None = None,
+                 rate_hz: float = DEFAULT_RATE, clock: Clock | None = None,
+                 robot: Robot | None = None,
                  registry: NodeRegistry | None = None, enabled: bool = True,
                  reload_timeout: float = RELOAD_TIMEOUT) -> None:
-        """Load the tree (raises :class:`~cyborg.bt.TreeLoadError`) and set up the topics and
-        services; :meth:`start` begins ticking. ``reload_timeout`` is the default of the node
-        parameter of that name (a value given to the node at start-up wins)."""
+        """Load the tree (raises :class:`~cyborg.bt.TreeLoadError`), set up topics and services.
+
+        :meth:`start` begins ticking. ``reload_timeout`` is the default of the node parameter of
+        that name (a value given to the node at start-up wins).
+        """
         self.node, self.path, self.tree_choice = node, Path(path), tree
         self.registry = registry if registry is not None else default_registry()
         self.clock = clock
@@ -111,16 +124,10 @@ class TreeRunnerNode:
             node.parameters.declare("reload_timeout", float(reload_timeout), "seconds (wall "
                                     "time) a reload may take before it is answered with an "
                                     "error", limits=(0.01, 3600.0))
-        types = node.types
         self._structure = tree_runner.STRUCTURE.publisher(node)
         self._updates = tree_runner.ACTIVE_PATH.publisher(node)
         self._enabled_pub = tree_runner.ENABLED.publisher(node)
         self._status = tree_runner.STATUS.publisher(node)
-        self._classes = {name: types.message_class(name) for name in (
-            tree_runner.STRUCTURE.type_name, tree_runner.ACTIVE_PATH.type_name,
-            tree_runner.ENABLED.type_name, tree_runner.STATUS.type_name,
-            "builtin_interfaces/msg/Time", tree_runner.ENABLE.response_type,
-            tree_runner.RELOAD.response_type)}
         tree_runner.ENABLE.server(node, self._on_enable, callbacks=node.callback_thread("enable"))
         tree_runner.RELOAD.server(node, self._on_reload, deferred=True)
         self.control = TreeControl(node, lambda: self.tree,
@@ -168,6 +175,7 @@ class TreeRunnerNode:
     # ------------------------------------------------------------------ running
     @property
     def enabled(self) -> bool:
+        """Whether the tree is enabled, as ``enabled`` says; after a disable, a halt may pend."""
         return self._enabled
 
     def start(self) -> None:
@@ -233,6 +241,7 @@ class TreeRunnerNode:
             self._thread.join(5.0)
 
     def destroy(self) -> None:
+        """Answer a pending reload, stop ticking (the tree halts) and destroy the node."""
         self._reloads.close()
         self.stop()
         self.control.destroy()
@@ -241,15 +250,13 @@ class TreeRunnerNode:
     # ------------------------------------------------------------------ publishing
     def _publish_structure(self) -> None:
         text = json.dumps(self.tree.structure.to_json(), separators=(",", ":"))
-        self._structure.publish(self._classes[tree_runner.STRUCTURE.type_name](tree=text))
+        self._structure.publish(BehaviorTree(tree=text))
 
     def _publish_enabled(self) -> None:
-        self._enabled_pub.publish(self._classes[tree_runner.ENABLED.type_name](
-            data=self._enabled))
+        self._enabled_pub.publish(Bool(data=self._enabled))
 
     def _publish_active(self, active: tuple[str, ...]) -> None:
-        self._updates.publish(self._classes[tree_runner.ACTIVE_PATH.type_name](
-            ids=list(active)))
+        self._updates.publish(BehaviorTreeNodes(ids=list(active)))
 
     def _on_tick(self, snapshot: TickSnapshot) -> None:
         active = tuple(snapshot.active)
@@ -262,10 +269,9 @@ class TreeRunnerNode:
             return  # nobody listens: skip building the message
         tree.timing = True  # per-node timings from the next tick on
         seconds = snapshot.time
-        stamp = self._classes["builtin_interfaces/msg/Time"](
-            sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9) % 1_000_000_000)
+        stamp = Time(sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9) % 1_000_000_000)
         visited = snapshot.visited
-        self._status.publish(self._classes[tree_runner.STATUS.type_name](
+        self._status.publish(BehaviorTreeStatus(
             stamp=stamp, tick=snapshot.tick, duration=snapshot.duration,
             status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
             visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
@@ -273,10 +279,10 @@ class TreeRunnerNode:
             active_ids=list(active), halted_ids=snapshot.halted))
 
     # ------------------------------------------------------------------ services
-    def _on_enable(self, request: Any) -> Any:
+    def _on_enable(self, request: SetBool_Request) -> SetBool_Response:
         on = bool(request.data)
         done = self.set_enabled(on, wait=HALT_WAIT)
-        response = self._classes[tree_runner.ENABLE.response_type]
+        response = SetBool.Response
         if on and not done:
             return response(success=False, message=(
                 "not enabled: the tree is still halting, because the tick before the disable "
@@ -287,11 +293,12 @@ class TreeRunnerNode:
                         "(a node in it is still waiting, e.g. on the robot)")
         return response(success=True, message=message)
 
-    def _on_reload(self, request: Any, responder: Responder) -> None:
+    def _on_reload(self, request: ReloadTree_Request,
+                   responder: Responder[ReloadTree_Response]) -> None:
         """Start loading in the background and return at once (deferred: the load answers)."""
         path = Path(request.path) if request.path else self.path
         self._reloads.request(path, responder, self.reload_timeout)
 
-    def _answer_reload(self, responder: Responder, success: bool, message: str) -> None:
-        responder.reply(self._classes[tree_runner.RELOAD.response_type](
-            success=success, message=message))
+    def _answer_reload(self, responder: Responder[ReloadTree_Response], success: bool,
+                       message: str) -> None:
+        responder.reply(ReloadTree.Response(success=success, message=message))

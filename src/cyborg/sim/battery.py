@@ -16,6 +16,12 @@ from cyborg.interfaces.robot import ChargingState as ChargingState
 
 @dataclass
 class Battery:
+    """The battery's charge, and how use and the charger change it (see the module doc).
+
+    ``charge_percent`` runs from 0 to 100; the voltage is linear in it between ``empty_volts``
+    and ``full_volts``; ``charging`` is set while the robot is docked and powered.
+    """
+
     charge_percent: float = 100.0
     idle_hours: float = 13.0  # hours from full to empty standing still
     driving_drain: float = 2.0  # extra percent per hour per m/s
@@ -26,10 +32,12 @@ class Battery:
 
     @property
     def voltage(self) -> float:
+        """Volts, linear in the charge from ``empty_volts`` (0 %) to ``full_volts`` (100 %)."""
         return self.empty_volts + (self.full_volts - self.empty_volts) * self.charge_percent / 100
 
     @property
     def state(self) -> ChargingState:
+        """Bulk below 80 %, overcharge below 99.5 %, then float; ``NOT`` unless charging."""
         if not self.charging:
             return ChargingState.NOT
         if self.charge_percent < 80.0:
@@ -40,6 +48,7 @@ class Battery:
 
     @property
     def empty(self) -> bool:
+        """Whether the charge has run out (below 0.01 %)."""
         return self.charge_percent < 0.01
 
     def step(self, dt: float, speed: float) -> None:

@@ -29,6 +29,8 @@ class DockPhase(StrEnum):
 
 @dataclass(frozen=True)
 class DockSettings:
+    """Distances (m), speeds (m/s) and waits (s) of docking and undocking."""
+
     depth: float = 0.3  # metres driven forward from the Dock pose onto the charger
     creep_speed: float = 0.1  # m/s in and out
     power_delay: float = 2.0  # seconds until the charger delivers power
@@ -50,5 +52,9 @@ class Docking:
 
     def enter(self, state: DockState, phase: DockPhase, now: float,
               position: tuple[float, float] = (0.0, 0.0)) -> None:
+        """Move to ``state`` and ``phase`` at simulated time ``now`` (s).
+
+        ``position`` (x, y in metres) is where the distance driven in the phase is measured from.
+        """
         self.state, self.phase, self.phase_started = state, phase, now
         self.travelled_from = position

@@ -40,6 +40,12 @@ class FollowerSettings:
 
 @dataclass(frozen=True)
 class Command:
+    """A speed command: ``speed`` in m/s, ``turn_rate`` in rad/s, and what the follower saw.
+
+    ``arrived``: the goal (and its heading, if asked for) is reached; ``remaining``: metres
+    still to go along the path.
+    """
+
     speed: float
     turn_rate: float
     arrived: bool = False
@@ -48,7 +54,11 @@ class Command:
 
 
 class PathFollower:
-    """Turns a path, the robot's pose and a laser scan into speed commands."""
+    """Turns a path, the robot's pose and a laser scan into speed commands.
+
+    With ``use_heading`` the robot turns to the path's final heading on arrival; ``settings``
+    default to :class:`FollowerSettings`.
+    """
 
     def __init__(self, path: Path, use_heading: bool,
                  settings: FollowerSettings | None = None) -> None:
@@ -59,10 +69,13 @@ class PathFollower:
 
     def update(self, pose: Pose2D, front_range: float,
                stop_range: float | None = None) -> Command:
-        """The command for now; ``front_range``: nearest obstacle ahead of the scanner in a
-        corridor a little wider than the robot (to slow down); ``stop_range``: the same in a
-        corridor exactly as wide as the robot (to stop; default ``front_range``). A door jamb
-        beside the path slows the robot but does not stop it."""
+        """The command for the robot at ``pose`` now.
+
+        ``front_range``: metres to the nearest obstacle ahead of the scanner in a corridor a
+        little wider than the robot (to slow down); ``stop_range``: the same in a corridor
+        exactly as wide as the robot (to stop; default ``front_range``). A door jamb beside the
+        path slows the robot but does not stop it.
+        """
         s = self.settings
         along, _gap = self.path.project(pose.x, pose.y)
         remaining = self.path.length - along
@@ -90,8 +103,11 @@ class PathFollower:
         return Command(max(speed, 0.0), turn, blocked=blocked, remaining=remaining)
 
     def _sharp_corners(self) -> tuple[np.ndarray, np.ndarray]:
-        """Where along the path it turns by more than ``sharp_corner``, and the speed for each
-        corner: the cruise speed times the cosine of the turn, at least the slow speed."""
+        """Where along the path it turns by more than ``sharp_corner``, and each corner's speed.
+
+        A corner's speed is the cruise speed times the cosine of the turn, at least the slow
+        speed.
+        """
         s, points = self.settings, self.path.points
         if len(points) < 3:
             return np.zeros(0), np.zeros(0)
@@ -106,8 +122,11 @@ class PathFollower:
         return along[sharp], speeds
 
     def _corner_limit(self, along: float) -> float:
-        """The highest speed from which the robot can still slow down to every sharp corner's
-        speed before reaching it (corners the robot is already at count from here)."""
+        """The highest speed from which the robot can still slow down for every sharp corner.
+
+        That is, down to each corner's speed before reaching it; corners the robot is already at
+        count from here.
+        """
         limit = math.inf
         s = self.settings
         for at, speed in zip(self._corners, self._corner_speeds, strict=True):
@@ -137,8 +156,11 @@ the LX; it stops only for obstacles within its own half width."""
 
 def front_ranges(ranges: np.ndarray, angles: np.ndarray, half_widths: tuple[float, ...],
                  range_max: float = 30.0) -> tuple[float, ...]:
-    """Distance ahead to the nearest return within corridors of the given half widths (one
-    projection of the scan serves all of them); inf where a corridor is clear."""
+    """Distance ahead (m) to the nearest return within corridors of the given half widths.
+
+    One projection of the scan serves all of them; inf where a corridor is clear. Returns
+    beyond ``range_max`` count as nothing seen.
+    """
     valid = ranges <= range_max
     ahead = valid & (np.abs(angles) < math.pi / 2)
     if not ahead.any():

@@ -17,7 +17,10 @@ from numba import njit
 
 @dataclass(frozen=True)
 class LaserSpec:
-    """Where the scanner sits on the robot and what it sees (the Pioneer LX's S300 by default)."""
+    """Where the scanner sits on the robot and what it sees (the Pioneer LX's S300 by default).
+
+    The field of view is in radians, centred on the robot's heading; ranges are in metres.
+    """
 
     beams: int = 541
     field_of_view: float = math.radians(270.0)
@@ -28,10 +31,12 @@ class LaserSpec:
 
     @property
     def angle_min(self) -> float:
+        """The first beam's angle (rad) relative to the robot's heading; the scan is symmetric."""
         return -self.field_of_view / 2
 
     @property
     def angle_increment(self) -> float:
+        """Radians between neighbouring beams."""
         return self.field_of_view / (self.beams - 1)
 
     def angles(self) -> np.ndarray:
@@ -77,7 +82,11 @@ def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution
 
 
 class Laser:
-    """Scans an occupancy grid from a robot pose."""
+    """Scans an occupancy grid from a robot pose.
+
+    ``occupied`` is a boolean (rows, columns) grid whose cell (0, 0) has its lower-left corner at
+    ``origin`` (m), with ``resolution`` metres per cell; ``seed`` seeds the range noise.
+    """
 
     def __init__(self, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
                  spec: LaserSpec | None = None, seed: int = 0) -> None:
@@ -89,8 +98,11 @@ class Laser:
         self._random = np.random.default_rng(seed)
 
     def scan(self, x: float, y: float, theta: float) -> np.ndarray:
-        """Ranges in metres for each beam, from the scanner's mount on the robot at the pose;
-        ``range_max + 1`` where nothing is within reach."""
+        """Ranges in metres for each beam, from the scanner's mount on the robot at the pose.
+
+        A beam reads ``range_max + 1`` where nothing is within reach. The pose is in metres and
+        radians.
+        """
         spec = self.spec
         sx = x + spec.mount_x * math.cos(theta)
         sy = y + spec.mount_x * math.sin(theta)

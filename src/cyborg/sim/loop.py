@@ -20,6 +20,9 @@ from cyborg.sim.simulator import Simulator
 
 log = logging.getLogger("cyborg.sim")
 
+REAL_TIME = 1.0
+"""The speed at which simulated time follows the wall clock: the default."""
+
 
 class SimulationLock:
     """A re-entrant lock that the simulation thread hands over to anyone waiting for it.
@@ -59,7 +62,14 @@ class SimulationLock:
 
 
 class SimulationLoop:
-    def __init__(self, simulator: Simulator, speed: float = 1.0) -> None:
+    """Steps ``simulator`` on a thread of its own at ``speed`` (see the module doc).
+
+    Whoever touches the simulator from another thread holds :attr:`lock`; the ``on_sensor``
+    callbacks run on the loop's thread, lock held, after each sensor step; :attr:`error` holds
+    what stopped the loop if it failed.
+    """
+
+    def __init__(self, simulator: Simulator, speed: float = REAL_TIME) -> None:
         self.simulator = simulator
         self.speed = speed
         self.lock = SimulationLock()
@@ -81,16 +91,19 @@ class SimulationLoop:
         self._speed = math.inf if speed == 0 else speed
 
     def start(self) -> None:
+        """Start stepping on the loop's thread, ``cyborg-sim``."""
         self._thread = threading.Thread(target=self._run, name="cyborg-sim", daemon=True)
         self._thread.start()
 
     def stop(self, timeout: float = 5.0) -> None:
+        """Stop after the current step; wait up to ``timeout`` seconds unless called by the loop."""
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout)
 
     @property
     def running(self) -> bool:
+        """Whether the loop's thread is alive: started, and neither stopped nor failed."""
         return self._thread is not None and self._thread.is_alive()
 
     def _run(self) -> None:

@@ -27,8 +27,12 @@ from cyborg.sim.robot import arc_step, body_gap
 
 @dataclass(frozen=True)
 class Motion:
-    """How the robot moves now (m/s, rad/s), how fast it can change that (m/s², rad/s²), and
-    the step (s) at which its drive applies changes."""
+    """How the robot moves now, how fast it can change that, and the step of its drive.
+
+    ``speed`` (m/s) and ``turn_rate`` (rad/s) are the motion now, ``acceleration`` (m/s²) and
+    ``turn_acceleration`` (rad/s²) its limits, ``step`` (s) the period at which the drive
+    applies changes.
+    """
 
     speed: float
     turn_rate: float
@@ -39,7 +43,11 @@ class Motion:
 
 @dataclass(frozen=True)
 class Surroundings:
-    """What the robot knows of the world near it: a wall clearance grid and laser returns."""
+    """What the robot knows of the world near it: a wall clearance grid and laser returns.
+
+    ``origin`` (m, the lower-left corner of cell (0, 0)) and ``resolution`` (m per cell) place
+    the grid as a :class:`~cyborg.nav.grid.MapGrid` is placed.
+    """
 
     clearance: np.ndarray  # metres from each cell centre to the nearest wall
     origin: tuple[float, float]
@@ -59,11 +67,14 @@ CREEP = 0.1
 def stopping_gap(x: float, y: float, theta: float, motion: Motion, command: tuple[float, float],
                  period: float, footprint: Footprint, around: Surroundings,
                  enough: float = math.inf) -> float:
-    """Smallest gap (m, negative when overlapping) between the body and the surroundings while
-    the robot follows ``command`` for ``period`` seconds and then brakes to a standstill.
+    """The smallest gap (m) between the body and the surroundings along a command and braking.
+
+    The robot at ``(x, y, theta)`` follows ``command`` (m/s, rad/s) for ``period`` seconds and
+    then brakes to a standstill; the gap is negative when the body overlaps something.
 
     Poses whose gap is certainly at least ``enough`` are not looked at: then the result is
-    exact only when it is below ``enough``; above, it only says "at least ``enough``"."""
+    exact only when it is below ``enough``; above, it only says "at least ``enough``".
+    """
     offsets, radius = footprint.circles()
     hits = np.ascontiguousarray(around.hits, dtype=np.float64).reshape(-1, 2)
     return float(_stopping_gap(
@@ -76,7 +87,9 @@ def stopping_gap(x: float, y: float, theta: float, motion: Motion, command: tupl
 def safest_command(x: float, y: float, theta: float, motion: Motion,
                    wanted: tuple[float, float], period: float, footprint: Footprint,
                    around: Surroundings) -> tuple[float, float]:
-    """``wanted`` when its motion keeps :data:`MARGIN` (or, where the robot is closer than
+    """The command to send (m/s, rad/s): ``wanted`` if it is safe, else the safest fallback.
+
+    ``wanted`` is safe when its motion keeps :data:`MARGIN` (or, where the robot is closer than
     that already, does not get closer); otherwise the first safe of: the same speed with half
     and a quarter of the turn; no speed with half and a quarter of the turn; when the wanted
     turn was on the spot, :data:`CREEP` forwards, then backwards, on a tight arc (full, then
@@ -84,7 +97,8 @@ def safest_command(x: float, y: float, theta: float, motion: Motion,
     keeping most room (the gentler one of equals).
 
     Checked again every control period, this keeps the robot clear by induction: once a safe
-    command was chosen, braking after it was found clear, so next period braking still is."""
+    command was chosen, braking after it was found clear, so next period braking still is.
+    """
     standing = Motion(0.0, 0.0, 1.0, 1.0, motion.step)
     needed = min(MARGIN, stopping_gap(x, y, theta, standing, (0.0, 0.0), 0.0, footprint,
                                       around))
@@ -105,8 +119,10 @@ def safest_command(x: float, y: float, theta: float, motion: Motion,
 
 
 def warm_up() -> None:
-    """Compile (or load from numba's cache) the check's kernel now: the first compilation takes
-    seconds, which would otherwise fall on the robot's first move."""
+    """Compile (or load from numba's cache) the check's kernel now.
+
+    The first compilation takes seconds, which would otherwise fall on the robot's first move.
+    """
     around = Surroundings(np.ones((4, 4), np.float32), (0.0, 0.0), 1.0, np.zeros((1, 2)))
     stopping_gap(2.0, 2.0, 0.0, Motion(0.0, 0.0, 1.0, 1.0), (0.0, 0.0), 0.1,
                  Footprint(length=0.2, width=0.1), around)

@@ -25,6 +25,8 @@ from cyborg.sim.motion_check import Motion, Surroundings, safest_command
 
 @dataclass(frozen=True)
 class NavigatorSettings:
+    """When to give up, replan and see obstacles: times in simulated seconds, lengths in m."""
+
     stall_timeout: float = 15.0  # seconds without progress along the path before giving up
     progress_step: float = 0.1  # metres of progress that count
     replan_interval: float = 2.0  # seconds between replans around a blocking obstacle
@@ -35,7 +37,11 @@ class NavigatorSettings:
 
 
 class Navigator:
-    """Drives to one goal at a time on a planner's map."""
+    """Drives to one goal at a time on a planner's map.
+
+    ``settings`` default to :class:`NavigatorSettings`. :attr:`state` and :attr:`message` say
+    how the goal goes; times (``now``) are simulated seconds.
+    """
 
     def __init__(self, planner: Planner, settings: NavigatorSettings | None = None) -> None:
         self.planner = planner
@@ -68,6 +74,7 @@ class Navigator:
         return result
 
     def cancel(self) -> None:
+        """Drop the goal; one still under way ends ``ABORTED_PATHPLAN`` ("cancelled")."""
         if not self.state.finished:
             self.state, self.message = PathState.ABORTED_PATHPLAN, "cancelled"
         self.follower = None
@@ -75,10 +82,13 @@ class Navigator:
     def update(self, now: float, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
                hits: np.ndarray, motion: Motion | None = None,
                period: float = 0.1) -> tuple[float, float]:
-        """Speed and turn rate for the next ``period`` seconds; ``hits``: the scan's returns as
-        map points; ``motion``: how the robot moves now (its odometry). With ``motion``, a
-        command whose motion until standstill would touch a wall or a return is replaced by a
-        gentler one (:func:`cyborg.sim.motion_check.safest_command`)."""
+        """Speed (m/s) and turn rate (rad/s) for the next ``period`` seconds.
+
+        ``ranges`` and ``angles`` are the latest scan's, ``hits`` its returns as map points;
+        ``motion``: how the robot moves now (its odometry). With ``motion``, a command whose
+        motion until standstill would touch a wall or a return is replaced by a gentler one
+        (:func:`cyborg.sim.motion_check.safest_command`). Zero unless moving to a goal.
+        """
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
         slow, stop = front_ranges(ranges, angles,

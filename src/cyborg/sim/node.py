@@ -34,7 +34,26 @@ from typing import Any
 
 import numpy as np
 
-from cyborg.bus import Node, ServerGoal, new_message
+from cyborg.bus import Node, ServerGoal
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.cyborg_msgs.action import (
+    MoveToGoal,
+    MoveToGoal_Feedback,
+    MoveToGoal_Goal,
+    MoveToGoal_Result,
+)
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState
+from cyborg.bus.msgs.geometry_msgs.msg import (
+    PoseWithCovariance,
+    Twist,
+    TwistWithCovariance,
+    Vector3,
+)
+from cyborg.bus.msgs.nav_msgs.msg import Odometry
+from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
+from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
+from cyborg.bus.msgs.std_msgs.msg import Header, String
+from cyborg.bus.msgs.std_srvs.srv import Trigger, Trigger_Request, Trigger_Response
 from cyborg.interfaces import robot
 from cyborg.interfaces.robot import DockState, MoveOutcome, PathState
 from cyborg.nav.arnl_map import ArnlMap
@@ -56,8 +75,6 @@ class SimulatorNode:
 
     def __init__(self, node: Node, loop: SimulationLoop, max_publish_rate: float = 30.0) -> None:
         self.node, self.loop, self.sim = node, loop, loop.simulator
-        types = node.types
-        self.types = types
         self._min_period = 1.0 / max_publish_rate
         self._published_at = 0.0
         self._last_state: tuple[Any, ...] = ()
@@ -66,9 +83,8 @@ class SimulatorNode:
         self._goal_generation = 0
         self._stepped = threading.Condition()  # notified after every sensor step
         self._newest_goal = 0
-        self._active_goal: ServerGoal | None = None
+        self._active_goal: ServerGoal[MoveToGoal_Goal, MoveToGoal_Feedback] | None = None
         self._feedback_at = -math.inf
-        self._feedback_class = types.message_class(robot.MOVE_TO_GOAL.feedback_type)
         self.clock = robot.CLOCK.publisher(node)
         self.pose = robot.POSE.publisher(node)
         self.odom = robot.ODOM.publisher(node)
@@ -90,14 +106,14 @@ class SimulatorNode:
         loop.on_sensor.append(self._publish)
 
     # ------------------------------------------------------------------ publishing
-    def _stamp(self) -> Any:
+    def _stamp(self) -> Time:
         # Whole nanoseconds first: int() and round() of the parts apart turned 2.9999999999999996
         # into 2 s + 0 ns, one second back, which /clock followers take for a jump.
         sec, nanosec = divmod(round(self.sim.time * 1e9), 1_000_000_000)
-        return self.types.message_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec)
+        return Time(sec=sec, nanosec=nanosec)
 
-    def _header(self, frame: str) -> Any:
-        return self.types.message_class("std_msgs/msg/Header")(stamp=self._stamp(), frame_id=frame)
+    def _header(self, frame: str) -> Header:
+        return Header(stamp=self._stamp(), frame_id=frame)
 
     def _publish(self, sim: Simulator) -> None:
         if self.node.destroyed:
@@ -116,53 +132,49 @@ class SimulatorNode:
         self._feedback(sim)
         with self._stepped:
             self._stepped.notify_all()
-        message = self.types.message_class
-        self.clock.publish(message(robot.CLOCK.type_name)(clock=self._stamp()))
+        self.clock.publish(Clock(clock=self._stamp()))
         if sim.time - self._battery_at >= 1.0:
             self._battery_at = sim.time
             self._publish_battery(sim)
         state = (sim.base.bumpers.front, sim.base.bumpers.rear, sim.navigator.state)
         if state != self._last_state:
             self._last_state = state
-            self.bumpers.publish(message(robot.BUMPER_STATE.type_name)(
+            self.bumpers.publish(BumperState(
                 header=self._header("base_link"), front_bumpers=np.array([state[0]]),
                 rear_bumpers=np.array([state[1]])))
-            self.path_state.publish(message(robot.PATH_STATE.type_name)(data=state[2].value))
+            self.path_state.publish(String(data=state[2].value))
         follower = sim.navigator.follower
         if follower is not None and follower.path is not self._path_shown:
             self._path_shown = follower.path
-            self.path.publish(follower.path.to_message(self.types, stamp=self._stamp()))
+            self.path.publish(follower.path.to_message(stamp=self._stamp()))
         now = time.monotonic()
         if now - self._published_at < self._min_period:
             return
         self._published_at = now
         pose = sim.pose
-        self.pose.publish(pose.to_message(self.types))
+        self.pose.publish(pose.to_message())
         self.odom.publish(self._odometry(sim))
         self.scan.publish(self._scan(sim))
 
     def _publish_battery(self, sim: Simulator) -> None:
         battery = sim.battery
-        self.battery.publish(self.types.message_class(robot.BATTERY_STATUS.type_name)(
+        self.battery.publish(BatteryStatus(
             header=self._header("base_link"), charging_state=int(battery.state),
             charge_percent=battery.charge_percent, voltage=battery.voltage,
             charging=battery.charging, dock_state=sim.docking.state.value))
 
-    def _odometry(self, sim: Simulator) -> Any:
-        pose = sim.pose.to_pose()
-        odometry = new_message(self.types, robot.ODOM.type_name, {
-            "child_frame_id": "base_link",
-            "pose": {"pose": {"position": {"x": pose.position.x, "y": pose.position.y},
-                              "orientation": {"z": pose.orientation.z,
-                                              "w": pose.orientation.w}}},
-            "twist": {"twist": {"linear": {"x": sim.base.speed},
-                                "angular": {"z": sim.base.turn_rate}}}})
-        odometry.header = self._header("map")
-        return odometry
+    def _odometry(self, sim: Simulator) -> Odometry:
+        # zero covariances: unknown, as nav_msgs/Odometry says of zeros
+        pose = PoseWithCovariance(pose=sim.pose.to_pose().to_message(),
+                                  covariance=np.zeros(36))
+        twist = Twist(linear=Vector3(x=float(sim.base.speed), y=0.0, z=0.0),
+                      angular=Vector3(x=0.0, y=0.0, z=float(sim.base.turn_rate)))
+        return Odometry(header=self._header("map"), child_frame_id="base_link", pose=pose,
+                        twist=TwistWithCovariance(twist=twist, covariance=np.zeros(36)))
 
-    def _scan(self, sim: Simulator) -> Any:
+    def _scan(self, sim: Simulator) -> LaserScan:
         spec = sim.laser.spec
-        return self.types.message_class(robot.SCAN.type_name)(
+        return LaserScan(
             header=self._header("laser"), angle_min=spec.angle_min,
             angle_max=spec.angle_min + spec.angle_increment * (spec.beams - 1),
             angle_increment=spec.angle_increment, time_increment=0.0,
@@ -171,37 +183,40 @@ class SimulatorNode:
             intensities=np.zeros(0, np.float32))
 
     def _map_changed(self, arnl_map: ArnlMap, planner: Planner) -> None:
-        """A new map (``load_map_file``, on the loading thread): the grids are built before
-        the simulation's lock is taken, so ``stop`` and the simulation wait only for the swap."""
+        """Switch the simulation to a new map (``load_map_file``, on the loading thread).
+
+        The grids are built before the simulation's lock is taken, so ``stop`` and the
+        simulation wait only for the swap.
+        """
         prepared = self.sim.prepare_map(arnl_map, planner=planner)
         with self.loop.lock:
             self.sim.install_map(prepared)
 
     # ------------------------------------------------------------------ services
-    def _trigger(self, success: bool, message: str) -> Any:
-        return self.types.message_class(robot.DOCK.response_type)(
-            success=success, message=message)
+    @staticmethod
+    def _trigger(success: bool, message: str) -> Trigger_Response:
+        return Trigger.Response(success=success, message=message)
 
-    def _dock(self, _request: Any) -> Any:
+    def _dock(self, _request: Trigger_Request) -> Trigger_Response:
         with self.loop.lock:
             self._goal_generation += 1
             ok = self.sim.dock()
             return self._trigger(ok, "docking" if ok else self.sim.docking.message)
 
-    def _undock(self, _request: Any) -> Any:
+    def _undock(self, _request: Trigger_Request) -> Trigger_Response:
         with self.loop.lock:
             ok = self.sim.undock()
             return self._trigger(ok, "undocking" if ok else
                                  f"not docked ({self.sim.docking.state.value})")
 
-    def _stop(self, _request: Any) -> Any:
+    def _stop(self, _request: Trigger_Request) -> Trigger_Response:
         with self.loop.lock:
             self._goal_generation += 1
             self.sim.cancel()
         return self._trigger(True, "stopped")
 
     # ------------------------------------------------------------------ move_to_goal
-    def _move(self, goal: ServerGoal) -> Any:
+    def _move(self, goal: ServerGoal[MoveToGoal_Goal, MoveToGoal_Feedback]) -> MoveToGoal_Result:
         """Run one move_to_goal goal: start it, then wait for its end.
 
         Feedback is sent from the simulation's own thread (see :meth:`_feedback`), every
@@ -211,7 +226,7 @@ class SimulatorNode:
         newer one's is preempted at once.
         """
         request = goal.request
-        result = self.types.message_class(robot.MOVE_TO_GOAL.result_type)
+        result = MoveToGoal.Result
         with self.loop.lock:
             if goal.cancel_requested:
                 goal.canceled()
@@ -268,6 +283,6 @@ class SimulatorNode:
         if goal is None or sim.time < self._feedback_at + FEEDBACK_PERIOD:
             return
         self._feedback_at = sim.time
-        goal.publish_feedback(self._feedback_class(
-            current_pose=sim.pose.to_message(self.types),
+        goal.publish_feedback(MoveToGoal.Feedback(
+            current_pose=sim.pose.to_message(),
             distance_remaining=min(sim.navigator.remaining, 1e9)))

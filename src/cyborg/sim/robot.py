@@ -1,5 +1,7 @@
-"""The simulated Pioneer LX base: differential drive with speed and acceleration limits,
-a body that cannot pass through walls, and bumpers that report contact.
+"""The simulated Pioneer LX base: its differential drive, its body and its bumpers.
+
+The drive has speed and acceleration limits, the body cannot pass through walls, and the
+bumpers report contact.
 
 Motion is unicycle kinematics (forward speed ``v``, turn rate ``w``) integrated exactly over each
 step. Commands are followed within the acceleration limits. A step that would make the body
@@ -31,17 +33,25 @@ class DriveLimits:
 
 @dataclass
 class Bumpers:
+    """Contact of the front and rear bumpers."""
+
     front: bool = False
     rear: bool = False
 
     @property
     def any(self) -> bool:
+        """Whether either bumper reports contact."""
         return self.front or self.rear
 
 
 @dataclass
 class RobotBase:
-    """Pose, velocity and contact of the robot in a world given by a clearance grid."""
+    """Pose, velocity and contact of the robot in a world given by a clearance grid.
+
+    ``clearance`` holds metres to the nearest wall per cell; cell (0, 0) has its lower-left
+    corner at ``origin`` (m), and ``resolution`` is metres per cell. ``speed`` (m/s) and
+    ``turn_rate`` (rad/s) are the motion now.
+    """
 
     clearance: np.ndarray  # metres to the nearest wall, per cell of the world grid
     origin: tuple[float, float]
@@ -89,6 +99,7 @@ class RobotBase:
                               self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
 
     def collides(self, pose: Pose2D) -> bool:
+        """Whether the body at ``pose`` overlaps a wall."""
         return self.body_clearance(pose) < 0.0
 
     def _worse(self, moved: Pose2D) -> bool:
@@ -106,8 +117,11 @@ _NO_POINTS = np.zeros((0, 2))
 @njit(cache=True)
 def arc_step(x: float, y: float, theta: float, speed: float, turn_rate: float,
              dt: float) -> tuple[float, float, float]:  # pragma: no cover - jit
-    """Where unicycle motion at ``speed`` and ``turn_rate`` for ``dt`` seconds leads: an exact
-    arc (a straight line when not turning). The heading is not normalised."""
+    """Where unicycle motion at ``speed`` and ``turn_rate`` for ``dt`` seconds leads.
+
+    The motion is an exact arc (a straight line when not turning); the heading is not
+    normalised.
+    """
     heading = theta + turn_rate * dt
     if abs(turn_rate) > 1e-9:
         radius = speed / turn_rate
@@ -120,9 +134,12 @@ def arc_step(x: float, y: float, theta: float, speed: float, turn_rate: float,
 def body_gap(x: float, y: float, theta: float, offsets: np.ndarray, radius: float,
              clearance: np.ndarray, ox: float, oy: float, resolution: float,
              points: np.ndarray) -> float:  # pragma: no cover - jit
-    """The body's smallest gap at a pose: its circles (centres ``offsets`` along the heading)
-    against a clearance grid (looked up by the cell each centre falls in; 0 outside) and
-    against ``points`` (N x 2, e.g. laser returns; may be empty)."""
+    """The body's smallest gap (m, negative when overlapping) at a pose.
+
+    Its circles (centres ``offsets`` along the heading, radius ``radius``) are held against a
+    clearance grid (looked up by the cell each centre falls in; 0 outside) and against
+    ``points`` (N x 2, e.g. laser returns; may be empty).
+    """
     rows, columns = clearance.shape
     lowest = np.inf
     for offset in offsets:

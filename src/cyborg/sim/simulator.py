@@ -38,6 +38,8 @@ log = logging.getLogger("cyborg.sim")
 
 @dataclass(frozen=True)
 class SimSettings:
+    """Step rates (Hz), the world grid (m per cell), the parts' settings, the noise seed."""
+
     physics_rate: float = 50.0  # Hz
     sensor_rate: float = 10.0  # Hz: laser, navigation, docking decisions
     world_resolution: float = 0.05  # metres per cell of the simulated world
@@ -60,7 +62,12 @@ class PreparedMap:
 
 
 class Simulator:
-    """One robot in one map; see the module docstring."""
+    """One robot in one map; see the module docstring.
+
+    ``start`` is a pose or a goal name (see :meth:`load_map`); ``settings`` default to
+    :class:`SimSettings` and ``battery`` to a full :class:`~cyborg.sim.battery.Battery`. Not
+    thread-safe: under a :class:`~cyborg.sim.loop.SimulationLoop`, hold its lock.
+    """
 
     def __init__(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
                  settings: SimSettings | None = None, battery: Battery | None = None) -> None:
@@ -81,17 +88,23 @@ class Simulator:
     # ------------------------------------------------------------------ world
     def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
                  planner: Planner | None = None) -> None:
-        """Switch to another map; the robot starts at ``start`` (a pose or a goal name), or at
-        the map's home, or its dock, or a free point near the middle of the map
-        (:mod:`cyborg.sim.start`). The choice is in ``start_choice`` and in the log: a warning
-        when the map names no start, so ``cyborg sim`` shows it."""
+        """Switch to another map, with the robot standing where ``start`` says.
+
+        ``start`` is a pose or a goal name; without one the robot starts at the map's home, or
+        its dock, or a free point near the middle of the map (:mod:`cyborg.sim.start`). The
+        choice is in ``start_choice`` and in the log: a warning when the map names no start, so
+        ``cyborg sim`` shows it.
+        """
         self.install_map(self.prepare_map(arnl_map, start, planner))
 
     def prepare_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
                     planner: Planner | None = None) -> PreparedMap:
-        """Build everything a map needs (grids, clearance, laser, start) without touching the
-        running simulation: the slow half of :meth:`load_map`, which a caller can run without
-        holding the simulation's lock, then :meth:`install_map` under it."""
+        """Build what a map needs (grids, clearance, laser, start), leaving the simulation be.
+
+        This is the slow half of :meth:`load_map`, which a caller can run without holding the
+        simulation's lock, then :meth:`install_map` under it. Raises MapError if the map is too
+        large for the grid caps (:mod:`cyborg.nav.map_limits`).
+        """
         settings = self.settings
         world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
         planner = planner or Planner(arnl_map)
@@ -119,6 +132,7 @@ class Simulator:
 
     @property
     def pose(self) -> Pose2D:
+        """The robot's pose now, in the map frame (m, rad)."""
         return self.base.pose
 
     # ------------------------------------------------------------------ requests
@@ -172,6 +186,7 @@ class Simulator:
         return True
 
     def undock(self) -> bool:
+        """Start undocking if docked; whether the robot is undocking now."""
         if self.docking.state is not DockState.DOCKED:
             return self.docking.state is DockState.UNDOCKING
         self.battery.charging = False
@@ -191,6 +206,7 @@ class Simulator:
         self.time = self._steps * dt
 
     def run(self, seconds: float) -> None:
+        """Step through ``seconds`` of simulated time, rounded to whole physics steps."""
         for _ in range(round(seconds * self.settings.physics_rate)):
             self.step()
 

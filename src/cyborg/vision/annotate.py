@@ -167,8 +167,10 @@ def _layout(boxes: np.ndarray, thickness: int, codes: np.ndarray, ends: np.ndarr
 @njit("void(uint8[:, ::1], int64[:, ::1], int64, uint8[::1])", cache=True, nogil=True)
 def _draw_outlines(target: np.ndarray, boxes: np.ndarray, thickness: int,
                    colour: np.ndarray) -> None:  # pragma: no cover - compiled
-    """The outlines, box by box and row by row: the top and bottom edges as long runs of
-    pixels, the sides as short ones."""
+    """Draws the outlines, box by box and row by row.
+
+    The top and bottom edges are drawn as long runs of pixels, the sides as short ones.
+    """
     height, width = target.shape[0], target.shape[1] // 3
     for b in range(boxes.shape[0]):
         left, top = max(boxes[b, 0], 0), max(boxes[b, 1], 0)
@@ -196,8 +198,10 @@ def _draw(rows: np.ndarray, boxes: np.ndarray, thickness: int, colour: np.ndarra
           codes: np.ndarray, ends: np.ndarray, cells: np.ndarray, ink: np.ndarray,
           advances: np.ndarray, descents: np.ndarray, height: int, pen_x: int,
           pen_y: int) -> None:  # pragma: no cover - compiled
-    """Lays out and draws all outlines, then all labels, on ``rows`` (``height x width * 3``
-    bytes)."""
+    """Lays out and draws all outlines, then all labels, on ``rows``.
+
+    ``rows`` is the image as ``height x width * 3`` bytes.
+    """
     count = boxes.shape[0]
     outlines = np.empty((count, 4), dtype=np.int64)
     labels = np.empty((count, 4), dtype=np.int64)

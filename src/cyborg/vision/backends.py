@@ -24,11 +24,18 @@ from cyborg.vision.frames import VisionError
 
 
 class Backend(Protocol):
-    name: str
-    input_hw: tuple[int, int]
-    metadata: dict[str, str]
+    """What a detector asks of the runtime that runs its network."""
 
-    def run(self, tensor: np.ndarray) -> np.ndarray: ...
+    name: str
+    """The runtime, for messages: ``onnxruntime`` or ``opencv``."""
+    input_hw: tuple[int, int]
+    """``(height, width)`` in px of the network's input."""
+    metadata: dict[str, str]
+    """The model file's own metadata (an Ultralytics export's class names among them)."""
+
+    def run(self, tensor: np.ndarray) -> np.ndarray:
+        """The network's output for a ``1 x 3 x H x W`` float32 tensor, as one array."""
+        ...
 
 
 def _existing(path: Path, what: str) -> Path:
@@ -83,6 +90,7 @@ class OnnxRuntimeBackend:
         self.metadata = dict(self.session.get_modelmeta().custom_metadata_map)
 
     def run(self, tensor: np.ndarray) -> np.ndarray:
+        """The model's first output for a ``1 x 3 x H x W`` float32 tensor."""
         output: np.ndarray = self.session.run(self.output_names[:1],
                                               {self.input_name: tensor})[0]
         return output
@@ -124,6 +132,7 @@ class OpenCvBackend:
         self.output_layers = list(self.net.getUnconnectedOutLayersNames())
 
     def run(self, tensor: np.ndarray) -> np.ndarray:
+        """The network's output for a ``1 x 3 x H x W`` tensor; several heads' rows stacked."""
         self.net.setInput(tensor)
         outputs = self.net.forward(self.output_layers)
         if len(outputs) == 1:

@@ -14,6 +14,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.vision.frames import Frame, FrameSource, VisionError
 from cyborg.vision.image_messages import (
     compressed_to_bgr,
@@ -28,6 +30,7 @@ BAG_SUFFIXES = frozenset({".bag", ".db3", ".mcap"})
 
 
 def is_bag(path: Path) -> bool:
+    """Whether ``path`` is a bag: a ``.bag``, ``.db3`` or ``.mcap`` file, or a bag folder."""
     return (path.suffix.lower() in BAG_SUFFIXES
             or (path.is_dir() and (path / "metadata.yaml").is_file()))
 
@@ -109,6 +112,7 @@ class BagSource(FrameSource):
             topics["right"] = right
         return topics
 
+    @override
     def frames(self) -> Iterator[Frame]:
         streams = {topic: stream for stream, topic in self.topics.items()}
         pairer = ExactPairer(tuple(self.topics))
@@ -146,6 +150,7 @@ class BagSource(FrameSource):
             return compressed_to_bgr(message, where)
         return image_to_bgr(message, where)
 
+    @override
     def close(self) -> None:
         if self.reader.stack is not None:
             self.reader.close()

@@ -11,6 +11,8 @@ import queue
 from collections.abc import Iterator
 from typing import Any
 
+from typing_extensions import override
+
 from cyborg.bus import Node
 from cyborg.interfaces.detector import CAMERA_STREAMS
 from cyborg.vision.camera_topics import CameraTopics
@@ -52,6 +54,7 @@ class BusSource(FrameSource):
             self._queue.put_nowait(complete)
         return receive
 
+    @override
     def frames(self) -> Iterator[Frame]:
         while True:
             try:
@@ -69,9 +72,14 @@ class BusSource(FrameSource):
 
     @property
     def total_dropped(self) -> int:
+        """Frames dropped in all: while the consumer was busy, and unpaired by the pairer."""
         return self.dropped + self.pairer.dropped
 
     def close(self) -> None:
+        """Ends :meth:`frames` after what is queued (one frame may be dropped); any thread.
+
+        The subscriptions stay until the node is destroyed.
+        """
         try:
             self._queue.put_nowait(_END)
         except queue.Full:

@@ -85,12 +85,16 @@ class CameraInputs:
 
     @property
     def dropped(self) -> int:
-        """Messages that never became part of a frame (an image overtaken while it waited for
-        its depth map, a depth map without its image). Not counted while starved."""
+        """Messages that never became part of a frame; not counted while starved.
+
+        Such as an image overtaken while it waited for its depth map, or a depth map without
+        its image.
+        """
         return self._dropped + self.pairer.dropped
 
     @property
     def starved(self) -> bool:
+        """Whether images go out alone because the optional streams gave no pair in time."""
         return self.probe is not None
 
     def add(self, stream: str, stamp: int, message: Any) -> dict[str, Any] | None:
@@ -127,8 +131,10 @@ class CameraInputs:
 
     # ------------------------------------------------------------------ states
     def _follow_graph(self) -> None:
-        """Pair exactly the optional streams that have a publisher now (or, before the graph
-        shows one, whose messages come)."""
+        """Pairs exactly the optional streams that have a publisher now.
+
+        Before the graph shows a stream's publisher, a message of it is enough.
+        """
         published = {stream for stream in self.optional
                      if self.publishers(getattr(self.topics, stream))}
         self.shown |= published

@@ -31,13 +31,18 @@ log = logging.getLogger(__name__)
 
 IMAGE_TOPIC, RIGHT_TOPIC, DEPTH_TOPIC = IMAGE.name, RIGHT_IMAGE.name, DEPTH.name
 """The topics' names in the camera's namespace."""
+DEFAULT_RATE = 15.0
+"""Frames per second a file source is played at unless told otherwise."""
+DEFAULT_FRAME_ID = "camera_left"
+"""The images' frame unless told otherwise."""
 
 
 class CameraNode:
     """Publishes a source's frames from a thread of its own until stopped or exhausted."""
 
-    def __init__(self, node: Node, open_source: Callable[[], FrameSource], *, rate: float = 15.0,
-                 loop: bool = True, frame_id: str = "camera_left",
+    def __init__(self, node: Node, open_source: Callable[[], FrameSource], *,
+                 rate: float = DEFAULT_RATE, loop: bool = True,
+                 frame_id: str = DEFAULT_FRAME_ID,
                  now_ns: Callable[[], int] = time.time_ns) -> None:
         self.node, self.open_source = node, open_source
         self.rate, self.loop, self.frame_id, self.now_ns = rate, loop, frame_id, now_ns
@@ -53,6 +58,10 @@ class CameraNode:
                                         name=f"cyborg-camera{node.fq_name}")
 
     def start(self) -> None:
+        """Starts publishing from the camera's own thread; an unreadable source ends it.
+
+        The source's :class:`VisionError` is then logged and kept in :attr:`error`.
+        """
         self._thread.start()
 
     def _run(self) -> None:
@@ -83,18 +92,19 @@ class CameraNode:
             self.right = self._advertise(RIGHT_IMAGE)
         if depth is not None and self.depth is None:
             self.depth = self._advertise(DEPTH)
-        types, stamp = self.node.types, self.now_ns()
+        stamp = self.now_ns()
         if right is not None and self.right is not None:
-            self.right.publish(bgr_to_image(types, right, stamp, self.frame_id))
+            self.right.publish(bgr_to_image(right, stamp, self.frame_id))
         if depth is not None and self.depth is not None:
-            self.depth.publish(depth_to_image(types, depth, stamp, self.frame_id))
-        self.image.publish(bgr_to_image(types, left, stamp, self.frame_id))
+            self.depth.publish(depth_to_image(depth, stamp, self.frame_id))
+        self.image.publish(bgr_to_image(left, stamp, self.frame_id))
         self.published += 1
 
     def _advertise(self, topic: Topic) -> Publisher:
         return topic.publisher(self.node)
 
     def stop(self) -> None:
+        """Stops publishing, waiting up to 2 s for the camera's thread to end."""
         self._stop.set()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(2.0)

@@ -53,8 +53,11 @@ class StereoCalibration:
                               f"not f={self.focal_px} px, B={self.baseline_m} m")
 
     def depth_from_disparity(self, disparity: np.ndarray) -> np.ndarray:
-        """Depth in metres; NaN where the disparity is not positive or not finite (or, with a
-        negative ``doffs``, where ``d + doffs`` is not positive: no depth is negative)."""
+        """Depth in metres of a disparity map (px), NaN where it gives none.
+
+        NaN where the disparity is not positive or not finite, or, with a negative ``doffs``,
+        where ``d + doffs`` is not positive: no depth is negative.
+        """
         disparity = disparity.astype(np.float32, copy=False)
         shifted = disparity + np.float32(self.doffs_px)
         valid = np.isfinite(disparity) & (disparity > 0) & (shifted > 0)

@@ -35,6 +35,12 @@ FORMATS = {Layout.YOLOX: InputFormat(rgb=False, scale=1.0, centred=False),
            Layout.END2END: InputFormat(rgb=True, scale=1 / 255, centred=True),
            Layout.DARKNET: InputFormat(rgb=True, scale=1 / 255, centred=True)}
 """The input each family was trained on (channel order set per family, never left implicit)."""
+DEFAULT_CONFIDENCE = 0.5
+"""Detections below this confidence are dropped unless told otherwise."""
+DEFAULT_IOU = 0.45
+"""Boxes of one class that overlap more than this merge unless told otherwise."""
+DEFAULT_BACKEND = OnnxRuntimeBackend.name
+"""The runtime of ONNX models unless told otherwise."""
 
 
 @dataclass(frozen=True)
@@ -73,7 +79,8 @@ class Detector:
     """A YOLO-family detector on one backend. Thread-compatible, not thread-safe."""
 
     def __init__(self, backend: Backend, *, layout: Layout | None = None,
-                 labels: tuple[str, ...] = COCO, confidence: float = 0.5, iou: float = 0.45,
+                 labels: tuple[str, ...] = COCO, confidence: float = DEFAULT_CONFIDENCE,
+                 iou: float = DEFAULT_IOU,
                  classes: frozenset[str] = frozenset(), max_detections: int = 100,
                  model_name: str = "") -> None:
         self.backend = backend
@@ -92,9 +99,10 @@ class Detector:
         self._decode(probe, 1.1)  # a wrong layout fails here, clearly
 
     @staticmethod
-    def open(model: str | Path, *, backend: str = "onnxruntime", family: str | None = None,
+    def open(model: str | Path, *, backend: str = DEFAULT_BACKEND, family: str | None = None,
              weights: Path | None = None, labels: Path | None = None, threads: int = 0,
-             input_size: int | None = None, confidence: float = 0.5, iou: float = 0.45,
+             input_size: int | None = None, confidence: float = DEFAULT_CONFIDENCE,
+             iou: float = DEFAULT_IOU,
              classes: frozenset[str] = frozenset()) -> Detector:
         """A detector for a model (``.onnx``, or a Darknet ``.cfg`` with ``weights``).
 
@@ -188,10 +196,12 @@ def _metadata_labels(metadata: dict[str, str]) -> tuple[str, ...] | None:
 def _best_in_image(boxes: np.ndarray, scores: np.ndarray, class_ids: np.ndarray, iou: float,
                    limit: int, scale: float, offset_x: float, offset_y: float, width: float,
                    height: float) -> np.ndarray:  # pragma: no cover - compiled
-    """Suppression, then the boxes kept in image pixels, best first: ``N x 6`` rows of
-    ``x1, y1, x2, y2, score, class id``. One compiled call: right after the network has run,
-    the numpy calls this replaces (indexing, mapping, three conversions to lists) cost several
-    times their warm figure."""
+    """Suppression, then the boxes kept in image pixels, best first, as ``N x 6`` rows.
+
+    Each row is ``x1, y1, x2, y2, score, class id``. One compiled call: right after the network
+    has run, the numpy calls this replaces (indexing, mapping, three conversions to lists) cost
+    several times their warm figure.
+    """
     kept = greedy(boxes, scores, class_ids, iou, limit)
     chosen = np.empty((len(kept), 6))
     to_image(boxes, kept, scale, offset_x, offset_y, width, height, chosen)

@@ -1,5 +1,4 @@
-"""The detector node: camera frames from the bus in; predictions, detections and the annotated
-image out.
+"""The detector node: camera frames from the bus in; predictions, detections, annotated image out.
 
 Subscribes to a colour image topic and, when given, a depth topic (``32FC1`` metres or
 ``16UC1`` millimetres) and/or a right-image topic for stereo depth; streams are paired by exact
@@ -53,13 +52,16 @@ log = logging.getLogger(__name__)
 
 
 class DetectorNode:
-    """Runs a :class:`DetectionPipeline` on a node, on frames from the bus."""
+    """Runs a :class:`DetectionPipeline` on a node, on frames from the bus.
+
+    ``now_ns`` stamps the predictions (wall or simulated time); ``clock`` (monotonic seconds)
+    times the ``patience`` (s) granted to a depth publisher that yields no pair. Frames are
+    detected on the node's callback thread.
+    """
 
     def __init__(self, node: Node, pipeline: DetectionPipeline, topics: CameraTopics, *,
                  now_ns: Callable[[], int] = time.time_ns,
                  clock: Callable[[], float] = time.monotonic, patience: float = 5.0) -> None:
-        """``now_ns`` stamps the predictions (wall or simulated time); ``clock`` (monotonic
-        seconds) times the ``patience`` granted to a depth publisher that yields no pair."""
         self.node, self.pipeline, self.topics = node, pipeline, topics
         self.now_ns = now_ns
         detector = pipeline.detector
@@ -120,6 +122,7 @@ class DetectorNode:
         return receive
 
     def watched(self) -> bool:
+        """Whether any output has a subscriber; frames are skipped (and counted) while none has."""
         return any(publisher.subscription_count() > 0
                    for publisher in (self.predictions, self.detections, self.image))
 
@@ -139,11 +142,10 @@ class DetectorNode:
             return
         self.processed += 1
         self.last = result
-        types = self.node.types
-        self.predictions.publish(predictions_message(types, result.detections,
+        self.predictions.publish(predictions_message(result.detections,
                                                      image_message.header, self.now_ns()))
-        self.detections.publish(detection_array_message(types, result.detections,
+        self.detections.publish(detection_array_message(result.detections,
                                                         image_message.header))
         if result.annotated is not None:
-            self.image.publish(bgr_to_image(types, result.annotated, frame.stamp_ns,
+            self.image.publish(bgr_to_image(result.annotated, frame.stamp_ns,
                                             frame.frame_id))

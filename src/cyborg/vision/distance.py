@@ -39,12 +39,12 @@ def box_distance(depth: np.ndarray, box: tuple[float, float, float, float], *,
 
 def box_distances(depth: np.ndarray, boxes: np.ndarray, *, inner: float = 0.5,
                   samples: int = SAMPLES) -> np.ndarray:
-    """:func:`box_distance` for ``N x 4`` boxes (``x1, y1, x2, y2``) at once: ``N x 2``
-    (median metres, valid fraction).
+    """:func:`box_distance` for ``N x 4`` boxes at once: ``N x 2`` (median m, valid fraction).
 
-    One compiled pass over all boxes: called right after the network has run, when the
-    interpreter's and numpy's code and data are out of the CPU's caches, a chain of numpy calls
-    per box costs several times its warm figure, while one compiled loop does not.
+    Boxes are rows of ``x1, y1, x2, y2`` in px. One compiled pass over all boxes: called right
+    after the network has run, when the interpreter's and numpy's code and data are out of the
+    CPU's caches, a chain of numpy calls per box costs several times its warm figure, while one
+    compiled loop does not.
     """
     if depth.ndim != 2:
         raise ValueError(f"depth map must be 2-D, not {depth.ndim}-D")

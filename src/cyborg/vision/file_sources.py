@@ -25,6 +25,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from typing_extensions import override
 
 from cyborg.vision.frames import Frame, FrameSource, VisionError
 from cyborg.vision.image_files import (
@@ -39,6 +40,10 @@ DEFAULT_RATE = 30.0
 
 
 def stamp_for(path: Path, index: int, rate: float) -> int:
+    """The stamp (ns) of the file ``path``, the ``index``-th at ``rate`` frames per second.
+
+    A name that is an integer of 16 or more digits is the stamp; otherwise ``index / rate`` s.
+    """
     stem = path.stem
     if stem.isascii() and stem.isdigit() and len(stem) >= 16:
         return int(stem)
@@ -64,6 +69,7 @@ class ImageSource(FrameSource):
         self.path, self.right, self.depth, self.side_by_side = path, right, depth, side_by_side
         read_image(path)  # fail now, not in the middle of a run
 
+    @override
     def frames(self) -> Iterator[Frame]:
         left = read_image(self.path)
         right = read_image(self.right) if self.right is not None else None
@@ -82,8 +88,11 @@ def _frame(stamp: int, left: np.ndarray, right: np.ndarray | None, depth: np.nda
 
 
 def _files(folder: Path, suffixes: frozenset[str]) -> dict[str, Path]:
-    """The folder's files with one of ``suffixes``, by name without suffix (which pairs a left
-    image with its right image and depth map); two files of one name are an error."""
+    """The folder's files with one of ``suffixes``, by name without suffix.
+
+    The name pairs a left image with its right image and depth map; two files of one name are
+    an error.
+    """
     found: dict[str, Path] = {}
     for path in sorted(folder.iterdir()):
         if not (path.is_file() and path.suffix.lower() in suffixes):
@@ -126,6 +135,7 @@ class FolderSource(FrameSource):
         self.names = wanted
         self.length = len(wanted)
 
+    @override
     def frames(self) -> Iterator[Frame]:
         for index, name in enumerate(self.names):
             path = self.left[name]
@@ -194,6 +204,7 @@ class VideoSource(FrameSource):
             yield _frame(stamp, left, right, None, index, f"{self.name} frame {index}")
             index += 1
 
+    @override
     def close(self) -> None:
         self.capture.release()
         if self.right_capture is not None:

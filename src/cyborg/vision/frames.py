@@ -90,6 +90,7 @@ class FrameSource:
         self.dropped = 0
 
     def frames(self) -> Iterator[Frame]:
+        """The frames, in order; raises :class:`VisionError` on data it cannot read."""
         raise NotImplementedError
 
     def __iter__(self) -> Iterator[Frame]:

@@ -94,8 +94,10 @@ class GlyphFont:
 
 
 def encode(texts: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-    """The texts' character codes one after another (uint8; anything outside printable ASCII
-    as ``?``), and where each text ends in them (int64)."""
+    """The texts' character codes one after another (uint8), and where each text ends (int64).
+
+    Anything outside printable ASCII becomes ``?``.
+    """
     joined = "".join(texts).encode("ascii", "replace").translate(_PRINTABLE)
     return (np.frombuffer(joined, dtype=np.uint8),
             np.fromiter(accumulate(map(len, texts)), dtype=np.int64, count=len(texts)))

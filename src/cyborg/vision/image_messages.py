@@ -13,6 +13,9 @@ from typing import Any
 import cv2
 import numpy as np
 
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.sensor_msgs.msg import Image
+from cyborg.bus.msgs.std_msgs.msg import Header
 from cyborg.vision.depth import depth_in_metres
 from cyborg.vision.frames import VisionError, check_image
 
@@ -24,12 +27,16 @@ _DEPTH: dict[str, np.dtype[Any]] = {"32FC1": np.dtype("<f4"), "16UC1": np.dtype(
 
 
 def stamp_ns(header: Any) -> int:
+    """A ``std_msgs/Header``'s stamp in nanoseconds (since the epoch, or of simulated time)."""
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
 def _bytes(data: Any) -> np.ndarray:
-    """A message's ``uint8[]`` field as a flat ``uint8`` array: a numpy array (as rosbags and
-    the bus deserialise it), or ``bytes``, which ``np.asarray`` would try to parse as a number."""
+    """A message's ``uint8[]`` field as a flat ``uint8`` array.
+
+    The field is a numpy array (as rosbags and the bus deserialise it) or ``bytes``, which
+    ``np.asarray`` would try to parse as a number.
+    """
     if isinstance(data, bytes | bytearray | memoryview):
         return np.frombuffer(data, dtype=np.uint8)
     return np.asarray(data, dtype=np.uint8).reshape(-1)
@@ -85,29 +92,36 @@ def compressed_to_bgr(message: Any, topic: str = "image") -> np.ndarray:
     return image
 
 
-def header(types: Any, stamp: int, frame_id: str) -> Any:
-    time_class = types.message_class("builtin_interfaces/msg/Time")
-    return types.message_class("std_msgs/msg/Header")(
-        stamp=time_class(sec=stamp // 1_000_000_000, nanosec=stamp % 1_000_000_000),
-        frame_id=frame_id)
+def header(stamp: int, frame_id: str) -> Header:
+    """A ``std_msgs/Header`` stamped ``stamp`` (nanoseconds) in ``frame_id``."""
+    return Header(stamp=Time(sec=stamp // 1_000_000_000, nanosec=stamp % 1_000_000_000),
+                  frame_id=frame_id)
 
 
-def bgr_to_image(types: Any, image: np.ndarray, stamp: int, frame_id: str) -> Any:
-    """A ``bgr8`` ``sensor_msgs/Image`` sharing ``image``'s memory when it is contiguous."""
+def bgr_to_image(image: np.ndarray, stamp: int, frame_id: str) -> Image:
+    """A ``bgr8`` ``sensor_msgs/Image`` sharing ``image``'s memory when it is contiguous.
+
+    ``stamp`` is in nanoseconds. Raises
+    :class:`~cyborg.vision.frames.VisionError` for an image that is not BGR.
+    """
     check_image(image, "image")  # a grey image would give a message whose step lies
     pixels = np.ascontiguousarray(image)
     height, width = pixels.shape[:2]
-    return types.message_class("sensor_msgs/msg/Image")(
-        header=header(types, stamp, frame_id), height=height, width=width, encoding="bgr8",
+    return Image(
+        header=header(stamp, frame_id), height=height, width=width, encoding="bgr8",
         is_bigendian=0, step=width * 3, data=pixels.reshape(-1))
 
 
-def depth_to_image(types: Any, depth: np.ndarray, stamp: int, frame_id: str) -> Any:
-    """A ``32FC1`` ``sensor_msgs/Image`` of depth in metres."""
+def depth_to_image(depth: np.ndarray, stamp: int, frame_id: str) -> Image:
+    """A ``32FC1`` ``sensor_msgs/Image`` of depth in metres, stamped ``stamp`` (nanoseconds).
+
+    Raises :class:`~cyborg.vision.frames.VisionError` unless ``depth`` is a non-empty 2-D
+    array.
+    """
     metres = np.ascontiguousarray(depth, dtype=np.float32)
     if metres.ndim != 2 or metres.size == 0:
         raise VisionError(f"depth map must be a 2-D array in metres, not {metres.shape}")
     height, width = metres.shape
-    return types.message_class("sensor_msgs/msg/Image")(
-        header=header(types, stamp, frame_id), height=height, width=width, encoding="32FC1",
+    return Image(
+        header=header(stamp, frame_id), height=height, width=width, encoding="32FC1",
         is_bigendian=0, step=width * 4, data=metres.reshape(-1).view(np.uint8))

@@ -35,6 +35,8 @@ from cyborg.vision.frames import VisionError
 
 
 class Layout(Enum):
+    """How a network's output is laid out; see the module docstring's table."""
+
     YOLOX = "yolox"
     YOLOV5 = "yolov5"
     YOLOV8 = "yolov8"
@@ -51,6 +53,7 @@ LAYOUT_ALIASES = {"yolox": Layout.YOLOX, "yolov5": Layout.YOLOV5, "yolov6": Layo
 
 
 def layout_named(name: str) -> Layout:
+    """The layout of the family ``name`` (any case); :class:`VisionError` for an unknown one."""
     try:
         return LAYOUT_ALIASES[name.lower()]
     except KeyError:
@@ -71,6 +74,7 @@ class Candidates:
 
     @staticmethod
     def empty() -> Candidates:
+        """No candidates: arrays of length 0 of the right types."""
         return Candidates(np.zeros((0, 4), np.float32), np.zeros(0, np.float32),
                           np.zeros(0, np.int32))
 

@@ -44,9 +44,12 @@ class Letterbox:
 def to_image(boxes: np.ndarray, chosen: np.ndarray, scale: float, offset_x: float,
              offset_y: float, width: float, height: float,
              into: np.ndarray) -> None:  # pragma: no cover - compiled
-    """``x1, y1, x2, y2`` boxes ``chosen`` from network-input pixels → image pixels, clipped to
-    the image, into the first four columns of ``into``'s rows (for compiled callers, with a
-    :class:`Letterbox`'s scale and offsets and its image's size)."""
+    """Maps the ``x1, y1, x2, y2`` boxes ``chosen`` from network-input pixels to image pixels.
+
+    The boxes are clipped to the image and written into the first four columns of ``into``'s
+    rows. For compiled callers, with a :class:`Letterbox`'s scale and offsets and its image's
+    size.
+    """
     for row in range(len(chosen)):
         for column in range(4):
             offset, limit = (offset_x, width) if column % 2 == 0 else (offset_y, height)

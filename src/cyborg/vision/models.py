@@ -28,6 +28,8 @@ DEFAULT_MODEL = "yolox_nano"
 
 @dataclass(frozen=True)
 class KnownModel:
+    """A model that can be fetched by name: where from, its SHA-256 and size (bytes), licence."""
+
     name: str
     url: str
     sha256: str
@@ -38,6 +40,7 @@ class KnownModel:
 
     @property
     def filename(self) -> str:
+        """The file it is saved as in a models folder."""
         return f"{self.name}.onnx"
 
 
@@ -69,6 +72,7 @@ def model_dirs() -> list[Path]:
 
 
 def cache_dir() -> Path:
+    """The user's model cache, where fetched models go: ``$XDG_CACHE_HOME/cyborg/models``."""
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "cyborg" / "models"
 

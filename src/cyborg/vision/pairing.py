@@ -15,6 +15,8 @@ from typing import Any
 class ExactPairer:
     """Collects items of named streams; returns a complete set once every stream has a stamp.
 
+    ::
+
         pairer = ExactPairer(("image", "depth"))
         pairer.add("image", stamp, left)           # None: still waiting
         pairer.add("depth", stamp, depth)          # {"image": left, "depth": depth}

@@ -47,6 +47,7 @@ class DetectionPipeline:
         self.canvases = Canvases()
 
     def depth_of(self, frame: Frame) -> np.ndarray | None:
+        """The frame's depth map (m): its own, else from its stereo pair; None without either."""
         if frame.depth is not None:
             return frame.depth
         if frame.right is not None and self.stereo is not None:

@@ -15,6 +15,7 @@ from collections.abc import Iterator
 
 import cv2
 import numpy as np
+from typing_extensions import override
 
 from cyborg.vision.depth import StereoCalibration
 from cyborg.vision.frames import Frame, FrameSource, VisionError
@@ -63,6 +64,7 @@ class SampleSource(FrameSource):
                               "scikit-image)") from exc
         self.sample, self.name, self.length = name, f"sample:{name}", 1
 
+    @override
     def frames(self) -> Iterator[Frame]:
         if self.sample == "motorcycle":
             left, right, depth = motorcycle()

@@ -48,8 +48,10 @@ def camera_index(spec: str) -> int | None:
 
 
 def anchored(spec: str, base: Path) -> str:
-    """``spec`` with its file paths made absolute against ``base`` (both sides of a stereo
-    pair); cameras, samples and bus topics are left as they are."""
+    """``spec`` with its file paths (both sides of a stereo pair) made absolute against ``base``.
+
+    Cameras, samples and bus topics are left as they are.
+    """
     if camera_index(spec) is not None or spec.startswith(("camera:", "sample:", "bus:")):
         return spec
     return ",".join(str((base / Path(part.strip()).expanduser()).resolve())
@@ -57,8 +59,10 @@ def anchored(spec: str, base: Path) -> str:
 
 
 def open_source(spec: str, options: SourceOptions | None = None) -> FrameSource:
-    """The frame source ``spec`` names (see the module's table); ``bus:`` is opened by the
-    caller, which owns a bus node."""
+    """The frame source ``spec`` names (see the module's table); :class:`VisionError` if none.
+
+    A ``bus:`` source is opened by the caller, which owns a bus node.
+    """
     options = options or SourceOptions()
     index = camera_index(spec)
     if index is not None:

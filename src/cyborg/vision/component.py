@@ -1,4 +1,9 @@
-"""The launch kinds of the vision stack: ``camera`` and ``detector``.
+"""The camera and the detector as components: their parameters, defaults, and how they start.
+
+:func:`start_camera` and :func:`start_detector` are the ``camera`` and ``detector`` kinds of
+launch files (see :mod:`cyborg.bus.component`) and what ``cyborg up`` runs beside the robot.
+Their bus parameters are read-only, but for the detector's thresholds and classes, which
+:class:`~cyborg.vision.DetectorNode` lets change while it runs:
 
 ==============  ================================================================================
 kind            parameters (default)
@@ -16,6 +21,11 @@ kind            parameters (default)
                 ``right_topic`` (""), ``focal``/``baseline``/``doffs`` (stereo depth),
                 ``use_sim_time``
 ==============  ================================================================================
+
+The values come from where they are defined, :class:`~cyborg.vision.CameraNode`,
+:class:`~cyborg.vision.Detector`, :mod:`~cyborg.vision.models` and, for namespaces and topics,
+:mod:`cyborg.interfaces.detector`; the constants below name them for the commands that build
+specs (``cyborg up``).
 """
 
 from __future__ import annotations
@@ -24,28 +34,35 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from cyborg.app.node_spec import NodeSpec
 from cyborg.bus import Context, Node, SimClock
-from cyborg.vision import (
-    CameraNode,
-    CameraTopics,
-    DetectionPipeline,
-    Detector,
-    DetectorNode,
-    SourceOptions,
-    StereoCalibration,
-    StereoDepth,
-    VisionError,
-    open_source,
-)
-from cyborg.vision.camera_node import DEPTH_TOPIC, IMAGE_TOPIC
+from cyborg.bus.component import NodeSpec
+from cyborg.interfaces import detector as contract
+from cyborg.vision.camera_node import DEFAULT_FRAME_ID, DEFAULT_RATE, IMAGE_TOPIC, CameraNode
+from cyborg.vision.camera_topics import CameraTopics
+from cyborg.vision.depth import StereoCalibration, StereoDepth
+from cyborg.vision.detector import DEFAULT_BACKEND, Detector
+from cyborg.vision.detector_node import DetectorNode
+from cyborg.vision.frames import VisionError
 from cyborg.vision.models import DEFAULT_MODEL, find_model
-from cyborg.vision.sources import anchored
+from cyborg.vision.pipeline import DetectionPipeline
+from cyborg.vision.sources import SourceOptions, anchored, open_source
 
-DEFAULT_CAMERA = "/cyborg/camera"
+CAMERA_NAME = "camera"
+"""The camera's node name unless told otherwise."""
+CAMERA_NAMESPACE = contract.CAMERA_NAMESPACE
+"""The camera's namespace unless told otherwise (``/cyborg/camera``)."""
+CAMERA_RATE = DEFAULT_RATE
+"""Frames per second a camera plays files at unless told otherwise."""
+DETECTOR_NAME = "detector"
+"""The detector's node name unless told otherwise."""
+DETECTOR_NAMESPACE = contract.DETECTOR_NAMESPACE
+"""The detector's namespace unless told otherwise (``/cyborg/detector``)."""
+MODEL = DEFAULT_MODEL
+"""The detector's model unless told otherwise: a name looked for in the model folders."""
 
 
-def _clock(node: Node, sim_time: bool) -> Callable[[], int]:
+def _stamps(node: Node, sim_time: bool) -> Callable[[], int]:
+    """Nanosecond stamps from the wall clock, or from ``/clock`` under ``use_sim_time``."""
     if not sim_time:
         return time.time_ns
     clock = SimClock(node)
@@ -53,20 +70,25 @@ def _clock(node: Node, sim_time: bool) -> Callable[[], int]:
 
 
 class RunningCamera:
+    """A started camera: its node, playing ``source``."""
+
     def __init__(self, camera: CameraNode, source: str) -> None:
         self.camera, self.source = camera, source
 
     def describe(self) -> str:
+        """What it plays, how fast, and on which topics."""
         node = self.camera.node
         return (f"camera       {node.fq_name}: {self.source} at {self.camera.rate:g} Hz on "
                 f"{node.namespace}/{IMAGE_TOPIC} (+ right, depth when the source has them)")
 
     def stop(self) -> None:
+        """Stops playing and leaves the bus."""
         self.camera.stop()
         self.camera.node.destroy()
 
 
 def start_camera(context: Context, spec: NodeSpec) -> RunningCamera:
+    """Starts a camera from ``spec``; a source that cannot be opened refuses it."""
     node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
     try:
         params = node.parameters
@@ -74,14 +96,14 @@ def start_camera(context: Context, spec: NodeSpec) -> RunningCamera:
         if not source:
             raise spec.error("the camera needs a `source` parameter (a file, folder, video, "
                              "bag, camera:N or sample:motorcycle)")
-        rate = float(params.declare("rate", 15.0, "frames per second", read_only=True))
+        rate = float(params.declare("rate", CAMERA_RATE, "frames per second", read_only=True))
         loop = bool(params.declare("loop", True, "start again at the end", read_only=True))
         sbs = bool(params.declare("side_by_side", False, "left|right frames", read_only=True))
         depth = str(params.declare("depth", "", "depth map file of an image", read_only=True))
         right = str(params.declare("right", "", "right image file", read_only=True))
         image_topic = str(params.declare("image_topic", "", "bag image topic", read_only=True))
         depth_topic = str(params.declare("depth_topic", "", "bag depth topic", read_only=True))
-        frame_id = str(params.declare("frame_id", "camera_left", "frame of the images",
+        frame_id = str(params.declare("frame_id", DEFAULT_FRAME_ID, "frame of the images",
                                       read_only=True))
         sim_time = bool(params.declare("use_sim_time", False, "stamp with /clock",
                                        read_only=True))
@@ -95,7 +117,7 @@ def start_camera(context: Context, spec: NodeSpec) -> RunningCamera:
         except VisionError as exc:
             raise spec.error(str(exc)) from exc
         camera = CameraNode(node, lambda: open_source(spec_source, options), rate=rate,
-                            loop=loop, frame_id=frame_id, now_ns=_clock(node, sim_time))
+                            loop=loop, frame_id=frame_id, now_ns=_stamps(node, sim_time))
         camera.start()
     except BaseException:
         node.destroy()
@@ -104,10 +126,13 @@ def start_camera(context: Context, spec: NodeSpec) -> RunningCamera:
 
 
 class RunningDetector:
+    """A started detector: its node, and the model it runs."""
+
     def __init__(self, detector: DetectorNode, model: Path) -> None:
         self.detector, self.model = detector, model
 
     def describe(self) -> str:
+        """The model and its runtime, the topics it reads, and those it publishes."""
         node, detector = self.detector.node, self.detector.pipeline.detector
         inputs = ", ".join(topic for topic in (self.detector.topics.image,
                                                self.detector.topics.depth,
@@ -117,10 +142,12 @@ class RunningDetector:
                 f" .../detections, .../detection_image while subscribed")
 
     def stop(self) -> None:
+        """Leaves the bus."""
         self.detector.node.destroy()
 
 
 def start_detector(context: Context, spec: NodeSpec) -> RunningDetector:
+    """Starts a detector from ``spec``; a model that cannot be found or run refuses it."""
     node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
     try:
         params = node.parameters
@@ -128,15 +155,15 @@ def start_detector(context: Context, spec: NodeSpec) -> RunningDetector:
         def fixed(name: str, default: object, description: str) -> object:
             return params.declare(name, default, description, read_only=True)
 
-        model_name = str(fixed("model", DEFAULT_MODEL, "model file or name"))
+        model_name = str(fixed("model", MODEL, "model file or name"))
         family = str(fixed("family", "", "detector family (default: from the model)"))
-        backend = str(fixed("backend", "onnxruntime", "onnxruntime or opencv"))
+        backend = str(fixed("backend", DEFAULT_BACKEND, "onnxruntime or opencv"))
         weights = str(fixed("weights", "", "Darknet weights file"))
         labels = str(fixed("labels", "", "label file (default: COCO)"))
         threads = int(fixed("threads", 0, "inference threads (0: auto)"))  # type: ignore[call-overload]
         input_size = int(fixed("input_size", 0, "input size of dynamic models"))  # type: ignore[call-overload]
-        image_topic = str(fixed("image_topic", f"{DEFAULT_CAMERA}/{IMAGE_TOPIC}", "images"))
-        depth_topic = str(fixed("depth_topic", f"{DEFAULT_CAMERA}/{DEPTH_TOPIC}",
+        image_topic = str(fixed("image_topic", contract.DEFAULT_IMAGE_TOPIC, "images"))
+        depth_topic = str(fixed("depth_topic", contract.DEFAULT_DEPTH_TOPIC,
                                 "depth maps (empty: none)"))
         right_topic = str(fixed("right_topic", "", "right images for stereo depth"))
         focal = float(fixed("focal", 0.0, "stereo focal length, px"))  # type: ignore[arg-type]
@@ -159,7 +186,7 @@ def start_detector(context: Context, spec: NodeSpec) -> RunningDetector:
             raise spec.error("right_topic needs focal and baseline for depth from stereo")
         detector_node = DetectorNode(node, DetectionPipeline(detector, stereo=stereo),
                                      CameraTopics(image_topic, depth_topic, right_topic),
-                                     now_ns=_clock(node, sim_time))
+                                     now_ns=_stamps(node, sim_time))
     except BaseException:
         node.destroy()
         raise
