@@ -18,6 +18,8 @@ name                        type                                what
                                                                 charge, :class:`DockState`
 ``arnl_path_state``         std_msgs/String                     latched: a :class:`PathState`
 ``path``                    nav_msgs/Path                       latched: the path being followed
+``map_geometry``            cyborg_msgs/MapGeometry             latched: the map as displays draw
+                                                                it (walls, points, objects, hash)
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose;
                                                                 ends with a :class:`MoveOutcome`
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
@@ -39,7 +41,7 @@ from enum import IntEnum, StrEnum
 
 from cyborg.bus.clock import CLOCK_TOPIC
 from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal, MoveToGoal_Result
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState, MapGeometry
 from cyborg.bus.msgs.cyborg_msgs.srv import (
     AvailableGoals,
     ClosestGoal,
@@ -67,8 +69,9 @@ BUMPER_STATE = Topic("bumper_state", BumperState, latched=True)
 BATTERY_STATUS = Topic("battery_status", BatteryStatus, latched=True)
 PATH_STATE = Topic("arnl_path_state", String, latched=True)
 PATH = Topic("path", Path, latched=True)
+MAP_GEOMETRY = Topic("map_geometry", MapGeometry, latched=True)
 TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
-                             PATH)
+                             PATH, MAP_GEOMETRY)
 
 # ---------------------------------------------------------------------- services and the action
 DOCK = Service("dock", Trigger)

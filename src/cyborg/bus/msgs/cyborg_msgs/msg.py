@@ -116,6 +116,41 @@ class cyborg_msgs__msg__GoalWithHeading:
 
 
 @dataclass
+class cyborg_msgs__msg__MapGeometry:
+    """Class for cyborg_msgs/msg/MapGeometry."""
+
+    header: std_msgs__msg__Header
+    source: str
+    hash: str
+    resolution: float
+    lines: np.ndarray[tuple[int, ...], np.dtype[np.float32]]
+    points: np.ndarray[tuple[int, ...], np.dtype[np.float32]]
+    objects: list[cyborg_msgs__msg__MapObject]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/MapGeometry'
+
+
+@dataclass
+class cyborg_msgs__msg__MapObject:
+    """Class for cyborg_msgs/msg/MapObject."""
+
+    kind: str
+    category: int
+    name: str
+    description: str
+    pose: geometry_msgs__msg__Pose2D
+    outline: np.ndarray[tuple[int, ...], np.dtype[np.float32]]
+    OTHER: ClassVar[int] = 0
+    GOAL: ClassVar[int] = 1
+    GOAL_WITH_HEADING: ClassVar[int] = 2
+    DOCK: ClassVar[int] = 3
+    HOME: ClassVar[int] = 4
+    FORBIDDEN_LINE: ClassVar[int] = 5
+    FORBIDDEN_AREA: ClassVar[int] = 6
+    SIM_OBSTACLE: ClassVar[int] = 7
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/MapObject'
+
+
+@dataclass
 class cyborg_msgs__msg__Prediction:
     """Class for cyborg_msgs/msg/Prediction."""
 
@@ -143,5 +178,7 @@ BehaviorTreeNodes = cyborg_msgs__msg__BehaviorTreeNodes
 BehaviorTreeStatus = cyborg_msgs__msg__BehaviorTreeStatus
 BumperState = cyborg_msgs__msg__BumperState
 GoalWithHeading = cyborg_msgs__msg__GoalWithHeading
+MapGeometry = cyborg_msgs__msg__MapGeometry
+MapObject = cyborg_msgs__msg__MapObject
 Prediction = cyborg_msgs__msg__Prediction
 Predictions = cyborg_msgs__msg__Predictions
