@@ -19,7 +19,8 @@ name                        type                                what
 ``arnl_path_state``         std_msgs/String                     latched: a :class:`PathState`
 ``path``                    nav_msgs/Path                       latched: the path being followed
 ``map_geometry``            cyborg_msgs/MapGeometry             latched: the map as displays draw
-                                                                it (walls, points, objects, hash)
+                                                                it (walls, points, objects, hash),
+                                                                again after each map switch
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose;
                                                                 ends with a :class:`MoveOutcome`
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
@@ -72,6 +73,9 @@ PATH = Topic("path", Path, latched=True)
 MAP_GEOMETRY = Topic("map_geometry", MapGeometry, latched=True)
 TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
                              PATH, MAP_GEOMETRY)
+
+MAP_FRAME = "map"
+"""The map's frame: poses, paths and ``map_geometry`` are in it."""
 
 # ---------------------------------------------------------------------- services and the action
 DOCK = Service("dock", Trigger)

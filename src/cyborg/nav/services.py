@@ -16,10 +16,11 @@ service                          type                            answers
 ===============================  ==============================  ===============================
 
 The map can be switched while running: :class:`NavigationMap` holds the current map and its
-planner and tells listeners (the simulator) when it changes. A map that fails to load leaves the
-old one in place and the reply says why (file and line). Loading runs on its own thread, one
-map at a time, so the node's other services (the simulator's ``stop``) keep answering; only
-``.map`` files are read, so the reply never quotes some other file to a caller.
+planner and tells listeners when it changes (the simulator before the switch, the map's
+publisher, :class:`~cyborg.nav.map_message.MapPublisher`, after it). A map that fails to load
+leaves the old one in place and the reply says why (file and line). Loading runs on its own
+thread, one map at a time, so the node's other services (the simulator's ``stop``) keep
+answering; only ``.map`` files are read, so the reply never quotes some other file to a caller.
 
 Requests are checked before the handlers run: a pose with a NaN or infinite number is refused
 with ``bad request: goal.x: nan is not a finite number`` (see :func:`require_finite`).
@@ -100,19 +101,29 @@ def require_finite(message: Any, path: str = "") -> None:
 
 
 class NavigationMap:
-    """The map in use and its planner; thread-safe; ``on_change`` listeners get new maps."""
+    """The map in use and its planner; thread-safe.
+
+    Two lists of listeners follow a switch of maps (:meth:`load`): ``listeners`` take the new
+    map and its planner before the switch and may refuse it (the simulator, which must drive
+    on it), ``switched`` are told of it once it is in use (the map's publisher).
+    """
 
     def __init__(self, arnl_map: ArnlMap, planner: Planner | None = None) -> None:
         self._lock = threading.Lock()
         self.map = arnl_map
         self.planner = planner or Planner(arnl_map)
         self.listeners: list[Callable[[ArnlMap, Planner], None]] = []
+        """Run before the switch, on the loading thread; one that raises refuses the map."""
+        self.switched: list[Callable[[ArnlMap], None]] = []
+        """Run after a switch, on the loading thread, with the map now in use."""
 
     def load(self, path: str | FilePath) -> ArnlMap:
         """Read and switch to another map; MapError leaves the current one in place.
 
         Listeners (the simulator) switch first: if one refuses the map, by raising, the
-        services keep the map the simulator still drives on.
+        services keep the map the simulator still drives on. Then the map is in use and the
+        ``switched`` listeners run; one that fails is logged and the others still run, since
+        the switch itself has happened.
         """
         arnl_map = read_map(path)
         planner = Planner(arnl_map)
@@ -120,6 +131,12 @@ class NavigationMap:
             listener(arnl_map, planner)
         with self._lock:
             self.map, self.planner = arnl_map, planner
+        for switched in list(self.switched):
+            try:
+                switched(arnl_map)
+            except Exception as exc:  # the map is in use all the same
+                log.error("after switching to %s: %s: %s", arnl_map.source,
+                          type(exc).__name__, exc, exc_info=True)
         return arnl_map
 
     def plan(self, start: Pose2D, goal: Pose2D, use_heading: bool = False) -> PlanResult:

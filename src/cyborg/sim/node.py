@@ -14,6 +14,8 @@ name                        type                                what
 ``battery_status``          cyborg_msgs/BatteryStatus           latched, every simulated second
 ``arnl_path_state``         std_msgs/String                     latched, on change
 ``path``                    nav_msgs/Path                       latched: the path being followed
+``map_geometry``            cyborg_msgs/MapGeometry             latched: the map for displays, at
+                                                                the start and after each switch
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
 ``stop``
@@ -55,9 +57,10 @@ from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import Header, String
 from cyborg.bus.msgs.std_srvs.srv import Trigger, Trigger_Request, Trigger_Response
 from cyborg.interfaces import robot
-from cyborg.interfaces.robot import DockState, MoveOutcome, PathState
+from cyborg.interfaces.robot import MAP_FRAME, DockState, MoveOutcome, PathState
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
+from cyborg.nav.map_message import MapPublisher
 from cyborg.nav.planner import Planner
 from cyborg.nav.services import NavigationMap, NavigationServices
 from cyborg.sim.loop import SimulationLoop
@@ -96,6 +99,7 @@ class SimulatorNode:
         self.maps = NavigationMap(self.sim.map, self.sim.planner)
         self.maps.listeners.append(self._map_changed)
         self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
+        self.map_geometry = MapPublisher(node, self.maps, self._stamp)
         # stop, dock and undock answer on a thread of their own: a slow plan, a closest-goal
         # search or a goal being accepted never delays the stop button
         motion = node.callback_thread("motion")
@@ -169,7 +173,7 @@ class SimulatorNode:
                                   covariance=np.zeros(36))
         twist = Twist(linear=Vector3(x=float(sim.base.speed), y=0.0, z=0.0),
                       angular=Vector3(x=0.0, y=0.0, z=float(sim.base.turn_rate)))
-        return Odometry(header=self._header("map"), child_frame_id="base_link", pose=pose,
+        return Odometry(header=self._header(MAP_FRAME), child_frame_id="base_link", pose=pose,
                         twist=TwistWithCovariance(twist=twist, covariance=np.zeros(36)))
 
     def _scan(self, sim: Simulator) -> LaserScan:
