@@ -197,6 +197,7 @@ def test_names_resolve_as_the_bus_resolves_them() -> None:
     assert pose.full_name("/cyborg") == pose.full_name("cyborg/") == "/cyborg/pose"
     assert pose.full_name("/") == pose.full_name("") == "/pose"
     assert robot.CLOCK.full_name("/cyborg") == "/clock"
+    assert robot.TF_STATIC.full_name("/robot2") == "/tf_static"  # one tree of frames, as in ROS
     assert robot.MAP_GEOMETRY.full_name("/robot2") == "/robot2/map_geometry"
     assert resolve("/a/b", "c/d") == "/a/b/c/d"
     assert detector.DEFAULT_IMAGE_TOPIC == "/cyborg/camera/left/image_raw"
@@ -205,7 +206,7 @@ def test_names_resolve_as_the_bus_resolves_them() -> None:
 
 def test_qos_follows_the_contract() -> None:
     assert robot.BATTERY_STATUS.qos == Qos.latched()
-    assert robot.MAP_GEOMETRY.qos == Qos.latched()
+    assert robot.MAP_GEOMETRY.qos == robot.FOOTPRINT.qos == robot.TF_STATIC.qos == Qos.latched()
     assert robot.POSE.qos == Qos(depth=10)
     assert detector.IMAGE.qos == Qos(depth=2)
     assert detector.PREDICTIONS.qos.durability is Durability.TRANSIENT_LOCAL

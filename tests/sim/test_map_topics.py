@@ -1,5 +1,6 @@
 """What a display needs from the simulator, latched: the map (``map_geometry``, again after a
-switch), for a subscriber that comes late, in another session."""
+switch), the body (``footprint``) and where the laser sits (``/tf_static``), for a subscriber
+that comes late, in another session."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from cyborg.bus import Context, Node
@@ -17,7 +19,9 @@ from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import robot
 from cyborg.interfaces.contract import Topic
 from cyborg.nav.arnl_map import read_map
+from cyborg.nav.footprint import PIONEER_LX
 from cyborg.nav.map_message import map_geometry
+from cyborg.sim.laser import LaserSpec
 from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.simulator import Simulator
@@ -63,10 +67,13 @@ class Latest:
             return next(message for message in self.messages if accept(message))
 
 
-def test_a_late_subscriber_gets_the_map(running: tuple[Context, Simulator]) -> None:
+def test_a_late_subscriber_gets_map_footprint_and_laser_mount(
+        running: tuple[Context, Simulator]) -> None:
     there, sim = running
     node = Node("display", "/", context=there)
-    geometry = Latest(node, robot.MAP_GEOMETRY)
+    geometry, footprint, transforms, scan = (
+        Latest(node, topic) for topic in (robot.MAP_GEOMETRY, robot.FOOTPRINT, robot.TF_STATIC,
+                                          robot.SCAN))
     received: MapGeometry = geometry.wait()
     assert received.source == "AMROffice.map" and received.header.frame_id == "map"
     assert len(received.points) == 2 * len(sim.map.points) == 2 * 23_181
@@ -74,8 +81,21 @@ def test_a_late_subscriber_gets_the_map(running: tuple[Context, Simulator]) -> N
     assert len(received.objects) == len(sim.map.objects)
     assert received.hash == map_geometry(sim.map).hash
 
+    body = footprint.wait()
+    assert body.header.frame_id == robot.BASE_FRAME
+    outline = [(point.x, point.y) for point in body.polygon.points]
+    np.testing.assert_allclose(outline, PIONEER_LX.polygon(), atol=1e-6)
+
+    mount = transforms.wait().transforms
+    laser_frame = scan.wait().header.frame_id
+    assert [(item.header.frame_id, item.child_frame_id) for item in mount] == [
+        (robot.BASE_FRAME, laser_frame)]
+    translation, rotation = mount[0].transform.translation, mount[0].transform.rotation
+    assert (translation.x, translation.y, translation.z) == (LaserSpec().mount_x, 0.0, 0.0)
+    assert (rotation.x, rotation.y, rotation.z, rotation.w) == (0.0, 0.0, 0.0, 1.0)
+
     graph = there.graph
-    for name in ("/robot7/map_geometry",):
+    for name in ("/robot7/map_geometry", "/robot7/footprint", "/tf_static"):
         publishers = [entity for entity in graph.entities([EntityKind.PUBLISHER])
                       if entity.topic == name]
         assert [entity.latched for entity in publishers] == [True], name

@@ -21,6 +21,10 @@ name                        type                                what
 ``map_geometry``            cyborg_msgs/MapGeometry             latched: the map as displays draw
                                                                 it (walls, points, objects, hash),
                                                                 again after each map switch
+``footprint``               geometry_msgs/PolygonStamped        latched: the robot's outline,
+                                                                frame ``base_link``
+``/tf_static``              tf2_msgs/TFMessage                  latched: ``base_link`` → ``laser``
+                                                                (the scan's frame), as ROS does
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose;
                                                                 ends with a :class:`MoveOutcome`
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
@@ -50,12 +54,13 @@ from cyborg.bus.msgs.cyborg_msgs.srv import (
     LoadMapFile,
     MakePlan,
 )
-from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Odometry, Path
 from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.msgs.std_srvs.srv import Trigger
+from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 from cyborg.interfaces.contract import Action, Service, Topic
 
 NAMESPACE = "/cyborg"
@@ -71,9 +76,16 @@ BATTERY_STATUS = Topic("battery_status", BatteryStatus, latched=True)
 PATH_STATE = Topic("arnl_path_state", String, latched=True)
 PATH = Topic("path", Path, latched=True)
 MAP_GEOMETRY = Topic("map_geometry", MapGeometry, latched=True)
+FOOTPRINT = Topic("footprint", PolygonStamped, latched=True)
+TF_STATIC = Topic("/tf_static", TFMessage, latched=True)
+"""Fixed transforms between the robot's frames; absolute and latched, as in ROS 2."""
 TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
-                             PATH, MAP_GEOMETRY)
+                             PATH, MAP_GEOMETRY, FOOTPRINT, TF_STATIC)
 
+BASE_FRAME = "base_link"
+"""The robot's frame: x forward, y left, origin on the drive axle."""
+LASER_FRAME = "laser"
+"""The laser scanner's frame: the ``scan``'s ``frame_id``, a child of :data:`BASE_FRAME`."""
 MAP_FRAME = "map"
 """The map's frame: poses, paths and ``map_geometry`` are in it."""
 

@@ -16,6 +16,8 @@ name                        type                                what
 ``path``                    nav_msgs/Path                       latched: the path being followed
 ``map_geometry``            cyborg_msgs/MapGeometry             latched: the map for displays, at
                                                                 the start and after each switch
+``footprint``               geometry_msgs/PolygonStamped        latched: the body's outline
+``/tf_static``              tf2_msgs/TFMessage                  latched: base_link → laser
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
 ``stop``
@@ -46,7 +48,13 @@ from cyborg.bus.msgs.cyborg_msgs.action import (
 )
 from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState
 from cyborg.bus.msgs.geometry_msgs.msg import (
+    Point32,
+    Polygon,
+    PolygonStamped,
     PoseWithCovariance,
+    Quaternion,
+    Transform,
+    TransformStamped,
     Twist,
     TwistWithCovariance,
     Vector3,
@@ -56,8 +64,16 @@ from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import Header, String
 from cyborg.bus.msgs.std_srvs.srv import Trigger, Trigger_Request, Trigger_Response
+from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 from cyborg.interfaces import robot
-from cyborg.interfaces.robot import MAP_FRAME, DockState, MoveOutcome, PathState
+from cyborg.interfaces.robot import (
+    BASE_FRAME,
+    LASER_FRAME,
+    MAP_FRAME,
+    DockState,
+    MoveOutcome,
+    PathState,
+)
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.map_message import MapPublisher
@@ -100,6 +116,10 @@ class SimulatorNode:
         self.maps.listeners.append(self._map_changed)
         self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
         self.map_geometry = MapPublisher(node, self.maps, self._stamp)
+        self.footprint = robot.FOOTPRINT.publisher(node)
+        self.footprint.publish(self._footprint())
+        self.tf_static = robot.TF_STATIC.publisher(node)
+        self.tf_static.publish(self._transforms())
         # stop, dock and undock answer on a thread of their own: a slow plan, a closest-goal
         # search or a goal being accepted never delays the stop button
         motion = node.callback_thread("motion")
@@ -144,7 +164,7 @@ class SimulatorNode:
         if state != self._last_state:
             self._last_state = state
             self.bumpers.publish(BumperState(
-                header=self._header("base_link"), front_bumpers=np.array([state[0]]),
+                header=self._header(BASE_FRAME), front_bumpers=np.array([state[0]]),
                 rear_bumpers=np.array([state[1]])))
             self.path_state.publish(String(data=state[2].value))
         follower = sim.navigator.follower
@@ -163,7 +183,7 @@ class SimulatorNode:
     def _publish_battery(self, sim: Simulator) -> None:
         battery = sim.battery
         self.battery.publish(BatteryStatus(
-            header=self._header("base_link"), charging_state=int(battery.state),
+            header=self._header(BASE_FRAME), charging_state=int(battery.state),
             charge_percent=battery.charge_percent, voltage=battery.voltage,
             charging=battery.charging, dock_state=sim.docking.state.value))
 
@@ -173,18 +193,33 @@ class SimulatorNode:
                                   covariance=np.zeros(36))
         twist = Twist(linear=Vector3(x=float(sim.base.speed), y=0.0, z=0.0),
                       angular=Vector3(x=0.0, y=0.0, z=float(sim.base.turn_rate)))
-        return Odometry(header=self._header(MAP_FRAME), child_frame_id="base_link", pose=pose,
+        return Odometry(header=self._header(MAP_FRAME), child_frame_id=BASE_FRAME, pose=pose,
                         twist=TwistWithCovariance(twist=twist, covariance=np.zeros(36)))
 
     def _scan(self, sim: Simulator) -> LaserScan:
         spec = sim.laser.spec
         return LaserScan(
-            header=self._header("laser"), angle_min=spec.angle_min,
+            header=self._header(LASER_FRAME), angle_min=spec.angle_min,
             angle_max=spec.angle_min + spec.angle_increment * (spec.beams - 1),
             angle_increment=spec.angle_increment, time_increment=0.0,
             scan_time=1.0 / sim.settings.sensor_rate, range_min=spec.range_min,
             range_max=spec.range_max, ranges=sim.ranges.astype(np.float32),
             intensities=np.zeros(0, np.float32))
+
+    def _footprint(self) -> PolygonStamped:
+        """The body's outline in its own frame (it never changes)."""
+        corners = [Point32(x=float(x), y=float(y), z=0.0)
+                   for x, y in self.sim.base.footprint.polygon()]
+        return PolygonStamped(header=self._header(BASE_FRAME), polygon=Polygon(points=corners))
+
+    def _transforms(self) -> TFMessage:
+        """Where the laser sits on the robot: ``mount_x`` ahead of the axle, facing forward."""
+        mount = TransformStamped(
+            header=self._header(BASE_FRAME), child_frame_id=LASER_FRAME,
+            transform=Transform(
+                translation=Vector3(x=float(self.sim.laser.spec.mount_x), y=0.0, z=0.0),
+                rotation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)))
+        return TFMessage(transforms=[mount])
 
     def _map_changed(self, arnl_map: ArnlMap, planner: Planner) -> None:
         """Switch the simulation to a new map (``load_map_file``, on the loading thread).
