@@ -1,0 +1,96 @@
+"""Helpers for the map data path's tests: a robot's messages built by hand (pose, scan, path,
+battery, map geometry), and a fake robot that publishes them on a bus."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from cyborg.bus import Node
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry, MapObject
+from cyborg.bus.msgs.geometry_msgs.msg import Point, Pose, Pose2D, PoseStamped, Quaternion
+from cyborg.bus.msgs.nav_msgs.msg import Path
+from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
+from cyborg.bus.msgs.std_msgs.msg import Header, String
+from cyborg.interfaces import robot
+
+BEAMS = 541
+INCREMENT = math.radians(0.5)
+
+
+def header(frame: str = "map") -> Header:
+    return Header(stamp=Time(sec=0, nanosec=0), frame_id=frame)
+
+
+def pose(x: float = 1.0, y: float = 2.0, theta: float = 0.5) -> Pose2D:
+    return Pose2D(x=x, y=y, theta=theta)
+
+
+def scan(ranges: Sequence[float] | np.ndarray | None = None, *, beams: int = BEAMS,
+         angle_min: float = -math.radians(135), increment: float = INCREMENT,
+         angle_max: float | None = None, range_min: float = 0.1,
+         range_max: float = 30.0) -> LaserScan:
+    """A scan of ``beams`` beams (all 5 m unless ``ranges`` says otherwise)."""
+    values = np.full(beams, 5.0, np.float32) if ranges is None else np.asarray(ranges,
+                                                                               np.float32)
+    if angle_max is None:
+        angle_max = angle_min + increment * (beams - 1)
+    return LaserScan(header=header("laser"), angle_min=angle_min, angle_max=angle_max,
+                     angle_increment=increment, time_increment=0.0, scan_time=0.1,
+                     range_min=range_min, range_max=range_max, ranges=values,
+                     intensities=np.zeros(0, np.float32))
+
+
+def path(points: Sequence[tuple[float, float]]) -> Path:
+    return Path(header=header(), poses=[
+        PoseStamped(header=header(), pose=Pose(position=Point(x=x, y=y, z=0.0),
+                                               orientation=Quaternion(x=0.0, y=0.0, z=0.0,
+                                                                      w=1.0)))
+        for x, y in points])
+
+
+def battery(charge: float = 80.0, dock: str = "UNDOCKED") -> BatteryStatus:
+    return BatteryStatus(header=header("base_link"), charging_state=0, charge_percent=charge,
+                         voltage=25.0, charging=False, dock_state=dock)
+
+
+def map_object(name: str = "Office", category: int = MapObject.GOAL, kind: str = "Goal",
+               at: tuple[float, float, float] = (1.0, 2.0, 0.0),
+               outline: Sequence[float] = ()) -> MapObject:
+    return MapObject(kind=kind, category=category, name=name, description="",
+                     pose=Pose2D(x=at[0], y=at[1], theta=at[2]),
+                     outline=np.asarray(outline, np.float32))
+
+
+def map_geometry(lines: Sequence[float] | np.ndarray = (0.0, 0.0, 10.0, 0.0, 10.0, 0.0, 10.0,
+                                                        5.0),
+                 points: Sequence[float] | np.ndarray = (1.0, 1.0, 2.5, 3.0, -1.0, 4.0),
+                 objects: Sequence[MapObject] | None = None, source: str = "small.map",
+                 hash_: str = "sha256:feed") -> MapGeometry:
+    """A small map: two walls, three points, a goal and a forbidden area (unless told)."""
+    if objects is None:
+        objects = [map_object(), map_object("no go", MapObject.FORBIDDEN_AREA, "ForbiddenArea",
+                                            (5.0, 1.0, 0.0),
+                                            (4.0, 0.0, 6.0, 0.0, 6.0, 2.0, 4.0, 2.0))]
+    return MapGeometry(header=header(), source=source, hash=hash_, resolution=0.05,
+                       lines=np.asarray(lines, np.float32),
+                       points=np.asarray(points, np.float32), objects=list(objects))
+
+
+class FakeMapRobot:
+    """Publishes a robot's topics under ``namespace`` on ``node``'s bus, by hand."""
+
+    def __init__(self, node: Node, namespace: str = "/robot1") -> None:
+        self.node, self.namespace = node, namespace
+        self.pose = robot.POSE.publisher(node, namespace)
+        self.scan = robot.SCAN.publisher(node, namespace)
+        self.path = robot.PATH.publisher(node, namespace)
+        self.path_state = robot.PATH_STATE.publisher(node, namespace)
+        self.battery = robot.BATTERY_STATUS.publisher(node, namespace)
+        self.map = robot.MAP_GEOMETRY.publisher(node, namespace)
+
+    def state(self, text: str) -> None:
+        self.path_state.publish(String(data=text))
