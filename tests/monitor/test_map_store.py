@@ -1,7 +1,7 @@
-"""Robots' maps as the page fetches them (cyborg.monitor.map_store): the blob's layout read back
-as the page reads it, maps the monitor will not draw refused whole with a warning, keys computed
-by the monitor (a forged hash changes nothing), and a bounded store that keeps the maps robots
-use."""
+"""Robots' maps as the page fetches them (cyborg.monitor.map_store, map_route): the blob's layout
+read back as the page reads it, maps the monitor will not draw refused whole with a warning,
+keys computed by the monitor (a forged hash changes nothing), a bounded store that keeps the
+maps robots use, and GET /api/map/{key} with immutable caching, ETag and 304, gzip and 404."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from cyborg.bus.msgs.cyborg_msgs.msg import MapObject
+from cyborg.monitor.map_route import CACHE_CONTROL, accepts_gzip, matches_etag
 from cyborg.monitor.map_store import (
     FORMAT,
     MAGIC,
@@ -24,6 +25,8 @@ from cyborg.monitor.map_store import (
     map_blob,
     map_key,
 )
+from cyborg.monitor.server import create_app
+from tests.monitor.monitor_protocol import bare_hub, local_client
 from tests.monitor.robot_messages import map_geometry, map_object
 
 
@@ -133,6 +136,49 @@ def test_the_store_keeps_a_bounded_number_of_bytes() -> None:
     second, _ = store.put(map_geometry(points=(2.0, 0.0)))
     assert first is not None and second is not None
     assert first.key not in store and second.key in store, "the newest stays, even over"
+
+
+# ---------------------------------------------------------------------------------- the route
+def test_the_map_route_caches_for_good_answers_304_and_gzips() -> None:
+    hub = bare_hub()
+    stored, _ = hub.robot_hub.store.put(map_geometry())
+    assert stored is not None
+    with local_client(create_app(hub)) as client:
+        plain = client.get(stored.url, headers={"accept-encoding": "identity"})
+        assert plain.status_code == 200
+        assert plain.headers["cache-control"] == CACHE_CONTROL
+        assert plain.headers["etag"] == f'"{stored.key}"'
+        assert plain.headers["content-type"] == "application/octet-stream"
+        assert "content-encoding" not in plain.headers
+        assert map_key(plain.content) == stored.key
+        zipped = client.get(stored.url, headers={"accept-encoding": "gzip, deflate"})
+        assert zipped.headers["content-encoding"] == "gzip"
+        assert zipped.content == plain.content, "the client unzips what it accepted"
+        assert int(zipped.headers["content-length"]) == len(stored.gzipped)
+        again = client.get(stored.url, headers={"if-none-match": f'"{stored.key}"'})
+        assert again.status_code == 304 and again.content == b""
+        assert again.headers["etag"] == f'"{stored.key}"'
+        assert client.get("/stats").json()["map_fetches"] == 2, "a 304 fetches nothing"
+        for missing in ("0" * 32, "nothex", "0" * 31 + "g", stored.key.upper()):
+            answer = client.get(f"/api/map/{missing}")
+            assert answer.status_code == 404 and "no such map" in answer.json()["error"]
+        assert client.get("/api/map/../../etc/passwd").status_code == 404
+
+
+def test_the_map_route_is_behind_the_host_guard() -> None:
+    hub = bare_hub()
+    stored, _ = hub.robot_hub.store.put(map_geometry())
+    assert stored is not None
+    with local_client(create_app(hub), base_url="http://rebind.attacker.example:8080") as client:
+        assert client.get(stored.url).status_code == 403
+
+
+def test_accept_encoding_and_if_none_match_are_read_as_http_says() -> None:
+    assert accepts_gzip("gzip") and accepts_gzip("deflate, gzip;q=0.5") and accepts_gzip("*")
+    assert not accepts_gzip(None) and not accepts_gzip("gzip;q=0") and not accepts_gzip("br")
+    assert not accepts_gzip("gzip;q=zero")
+    assert matches_etag('"a", W/"b"', '"b"') and matches_etag("*", '"x"')
+    assert not matches_etag('"a"', '"b"') and not matches_etag(None, '"b"')
 
 
 def test_a_stored_blob_is_the_gzip_of_what_is_served() -> None:

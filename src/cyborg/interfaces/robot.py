@@ -106,6 +106,18 @@ NAVIGATION_SERVICES: tuple[Service, ...] = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, C
 
 MOVE_TO_GOAL = Action("move_to_goal", MoveToGoal)
 
+def robot_namespace(topic: str, type_name: str) -> str | None:
+    """The namespace of the robot that publishes ``topic`` of ``type_name``, or None.
+
+    Robots are found by their pose (``/robot1/pose`` of type Pose2D → ``/robot1``); any other
+    topic names none. ``type_name`` is the topic's type as the bus graph shows it.
+    """
+    suffix = "/" + POSE.name
+    if type_name != POSE.type_name or not topic.endswith(suffix):
+        return None
+    return topic.removesuffix(suffix) or "/"
+
+
 # ---------------------------------------------------------------------- values in the messages
 
 

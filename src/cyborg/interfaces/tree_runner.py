@@ -101,3 +101,18 @@ def runner_namespace(topic: str, type_name: str) -> str | None:
     if type_name != STRUCTURE.type_name or not topic.endswith(suffix):
         return None
     return topic.removesuffix(suffix) or "/"
+
+
+RUNNER_UNDER_ROBOT = "/bt"
+"""Where a robot's tree runner lives under the robot's namespace (``/cyborg`` → ``/cyborg/bt``),
+as ``cyborg up`` places it (``app.launch.under_robot``)."""
+
+
+def robot_of_runner(namespace: str) -> str | None:
+    """The namespace of the robot that the tree runner under ``namespace`` drives, or None.
+
+    By the convention of :data:`RUNNER_UNDER_ROBOT`: ``/robot1/bt`` → ``/robot1``; a runner
+    elsewhere names no robot.
+    """
+    robot = namespace.removesuffix(RUNNER_UNDER_ROBOT)
+    return robot if robot != namespace and robot else None

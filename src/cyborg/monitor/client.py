@@ -41,6 +41,8 @@ class Client:
         the structure it draws, so any other tree, even one it was sent before, is sent
         again; deltas go only to a page that shows their tree."""
         self.asked: set[str] = set()
+        self.map_view = False
+        """The page shows the map: it gets the robots' state (:mod:`cyborg.monitor.robot_hub`)."""
         """Namespaces no runner was in that this page watched (capped per connection)."""
         limits = limits or Limits()
         self.bucket = Bucket(limits.rate, limits.burst)

@@ -18,6 +18,8 @@ enable       on                                          run (true) or pause (fa
 control      id, action, status, once, keep              hook a node (see ControlNode.srv)
 step         —                                           at a breakpoint: on to the next node
 resume       —                                           at a breakpoint: go on
+map          on                                          show the map (true) or not: the
+                                                         robots' state (robot_hub.py)
 ping         —                                           answered with pong (for latency)
 ===========  ==========================================  =====================================
 
@@ -145,6 +147,10 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
     elif kind == "release":
         if hub.seat.release(client.number):
             hub.announce_seat()
+    elif kind == "map":
+        if not isinstance(command.get("on"), bool):
+            raise CommandError("map: on must be true or false", "on")
+        hub.robot_hub.view(client, command["on"])
     elif kind == "ping":
         client.send({"t": "pong", "req": request})
     else:

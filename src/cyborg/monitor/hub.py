@@ -22,6 +22,7 @@ bus ever waits for a browser.
   was started with it (*pinned*) or while its runner is on the bus; when the runner has left
   and the last page watching it has gone, it is freed with everything kept for it. Watching a
   namespace no runner is in subscribes to nothing. Connections are counted per address.
+* **Robots and their maps**, for pages that show the map: :attr:`Hub.robot_hub`.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import Limits, check_namespace
+from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import ControlError, TreeSource
 
@@ -82,6 +84,8 @@ class Hub:
         self._numbers = itertools.count(1)
         self._warned_limit = False
         self.frames = 0
+        self.robot_hub = RobotHub(self.clients, self.sources,
+                                  lambda: self.broadcast(self.robots()))
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
@@ -149,7 +153,8 @@ class Hub:
         return {"t": "robots", "robots": [source.describe() for source in
                                           sorted(self.sources.values(),
                                                  key=lambda source: source.namespace)],
-                "seat": self.seat.holder.client if self.seat.holder else None}
+                "seat": self.seat.holder.client if self.seat.holder else None,
+                "map_robots": self.robot_hub.describe()}
 
     # ------------------------------------------------------------------ from the bus
     def notify(self, namespace: str, what: str) -> None:
@@ -253,11 +258,13 @@ class Hub:
         client.shown = None
         if client.watching is not None:
             self.send_tree(client, client.watching)
+        self.robot_hub.resend(client)
 
     # ------------------------------------------------------------------ clients
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         """Binds the hub to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
+        self.robot_hub.attach(loop)
 
     def refusal(self, host: str | None) -> str | None:
         """Why one more connection from ``host`` is refused, or None when it is not."""
@@ -330,6 +337,7 @@ class Hub:
             changed = self._release(namespace) or changed
         if changed:
             self.broadcast(self.robots())
+        await self.robot_hub.periodic()
         watched = {client.watching for client in self.clients if client.watching}
         for namespace in watched:
             source = self.sources.get(namespace)

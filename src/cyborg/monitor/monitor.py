@@ -31,10 +31,11 @@ import uvicorn
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
-from cyborg.interfaces import tree_runner
+from cyborg.interfaces import robot, tree_runner
 from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
+from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.server import create_app
 from cyborg.monitor.source import TreeSource
@@ -74,6 +75,7 @@ class Monitor:
                        seat=ControlSeat(read_token(token)), limits=limits)
         for namespace in namespaces:
             self.hub.follow(namespace, pinned=True)
+        self.hub.robot_hub.use(self._make_robot, self.discover_robots)
         names = [*allow_hosts, host] if host not in EVERY_INTERFACE else list(allow_hosts)
         self.hosts = HostPolicy(names)
         self.app = create_app(self.hub, hosts=self.hosts)
@@ -87,6 +89,15 @@ class Monitor:
     def discover(self) -> list[str]:
         """Namespaces of the tree runners on the bus (found by their structure topic)."""
         found = {tree_runner.runner_namespace(entity.topic, entity.type_name)
+                 for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
+        return sorted(namespace for namespace in found if namespace is not None)
+
+    def _make_robot(self, namespace: str) -> RobotSource:
+        return RobotSource(self.node, namespace, self.hub.robot_hub.notify)
+
+    def discover_robots(self) -> list[str]:
+        """Namespaces of the robots on the bus (found by their pose topic)."""
+        found = {robot.robot_namespace(entity.topic, entity.type_name)
                  for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
         return sorted(namespace for namespace in found if namespace is not None)
 
@@ -156,6 +167,7 @@ class Monitor:
             self._thread = None
         for source in list(self.hub.sources.values()):
             source.destroy()
+        self.hub.robot_hub.destroy()
         self.node.destroy()
 
     def __enter__(self) -> Monitor:

@@ -7,6 +7,7 @@ route                           what
 ``GET /static/...``             its scripts, styles and the vendored d3-hierarchy
 ``WS /ws``                      live updates and commands (:mod:`cyborg.monitor.commands`)
 ``GET /api/robots``             the trees the monitor follows, as JSON
+``GET /api/map/{key}``          a robot's map as a binary blob (:mod:`cyborg.monitor.map_route`)
 ``POST /api/export``            ``{"ns", "format": dot|svg|png, "collapsed": [ids]}`` → file
 ``GET /stats``                  counters, for health checks and benchmarks
 ==============================  ===============================================================
@@ -40,6 +41,7 @@ from cyborg.monitor.commands import located_error, receive
 from cyborg.monitor.export import ExportError, render, view_dot
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import BODY_LIMIT, MessageError, check_namespace, decode
+from cyborg.monitor.map_route import map_endpoint
 from cyborg.monitor.page_files import PageSource, page_files
 from cyborg.monitor.seat import is_loopback
 
@@ -84,7 +86,8 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
     async def stats(_request: Request) -> Response:
         return JSONResponse({"clients": len(hub.clients), "frames": hub.frames,
                              "trees": sorted(hub.sources),
-                             "dropped": sum(client.dropped for client in hub.clients)})
+                             "dropped": sum(client.dropped for client in hub.clients),
+                             "map_fetches": hub.robot_hub.store.fetches})
 
     async def export(request: Request) -> Response:
         origin = request.headers.get("origin")
@@ -160,6 +163,7 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
     routes = [
         Route("/", page),
         Route("/api/robots", robots),
+        Route("/api/map/{key}", map_endpoint(hub.robot_hub.store)),
         Route("/api/export", export, methods=["POST"]),
         Route("/stats", stats),
         WebSocketRoute("/ws", websocket),

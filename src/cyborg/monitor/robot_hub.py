@@ -1,0 +1,334 @@
+"""The map's switchboard: robots on the bus on one side, pages that show the map on the other.
+
+Owned by :class:`~cyborg.monitor.hub.Hub`; everything here runs on the web server's event loop
+except :meth:`RobotHub.notify`, which the bus calls from its threads.
+
+* **Robots** are found by their pose topic (:func:`cyborg.interfaces.robot.robot_namespace`)
+  and followed by one :class:`~cyborg.monitor.robot_source.RobotSource` each, at most
+  :data:`ROBOT_LIMIT` at once (a robot that left makes room for a new one). A robot is paired
+  with the tree runner that drives it by the namespace convention
+  (:func:`cyborg.interfaces.tree_runner.robot_of_runner`).
+* **Pages opt in** with ``{"t": "map", "on": true}``; the rest of this goes only to them. A page
+  that opts in gets, per robot, its ``map_ref``, its ``path``, an ``rs`` and its warnings.
+* **Robot state** goes out as ``rs``, throttled per robot on the leading edge: at once when
+  :data:`RS_INTERVAL` has passed since that robot's last one, else then. A 10 Hz robot passes
+  unchanged, the simulator's 30 Hz becomes about 12 Hz. An ``rs`` carries the pose, and the
+  scan when a new one came; the path state, battery and the current path's id when known.
+* **Paths** go out as ``path`` when a new one comes, at most one per :data:`PATH_INTERVAL` per
+  robot; **maps** are laid out and gzipped in a worker thread (:mod:`cyborg.monitor.map_store`)
+  and announced as ``map_ref`` (``key`` null when the robot's map was refused).
+* **Warnings** about a robot's messages go out as ``robot_warn``, at most one per second per
+  kind, with how often it happened.
+
+Every text is encoded once per message (:func:`~cyborg.monitor.robot_wire.wire_text`) and
+queued to every page that shows the map.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import time
+from collections.abc import Callable, Collection, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from cyborg.interfaces.tree_runner import robot_of_runner
+from cyborg.monitor.client import Client
+from cyborg.monitor.limits import check_namespace
+from cyborg.monitor.map_store import MapStore, StoredMap
+from cyborg.monitor.robot_source import RobotSource
+from cyborg.monitor.robot_wire import wire_text
+
+log = logging.getLogger("cyborg.monitor")
+
+ROBOT_LIMIT = 16
+"""Most robots the monitor follows at once."""
+RS_INTERVAL = 0.08
+"""Shortest time between two ``rs`` messages of one robot (s)."""
+PATH_INTERVAL = 0.5
+"""Shortest time between two ``path`` messages of one robot (s)."""
+RS_KINDS = frozenset({"pose", "scan", "state", "battery"})
+"""Changes that an ``rs`` message tells."""
+
+
+@dataclass
+class _Robot:
+    """What the hub keeps about one followed robot."""
+
+    source: RobotSource
+    seq: int = 0
+    last: float = -float("inf")
+    """When the robot's changes were last sent (monotonic s)."""
+    path_sent: int = 0
+    """The path id last sent to the pages."""
+    path_at: float = -float("inf")
+    path_later: bool = False
+    map: StoredMap | None = None
+    building: bool = False
+
+
+class RobotHub:
+    """Connects :class:`RobotSource` objects to the pages that show the map.
+
+    ``clients`` and ``trees`` are the hub's own (its connected pages, the tree sources it
+    follows by namespace), ``changed`` broadcasts the ``robots`` list; robots are made and found
+    by the functions given to :meth:`use` (none until then).
+    """
+
+    def __init__(self, clients: Collection[Client], trees: Mapping[str, object],
+                 changed: Callable[[], None], store: MapStore | None = None) -> None:
+        self._clients, self._trees, self._changed = clients, trees, changed
+        self.store = store or MapStore()
+        self.robots: dict[str, _Robot] = {}
+        self._make: Callable[[str], RobotSource] | None = None
+        self._discover: Callable[[], list[str]] = list
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._pending: set[str] = set()
+        self._tasks: set[asyncio.Task[None]] = set()
+        self._warned_limit = False
+
+    def use(self, make_source: Callable[[str], RobotSource],
+            discover: Callable[[], list[str]]) -> None:
+        """Follows robots from now on, with these two functions.
+
+        ``discover()`` lists the robots' namespaces on the bus, ``make_source(namespace)``
+        follows one.
+        """
+        self._make, self._discover = make_source, discover
+
+    def attach(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Binds the hub to the server's event loop; :meth:`notify` drops changes until then."""
+        self._loop = loop
+
+    # ------------------------------------------------------------------ robots
+    async def periodic(self) -> None:
+        """Follows robots that appeared, and sends warnings that waited; from the hub's loop.
+
+        Never raises: a failure is logged, and the hub's other periodic work goes on.
+        """
+        try:
+            if self._make is not None:
+                changed = False
+                for namespace in await asyncio.to_thread(self._discover):
+                    changed = self._found(namespace) or changed
+                if changed:
+                    self._changed()
+            for robot in list(self.robots.values()):
+                if robot.source.warnings.pending():
+                    self._send_warnings(robot, self._viewers())
+        except Exception:
+            log.exception("monitor: could not look for robots")
+
+    def _found(self, namespace: str) -> bool:
+        if namespace in self.robots or self._make is None:
+            return False
+        try:
+            namespace = check_namespace(namespace)
+        except ValueError:
+            return False  # a root or otherwise odd namespace: not one a page can name
+        if len(self.robots) >= ROBOT_LIMIT:
+            gone = next((name for name, robot in sorted(self.robots.items())
+                         if not robot.source.alive), None)
+            if gone is None:
+                if not self._warned_limit:
+                    log.warning("more than %d robots on the bus: the map shows the first",
+                                ROBOT_LIMIT)
+                    self._warned_limit = True
+                return False
+            self._release(gone)
+        self.robots[namespace] = _Robot(self._make(namespace))
+        self._request(namespace)  # what arrived while the source was being made
+        return True
+
+    def _release(self, namespace: str) -> None:
+        robot = self.robots.pop(namespace, None)
+        self._pending.discard(namespace)
+        if robot is not None:
+            try:
+                robot.source.destroy()
+            except Exception:
+                log.exception("could not stop following robot %s", namespace)
+
+    def describe(self) -> list[dict[str, Any]]:
+        """The robots for the ``robots`` message: namespace, paired tree, alive, map key."""
+        return [{"ns": namespace, "tree": self._tree_of(namespace),
+                 "alive": robot.source.alive, "map": robot.map.key if robot.map else None}
+                for namespace, robot in sorted(self.robots.items())]
+
+    def _tree_of(self, namespace: str) -> str | None:
+        return next((tree for tree in sorted(self._trees)
+                     if robot_of_runner(tree) == namespace), None)
+
+    def destroy(self) -> None:
+        """Stops following every robot."""
+        for namespace in list(self.robots):
+            self._release(namespace)
+
+    # ------------------------------------------------------------------ from the bus
+    def notify(self, namespace: str, _what: str) -> None:
+        """Called from any thread when something changed for the robot under ``namespace``."""
+        loop = self._loop
+        if loop is None or loop.is_closed() or namespace in self._pending:
+            return
+        self._pending.add(namespace)
+        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
+            loop.call_soon_threadsafe(self._wake, namespace)
+
+    def _request(self, namespace: str) -> None:
+        """:meth:`notify` from the loop itself."""
+        if namespace not in self._pending:
+            self._pending.add(namespace)
+            self._wake(namespace)
+
+    def _wake(self, namespace: str) -> None:
+        robot = self.robots.get(namespace)
+        if robot is None or self._loop is None:
+            self._pending.discard(namespace)
+            return
+        delay = robot.last + RS_INTERVAL - time.monotonic()
+        if delay > 0:
+            self._loop.call_later(delay, self._flush, namespace)
+        else:
+            self._flush(namespace)
+
+    def _flush(self, namespace: str) -> None:
+        self._pending.discard(namespace)
+        robot = self.robots.get(namespace)
+        if robot is None:
+            return
+        try:
+            self._send_changes(robot)
+        except Exception:
+            log.exception("monitor: could not send the state of robot %s", namespace)
+
+    def _send_changes(self, robot: _Robot) -> None:
+        source = robot.source
+        now = robot.last = time.monotonic()
+        changes = source.take_changes()
+        if "map" in changes:
+            self._build(robot)
+        if "alive" in changes:
+            self._changed()
+        viewers = self._viewers()
+        path_id = source.path_id
+        if path_id != robot.path_sent:
+            wait = robot.path_at + PATH_INTERVAL - now
+            if not viewers or wait <= 0:
+                robot.path_sent, robot.path_at = path_id, now
+                self._send(viewers, self._path_message(robot))
+                changes.add("path")
+            elif not robot.path_later and self._loop is not None:
+                robot.path_later = True
+                self._loop.call_later(wait, self._path_due, source.namespace)
+        if viewers and changes & (RS_KINDS | {"path"}):
+            self._send(viewers, self._rs_message(robot, scan="scan" in changes))
+        if "warn" in changes:
+            self._send_warnings(robot, viewers)
+
+    def _path_due(self, namespace: str) -> None:
+        robot = self.robots.get(namespace)
+        if robot is not None:
+            robot.path_later = False
+            self._request(namespace)
+
+    def _build(self, robot: _Robot) -> None:
+        if robot.building or self._loop is None:
+            return  # the build under way takes the newest message when it is done
+        robot.building = True
+        task = self._loop.create_task(self._build_maps(robot))
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+
+    async def _build_maps(self, robot: _Robot) -> None:
+        source = robot.source
+        try:
+            while (message := source.take_map()) is not None:
+                in_use = {other.map.key for other in self.robots.values() if other.map}
+                stored, warnings = await asyncio.to_thread(self.store.put, message, in_use)
+                for warning in warnings:
+                    source.warn("map", warning)
+                if self.robots.get(source.namespace) is not robot:
+                    return  # released meanwhile
+                if (stored.key if stored else None) != (robot.map.key if robot.map else None):
+                    robot.map = stored
+                    self._send(self._viewers(), self._map_ref(robot))
+                    self._changed()
+        except Exception:
+            log.exception("monitor: could not keep the map of robot %s", source.namespace)
+        finally:
+            robot.building = False
+
+    # ------------------------------------------------------------------ to pages
+    def _viewers(self) -> list[Client]:
+        return [client for client in self._clients if client.map_view]
+
+    @staticmethod
+    def _send(clients: list[Client], message: dict[str, Any] | None) -> None:
+        if message is None or not clients:
+            return
+        text = wire_text(message)
+        for client in clients:
+            client.send(text)
+
+    def _send_warnings(self, robot: _Robot, viewers: list[Client]) -> None:
+        for kind, message, count in robot.source.warnings.due():
+            self._send(viewers, {"t": "robot_warn", "ns": robot.source.namespace,
+                                 "kind": kind, "message": message, "count": count})
+
+    def view(self, client: Client, on: bool) -> None:
+        """Makes ``client`` show the map (``on``) or not; a page that starts gets everything."""
+        was, client.map_view = client.map_view, on
+        if on and not was:
+            self.resend(client)
+
+    def resend(self, client: Client) -> None:
+        """Sends ``client``, if it shows the map, every robot's map, path, state and warnings."""
+        if not client.map_view:
+            return
+        for robot in [robot for _name, robot in sorted(self.robots.items())]:
+            source = robot.source
+            if robot.map is not None:
+                self._send([client], self._map_ref(robot))
+            if source.path is not None:
+                self._send([client], self._path_message(robot))
+            self._send([client], self._rs_message(robot, scan=True))
+            for kind, message, count in source.warnings.latest():
+                self._send([client], {"t": "robot_warn", "ns": source.namespace,
+                                      "kind": kind, "message": message, "count": count})
+
+    @staticmethod
+    def _map_ref(robot: _Robot) -> dict[str, Any]:
+        stored = robot.map
+        return {"t": "map_ref", "ns": robot.source.namespace,
+                "key": stored.key if stored else None, "url": stored.url if stored else None,
+                "source": stored.source if stored else None,
+                "counts": stored.counts if stored else None}
+
+    @staticmethod
+    def _path_message(robot: _Robot) -> dict[str, Any] | None:
+        path = robot.source.path
+        if path is None:
+            return None
+        return {"t": "path", "ns": robot.source.namespace, "id": path["id"], "xy": path["xy"]}
+
+    @staticmethod
+    def _rs_message(robot: _Robot, *, scan: bool) -> dict[str, Any] | None:
+        source = robot.source
+        pose = source.pose
+        if pose is None:
+            return None  # nothing to place the rest on yet
+        robot.seq += 1
+        message: dict[str, Any] = {"t": "rs", "ns": source.namespace, "seq": robot.seq,
+                                   "p": pose}
+        if scan and source.scan is not None:
+            message["sc"] = source.scan
+        if source.state is not None:
+            message["st"] = source.state
+        if source.battery is not None:
+            message["bat"] = source.battery
+        path = source.path
+        if path is not None:
+            message["pid"] = path["id"]
+        return message

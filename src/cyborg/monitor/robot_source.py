@@ -1,0 +1,237 @@
+"""One robot, followed over the bus for the page's map: its topics in, checked, the latest kept.
+
+A :class:`RobotSource` subscribes, under the robot's namespace (``/cyborg`` by default; the
+names are those of :mod:`cyborg.interfaces.robot`), to ``pose``, ``scan``, ``path``,
+``arnl_path_state``, ``battery_status`` and ``map_geometry``. Its bus callbacks run on the
+monitor node's thread and only check, store and notify: each message goes through its function
+in :mod:`cyborg.monitor.robot_wire`, the result replaces the one kept (a message that cannot be
+drawn leaves it as it was), any warning goes to the robot's :class:`WarningLog`, and the
+listener hears ``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``, ``"state"``,
+``"battery"``, ``"map"``, ``"warn"``, ``"alive"``). The map is kept as the message itself:
+laying it out and compressing it is the hub's work, off the bus thread
+(:mod:`cyborg.monitor.map_store`).
+
+Liveness comes from the bus graph: the robot is alive while something publishes its pose.
+
+The robot's footprint and the laser's mount (``tf_static``) join here once they are contracts
+of :mod:`cyborg.interfaces.robot`; until then the page draws the scan from the robot's centre.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from cyborg.bus import Node, Qos, Subscription
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry
+from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.nav_msgs.msg import Path
+from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
+from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.bus.wire import EntityKind
+from cyborg.interfaces import robot
+from cyborg.monitor.robot_wire import (
+    Warnings,
+    battery_wire,
+    path_wire,
+    pose_wire,
+    scan_wire,
+    state_wire,
+)
+
+log = logging.getLogger("cyborg.monitor")
+
+Listener = Callable[[str, str], None]
+"""``listener(namespace, what)``."""
+
+WARNING_INTERVAL = 1.0
+"""Shortest time between two warnings of one kind about one robot sent to the pages (s)."""
+
+
+@dataclass
+class _Warning:
+    message: str
+    count: int
+    told: int = 0
+    """The count the pages were last told."""
+    told_at: float = -float("inf")
+
+
+class WarningLog:
+    """One robot's warnings by kind: the latest text of each, how often, what pages were told.
+
+    Safe to use from several threads: the bus thread adds, the web server's loop reads.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._kinds: dict[str, _Warning] = {}
+
+    def add(self, kind: str, message: str) -> None:
+        """Counts one more warning of ``kind``; ``message`` becomes its latest text."""
+        with self._lock:
+            found = self._kinds.get(kind)
+            if found is None:
+                self._kinds[kind] = _Warning(message, 1)
+            else:
+                found.message, found.count = message, found.count + 1
+
+    def due(self, now: float | None = None) -> list[tuple[str, str, int]]:
+        """``(kind, message, count)`` of each kind the pages should hear of now; marks them told.
+
+        A kind is due when it happened since the pages were last told, and that was at least
+        :data:`WARNING_INTERVAL` s ago.
+        """
+        now = time.monotonic() if now is None else now
+        due = []
+        with self._lock:
+            for kind, warning in self._kinds.items():
+                if warning.count > warning.told and now - warning.told_at >= WARNING_INTERVAL:
+                    warning.told, warning.told_at = warning.count, now
+                    due.append((kind, warning.message, warning.count))
+        return due
+
+    def pending(self) -> bool:
+        """Whether some warning has not been told yet (it may not be due yet)."""
+        with self._lock:
+            return any(warning.count > warning.told for warning in self._kinds.values())
+
+    def latest(self) -> list[tuple[str, str, int]]:
+        """``(kind, message, count)`` of every kind so far, for a page that starts to look."""
+        with self._lock:
+            return [(kind, warning.message, warning.count)
+                    for kind, warning in self._kinds.items()]
+
+
+class RobotSource:
+    """Follows the robot under ``namespace``; see the module docstring."""
+
+    def __init__(self, node: Node, namespace: str, listener: Listener) -> None:
+        self.node, self.namespace = node, "/" + namespace.strip("/")
+        self._listener = listener
+        self.pose: list[float] | None = None
+        """The last good pose, ``[x, y, θ]`` (see :func:`~robot_wire.pose_wire`)."""
+        self.scan: dict[str, Any] | None = None
+        self.path: dict[str, Any] | None = None
+        """The latest path, ``{"id", "xy"}``: ``id`` counts the path messages (from 1), the
+        page's name for the path it has."""
+        self.state: str | None = None
+        """``arnl_path_state``'s text."""
+        self.battery: dict[str, Any] | None = None
+        self.warnings = WarningLog()
+        self.alive = False
+        self._map: MapGeometry | None = None
+        self._changes: set[str] = set()
+        self._lock = threading.Lock()
+        ns = self.namespace
+        fresh = Qos(depth=2)  # the newest pose and scan are all that matter
+        self._subscriptions: list[Subscription[Any]] = [
+            robot.POSE.subscription(node, self._on_pose, ns, qos=fresh),
+            robot.SCAN.subscription(node, self._on_scan, ns, qos=fresh),
+            robot.PATH.subscription(node, self._on_path, ns),
+            robot.PATH_STATE.subscription(node, self._on_state, ns),
+            robot.BATTERY_STATUS.subscription(node, self._on_battery, ns),
+            robot.MAP_GEOMETRY.subscription(node, self._on_map, ns),
+        ]
+        self._remove_graph_listener = node.context.graph.on_change(self._check_alive)
+        self._check_alive()
+
+    # ------------------------------------------------------------------ topics in
+    def _on_pose(self, message: Pose2D) -> None:
+        pose, warnings = pose_wire(message)
+        self._warn("pose", warnings)
+        if pose is not None:
+            self.pose = pose
+            self._mark("pose")
+
+    def _on_scan(self, message: LaserScan) -> None:
+        scan, warnings = scan_wire(message)
+        self._warn("scan", warnings)
+        if scan is not None:
+            self.scan = scan
+            self._mark("scan")
+
+    def _on_path(self, message: Path) -> None:
+        path, warnings = path_wire(message)
+        self._warn("path", warnings)
+        self.path = {"id": self.path_id + 1, **path}
+        self._mark("path")
+
+    def _on_state(self, message: String) -> None:
+        state, warnings = state_wire(message.data)
+        self._warn("state", warnings)
+        self.state = state
+        self._mark("state")
+
+    def _on_battery(self, message: BatteryStatus) -> None:
+        battery, warnings = battery_wire(message)
+        self._warn("battery", warnings)
+        if battery is not None:
+            self.battery = battery
+            self._mark("battery")
+
+    def _on_map(self, message: MapGeometry) -> None:
+        with self._lock:
+            self._map = message
+        self._mark("map")
+
+    def _check_alive(self) -> None:
+        alive = self.node.context.graph.count(robot.POSE.full_name(self.namespace),
+                                              EntityKind.PUBLISHER) > 0
+        if alive != self.alive:
+            self.alive = alive
+            self._mark("alive")
+
+    # ------------------------------------------------------------------ to the hub
+    @property
+    def path_id(self) -> int:
+        """The latest path's id; 0 before the first."""
+        path = self.path
+        return int(path["id"]) if path is not None else 0
+
+    def _warn(self, kind: str, warnings: Warnings) -> None:
+        for message in warnings:
+            self.warn(kind, message)
+
+    def warn(self, kind: str, message: str) -> None:
+        """Records a warning about this robot (from any thread) and tells the listener."""
+        self.warnings.add(kind, message)
+        self._mark("warn")
+
+    def _mark(self, what: str) -> None:
+        with self._lock:
+            self._changes.add(what)
+        try:
+            self._listener(self.namespace, what)
+        except Exception:
+            log.exception("monitor listener failed on %s %s", self.namespace, what)
+
+    def take_changes(self) -> set[str]:
+        """What changed since the last call (the kinds the listener heard of)."""
+        with self._lock:
+            changes, self._changes = self._changes, set()
+        return changes
+
+    def take_map(self) -> MapGeometry | None:
+        """The map message received since the last call, or None; the source lets go of it."""
+        with self._lock:
+            message, self._map = self._map, None
+        return message
+
+    def destroy(self) -> None:
+        """Withdraws the subscriptions; the listener hears nothing more."""
+        self._remove_graph_listener()
+        for subscription in self._subscriptions:
+            subscription.destroy()
+        self._subscriptions = []
+        self._listener = _ignore
+        with self._lock:
+            self._map = None
+
+
+def _ignore(_namespace: str, _what: str) -> None:
+    """The listener of a source that was destroyed."""
