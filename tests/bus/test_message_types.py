@@ -106,7 +106,7 @@ def test_cyborg_msgs_are_registered(types: MessageTypes) -> None:
                  "Prediction", "Predictions", "BatteryStatus", "BehaviorTreeHooks"):
         assert f"cyborg_msgs/msg/{name}" in types
     for name in ("AvailableGoals", "ClosestGoal", "DistanceToGoal", "MakePlan", "LoadMapFile",
-                 "ControlNode", "ReloadTree", "GetBlackboard"):
+                 "ControlNode", "ReloadTree", "GetBlackboard", "SetPose"):
         assert f"cyborg_msgs/srv/{name}" in types.services
         assert f"cyborg_msgs/srv/{name}_Request" in types
         assert f"cyborg_msgs/srv/{name}_Event" in types

@@ -98,6 +98,17 @@ def assert_serves(graph: Graph, server: str, namespace: str, topics: Iterable[To
             f"{server} does not serve {service}"
 
 
+def assert_subscribes(graph: Graph, node_name: str, namespace: str,
+                      topics: Iterable[Topic]) -> None:
+    """Node ``node_name`` subscribes to each of ``topics`` as the contract says."""
+    used = {(entity.topic, entity.type_name): entity
+            for entity in endpoints(graph, node_name, [EntityKind.SUBSCRIPTION])}
+    for topic in topics:
+        entity = used.get((topic.full_name(namespace), topic.type_name))
+        assert entity is not None, f"{node_name} does not subscribe to {topic}"
+        assert entity.latched == topic.latched, topic
+
+
 # ---------------------------------------------------------------------- the robot
 BUS_ROBOT_ENDPOINTS = 13
 """pose and battery_status, six services, and move_to_goal's three services and two topics."""
@@ -109,7 +120,9 @@ def test_the_simulator_serves_everything_bus_robot_uses(bus: Context, shared: Pa
     graph = bus.graph
     contract = contract_names(robot.NAMESPACE, robot.TOPICS, robot.SERVICES, [robot.MOVE_TO_GOAL])
     settle(graph, lambda: len(endpoints(graph, "/cyborg/bt", USING)) >= BUS_ROBOT_ENDPOINTS
-           and len(endpoints(graph, "/cyborg/arnl", SERVING)) >= len(contract))
+           and len(endpoints(graph, "/cyborg/arnl", SERVING)) >= len(contract)
+           and len(endpoints(graph, "/cyborg/arnl", [EntityKind.SUBSCRIPTION]))
+           >= len(robot.COMMANDS))
 
     used = assert_client_is_served(graph, "/cyborg/bt", "/cyborg/arnl")
     assert used <= contract
@@ -117,6 +130,9 @@ def test_the_simulator_serves_everything_bus_robot_uses(bus: Context, shared: Pa
     assert_serves(graph, "/cyborg/arnl", robot.NAMESPACE, robot.TOPICS, robot.SERVICES)
     served = {entity.topic for entity in endpoints(graph, "/cyborg/arnl", SERVING)}
     assert served == contract, "the simulator serves something its contract does not name"
+    assert_subscribes(graph, "/cyborg/arnl", robot.NAMESPACE, robot.COMMANDS)
+    commands = {topic.full_name(robot.NAMESPACE) for topic in robot.COMMANDS}
+    assert commands == {"/cyborg/cmd_vel", "/initialpose"}
 
 
 def test_bus_robot_follows_the_robot_under_another_namespace(bus: Context, shared: Path) -> None:
@@ -198,6 +214,8 @@ def test_names_resolve_as_the_bus_resolves_them() -> None:
     assert pose.full_name("/") == pose.full_name("") == "/pose"
     assert robot.CLOCK.full_name("/cyborg") == "/clock"
     assert robot.TF_STATIC.full_name("/robot2") == "/tf_static"  # one tree of frames, as in ROS
+    assert robot.INITIAL_POSE.full_name("/robot2") == "/initialpose"  # where RViz publishes it
+    assert robot.CMD_VEL.full_name("/robot2") == "/robot2/cmd_vel"
     assert robot.MAP_GEOMETRY.full_name("/robot2") == "/robot2/map_geometry"
     assert resolve("/a/b", "c/d") == "/a/b/c/d"
     assert detector.DEFAULT_IMAGE_TOPIC == "/cyborg/camera/left/image_raw"
@@ -208,6 +226,8 @@ def test_qos_follows_the_contract() -> None:
     assert robot.BATTERY_STATUS.qos == Qos.latched()
     assert robot.MAP_GEOMETRY.qos == robot.FOOTPRINT.qos == robot.TF_STATIC.qos == Qos.latched()
     assert robot.POSE.qos == Qos(depth=10)
+    assert robot.CMD_VEL.qos == Qos(depth=1)  # only the newest command matters
+    assert robot.CURRENT_GOAL.qos == Qos.latched()
     assert detector.IMAGE.qos == Qos(depth=2)
     assert detector.PREDICTIONS.qos.durability is Durability.TRANSIENT_LOCAL
     action, service = robot.MOVE_TO_GOAL, robot.MAKE_PLAN
@@ -221,8 +241,8 @@ def test_qos_follows_the_contract() -> None:
 def test_every_type_in_the_contracts_is_known() -> None:
     """The classes the descriptors carry are the bus's own, under the names the graph shows."""
     types = MessageTypes()
-    for topic in (*robot.TOPICS, *tree_runner.TOPICS, *detector.CAMERA_STREAMS.values(),
-                  *detector.DETECTOR_TOPICS):
+    for topic in (*robot.TOPICS, *robot.COMMANDS, *tree_runner.TOPICS,
+                  *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS):
         assert types.message_class(topic.type_name) is topic.message_type, topic
     for service in (*robot.SERVICES, *tree_runner.SERVICES):
         assert service.type_name in types.services, service

@@ -18,6 +18,10 @@ name                        type                                what
                                                                 charge, :class:`DockState`
 ``arnl_path_state``         std_msgs/String                     latched: a :class:`PathState`
 ``path``                    nav_msgs/Path                       latched: the path being followed
+``current_goal``            cyborg_msgs/GoalWithHeading         latched: the goal being driven to
+                                                                (a pose goal named by its
+                                                                coordinates); an empty name when
+                                                                there is none
 ``map_geometry``            cyborg_msgs/MapGeometry             latched: the map as displays draw
                                                                 it (walls, points, objects, hash),
                                                                 again after each map switch
@@ -29,12 +33,24 @@ name                        type                                what
                                                                 ends with a :class:`MoveOutcome`
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
 ``stop``
+``set_pose``                cyborg_msgs/srv/SetPose             relocalise (the simulator
+                                                                teleports); cancels the goal
+``cmd_vel`` (subscribed)    geometry_msgs/Twist                 drive by hand: cancels the goal;
+                                                                clamped to :data:`TELEOP_MAX_SPEED`
+                                                                and :data:`TELEOP_MAX_TURN_RATE`;
+                                                                stops :data:`TELEOP_TIMEOUT` after
+                                                                the last command
+``/initialpose``            geometry_msgs/                      as ``set_pose``, from RViz's and
+(subscribed)                PoseWithCovarianceStamped           Foxglove's pose estimate tool
 ``nav/get_available_goals`` cyborg_msgs/srv/AvailableGoals      the map's named goals
 ``nav/get_distance_to_goal`` cyborg_msgs/srv/DistanceToGoal     planned path length to a pose
 ``nav/get_closest_goal``    cyborg_msgs/srv/ClosestGoal         nearest goal by path length
 ``make_plan``               cyborg_msgs/srv/MakePlan            a path on the static map
 ``load_map_file``           cyborg_msgs/srv/LoadMapFile         switch maps at runtime
 ==========================  ==================================  ==================================
+
+The robot publishes the topics and serves the services; it subscribes to the
+:data:`COMMANDS` (``cmd_vel``, ``/initialpose``), which others publish to act on it.
 
 The enums' values come from the message definitions where those declare them
 (BatteryStatus.msg, MoveToGoal.action); ARNL's path states exist only here.
@@ -46,15 +62,26 @@ from enum import IntEnum, StrEnum
 
 from cyborg.bus.clock import CLOCK_TOPIC
 from cyborg.bus.msgs.cyborg_msgs.action import MoveToGoal, MoveToGoal_Result
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState, MapGeometry
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BatteryStatus,
+    BumperState,
+    GoalWithHeading,
+    MapGeometry,
+)
 from cyborg.bus.msgs.cyborg_msgs.srv import (
     AvailableGoals,
     ClosestGoal,
     DistanceToGoal,
     LoadMapFile,
     MakePlan,
+    SetPose,
 )
-from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
+from cyborg.bus.msgs.geometry_msgs.msg import (
+    PolygonStamped,
+    Pose2D,
+    PoseWithCovarianceStamped,
+    Twist,
+)
 from cyborg.bus.msgs.nav_msgs.msg import Odometry, Path
 from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
@@ -75,12 +102,47 @@ BUMPER_STATE = Topic("bumper_state", BumperState, latched=True)
 BATTERY_STATUS = Topic("battery_status", BatteryStatus, latched=True)
 PATH_STATE = Topic("arnl_path_state", String, latched=True)
 PATH = Topic("path", Path, latched=True)
+CURRENT_GOAL = Topic("current_goal", GoalWithHeading, latched=True)
+"""rosarnl's ``current_goal``: the goal the navigator drives to, while it does.
+
+Its ``name`` is the map goal's name, or for a pose goal the pose's coordinates as
+``(x, y)`` in metres; ``position`` is where it leads, ``has_heading`` whether the robot turns
+to ``position.theta`` on arrival, ``comment`` the goal's description from the map. When the
+goal ends (reached, failed, cancelled, preempted) the topic says so with an empty ``name``."""
 MAP_GEOMETRY = Topic("map_geometry", MapGeometry, latched=True)
 FOOTPRINT = Topic("footprint", PolygonStamped, latched=True)
 TF_STATIC = Topic("/tf_static", TFMessage, latched=True)
 """Fixed transforms between the robot's frames; absolute and latched, as in ROS 2."""
 TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
-                             PATH, MAP_GEOMETRY, FOOTPRINT, TF_STATIC)
+                             PATH, CURRENT_GOAL, MAP_GEOMETRY, FOOTPRINT, TF_STATIC)
+"""The topics the robot publishes."""
+
+CMD_VEL = Topic("cmd_vel", Twist, depth=1)
+"""Drive by hand: ``linear.x`` (m/s, forward) and ``angular.z`` (rad/s, counter-clockwise).
+
+Each command cancels the goal (and docking) and holds until the next one; a zero twist stops
+the robot. Speeds are clamped to :data:`TELEOP_MAX_SPEED` and :data:`TELEOP_MAX_TURN_RATE`; a
+twist holding a NaN or an infinity is ignored. The robot never drives into what it knows
+(walls, its laser's returns): it slows and stops instead. It stops by itself
+:data:`TELEOP_TIMEOUT` wall-clock seconds after the last command, so a sender sends again
+(10 Hz) while the robot should move. Depth 1: only the newest command matters."""
+INITIAL_POSE = Topic("/initialpose", PoseWithCovarianceStamped)
+"""Relocalise, as RViz's "2D Pose Estimate" and Foxglove's pose estimate publish it: absolute,
+in the ``map`` frame (an empty ``frame_id`` counts as ``map``), the heading from the
+quaternion, the covariance ignored. The same as :data:`SET_POSE`; refusals are logged."""
+COMMANDS: tuple[Topic, ...] = (CMD_VEL, INITIAL_POSE)
+"""The topics the robot subscribes to: others publish them to act on it."""
+
+TELEOP_MAX_SPEED = 0.5
+"""The fastest a ``cmd_vel`` command drives the robot, m/s (forwards or backwards)."""
+TELEOP_MAX_TURN_RATE = 1.0
+"""The fastest a ``cmd_vel`` command turns the robot, rad/s."""
+TELEOP_TIMEOUT = 0.5
+"""Wall-clock seconds after the last ``cmd_vel`` command at which the robot stops (deadman).
+
+Wall clock, not simulated time: the commands come from a person at the pace of the wall
+clock, and a simulation running 30 times faster would otherwise stop the robot between two
+of a 10 Hz sender's commands (MobileEyes' ratioDrive waits 2 s the same way)."""
 
 BASE_FRAME = "base_link"
 """The robot's frame: x forward, y left, origin on the drive axle."""
@@ -98,8 +160,14 @@ DISTANCE_TO_GOAL = Service("nav/get_distance_to_goal", DistanceToGoal)
 CLOSEST_GOAL = Service("nav/get_closest_goal", ClosestGoal)
 MAKE_PLAN = Service("make_plan", MakePlan)
 LOAD_MAP_FILE = Service("load_map_file", LoadMapFile)
+SET_POSE = Service("set_pose", SetPose)
+"""Relocalise: the robot stands at ``pose`` (the simulator teleports it there, standing still).
+
+Any goal, docking and driving by hand end first. Refused (``success`` false, ``message``
+saying why, nothing changed) when the pose is not finite, off the map, or when the body there
+would overlap a wall, an obstacle or a forbidden area or line."""
 SERVICES: tuple[Service, ...] = (DOCK, UNDOCK, STOP, AVAILABLE_GOALS, DISTANCE_TO_GOAL,
-                                  CLOSEST_GOAL, MAKE_PLAN, LOAD_MAP_FILE)
+                                  CLOSEST_GOAL, MAKE_PLAN, LOAD_MAP_FILE, SET_POSE)
 NAVIGATION_SERVICES: tuple[Service, ...] = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, CLOSEST_GOAL,
                                              MAKE_PLAN, LOAD_MAP_FILE)
 """The services of :mod:`cyborg.nav.services`, answered on the map in use."""

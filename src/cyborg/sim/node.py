@@ -14,6 +14,8 @@ name                        type                                what
 ``battery_status``          cyborg_msgs/BatteryStatus           latched, every simulated second
 ``arnl_path_state``         std_msgs/String                     latched, on change
 ``path``                    nav_msgs/Path                       latched: the path being followed
+``current_goal``            cyborg_msgs/GoalWithHeading         latched: the goal driven to, or
+                                                                an empty name
 ``map_geometry``            cyborg_msgs/MapGeometry             latched: the map for displays, at
                                                                 the start and after each switch
 ``footprint``               geometry_msgs/PolygonStamped        latched: the body's outline
@@ -21,12 +23,17 @@ name                        type                                what
 ``move_to_goal``            cyborg_msgs/action/MoveToGoal       drive to a goal name or a pose
 ``dock``, ``undock``,       std_srvs/Trigger                    docking; ``stop`` cancels the goal
 ``stop``
+``set_pose``                cyborg_msgs/srv/SetPose             teleport the robot
+``cmd_vel`` (subscribed)    geometry_msgs/Twist                 drive by hand, with a deadman
+``/initialpose``            geometry_msgs/                      teleport the robot (RViz)
+(subscribed)                PoseWithCovarianceStamped
 ==========================  ==================================  ==================================
 
 plus the navigation services of :mod:`cyborg.nav.services` (goals, distances, make_plan,
 load_map_file), answered on the simulator's own map. Sensor topics are published at most
 ``max_publish_rate`` times per wall-clock second, so a simulation running hundreds of times
 faster than real time does not flood the bus; ``/clock`` follows every sensor step.
+``set_pose``, ``cmd_vel`` and ``/initialpose`` are :class:`~cyborg.sim.manual_node.ManualControl`'s.
 """
 
 from __future__ import annotations
@@ -34,6 +41,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -46,7 +54,7 @@ from cyborg.bus.msgs.cyborg_msgs.action import (
     MoveToGoal_Goal,
     MoveToGoal_Result,
 )
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, BumperState, GoalWithHeading
 from cyborg.bus.msgs.geometry_msgs.msg import (
     Point32,
     Polygon,
@@ -80,7 +88,8 @@ from cyborg.nav.map_message import MapPublisher
 from cyborg.nav.planner import Planner
 from cyborg.nav.services import NavigationMap, NavigationServices
 from cyborg.sim.loop import SimulationLoop
-from cyborg.sim.simulator import Simulator
+from cyborg.sim.manual_node import ManualControl
+from cyborg.sim.simulator import Simulator, Target
 
 SUCCEEDED, FAILED, CANCELED, NO_PATH = (int(MoveOutcome.SUCCEEDED), int(MoveOutcome.FAILED),
                                        int(MoveOutcome.CANCELED), int(MoveOutcome.NO_PATH))
@@ -90,9 +99,14 @@ FEEDBACK_PERIOD = 0.25
 
 
 class SimulatorNode:
-    """Publishes a running simulation and serves its actions and services."""
+    """Publishes a running simulation and serves its actions and services.
 
-    def __init__(self, node: Node, loop: SimulationLoop, max_publish_rate: float = 30.0) -> None:
+    ``clock`` gives wall-clock seconds (for the ``cmd_vel`` deadman); ``initial_pose``: whether
+    to follow ``/initialpose`` (see :class:`~cyborg.sim.manual_node.ManualControl`).
+    """
+
+    def __init__(self, node: Node, loop: SimulationLoop, max_publish_rate: float = 30.0, *,
+                 clock: Callable[[], float] = time.monotonic, initial_pose: bool = True) -> None:
         self.node, self.loop, self.sim = node, loop, loop.simulator
         self._min_period = 1.0 / max_publish_rate
         self._published_at = 0.0
@@ -100,6 +114,8 @@ class SimulatorNode:
         self._battery_at = -math.inf
         self._path_shown: object = None
         self._goal_generation = 0
+        self._preempted_by = ""
+        self._goal_shown: Target | None = None
         self._stepped = threading.Condition()  # notified after every sensor step
         self._newest_goal = 0
         self._active_goal: ServerGoal[MoveToGoal_Goal, MoveToGoal_Feedback] | None = None
@@ -112,6 +128,8 @@ class SimulatorNode:
         self.battery = robot.BATTERY_STATUS.publisher(node)
         self.path_state = robot.PATH_STATE.publisher(node)
         self.path = robot.PATH.publisher(node)
+        self.current_goal = robot.CURRENT_GOAL.publisher(node)
+        self.current_goal.publish(self._goal_message(None))
         self.maps = NavigationMap(self.sim.map, self.sim.planner)
         self.maps.listeners.append(self._map_changed)
         self.services = NavigationServices(node, self.maps, lambda: self.sim.pose)
@@ -120,12 +138,14 @@ class SimulatorNode:
         self.footprint.publish(self._footprint())
         self.tf_static = robot.TF_STATIC.publisher(node)
         self.tf_static.publish(self._transforms())
-        # stop, dock and undock answer on a thread of their own: a slow plan, a closest-goal
-        # search or a goal being accepted never delays the stop button
+        # stop, dock, undock, set_pose and cmd_vel are handled on a thread of their own: a slow
+        # plan, a closest-goal search or a goal being accepted never delays the stop button
         motion = node.callback_thread("motion")
         robot.DOCK.server(node, self._dock, callbacks=motion)
         robot.UNDOCK.server(node, self._undock, callbacks=motion)
         robot.STOP.server(node, self._stop, callbacks=motion)
+        self.manual = ManualControl(node, loop, self._preempt, motion, clock=clock,
+                                    initial_pose=initial_pose)
         robot.MOVE_TO_GOAL.server(node, self._move)
         loop.on_sensor.append(self._publish)
 
@@ -167,6 +187,10 @@ class SimulatorNode:
                 header=self._header(BASE_FRAME), front_bumpers=np.array([state[0]]),
                 rear_bumpers=np.array([state[1]])))
             self.path_state.publish(String(data=state[2].value))
+        goal = sim.current_goal
+        if goal is not self._goal_shown:
+            self._goal_shown = goal
+            self.current_goal.publish(self._goal_message(goal))
         follower = sim.navigator.follower
         if follower is not None and follower.path is not self._path_shown:
             self._path_shown = follower.path
@@ -206,6 +230,17 @@ class SimulatorNode:
             range_max=spec.range_max, ranges=sim.ranges.astype(np.float32),
             intensities=np.zeros(0, np.float32))
 
+    @staticmethod
+    def _goal_message(goal: Target | None) -> GoalWithHeading:
+        """``current_goal``: a pose goal is named by its coordinates; none has an empty name."""
+        if goal is None:
+            return GoalWithHeading(name="", comment="", position=Pose2D().to_message(),
+                                   has_heading=False)
+        pose = goal.pose
+        return GoalWithHeading(name=goal.name or f"({pose.x:.2f}, {pose.y:.2f})",
+                               comment=goal.comment, position=pose.to_message(),
+                               has_heading=goal.use_heading)
+
     def _footprint(self) -> PolygonStamped:
         """The body's outline in its own frame (it never changes)."""
         corners = [Point32(x=float(x), y=float(y), z=0.0)
@@ -236,9 +271,14 @@ class SimulatorNode:
     def _trigger(success: bool, message: str) -> Trigger_Response:
         return Trigger.Response(success=success, message=message)
 
+    def _preempt(self, reason: str) -> None:
+        """End the move_to_goal goal under way, if any, with ``reason`` (lock held)."""
+        self._goal_generation += 1
+        self._preempted_by = reason
+
     def _dock(self, _request: Trigger_Request) -> Trigger_Response:
         with self.loop.lock:
-            self._goal_generation += 1
+            self._preempt("preempted by docking (dock)")
             ok = self.sim.dock()
             return self._trigger(ok, "docking" if ok else self.sim.docking.message)
 
@@ -250,8 +290,9 @@ class SimulatorNode:
 
     def _stop(self, _request: Trigger_Request) -> Trigger_Response:
         with self.loop.lock:
-            self._goal_generation += 1
+            self._preempt("stopped (stop)")
             self.sim.cancel()
+            self.sim.end_teleop()
         return self._trigger(True, "stopped")
 
     # ------------------------------------------------------------------ move_to_goal
@@ -274,7 +315,7 @@ class SimulatorNode:
                 goal.abort()
                 return result(outcome=FAILED, message="preempted by a newer goal")
             self._newest_goal = goal.sequence
-            self._goal_generation += 1
+            self._preempt("preempted by another goal")
             generation = self._goal_generation
             try:
                 target = request.goal_name or Pose2D.from_message(request.pose)
@@ -298,7 +339,7 @@ class SimulatorNode:
                     busy = self.sim.docking.state is not DockState.UNDOCKED
                     if generation != self._goal_generation:
                         goal.abort()
-                        return result(outcome=FAILED, message="preempted by another goal")
+                        return result(outcome=FAILED, message=self._preempted_by)
                     if goal.cancel_requested:
                         self.sim.cancel()
                         goal.canceled()

@@ -10,6 +10,11 @@ times faster, or as fast as possible)::
     sim.go_to("room1")
     sim.run_until(lambda: sim.navigator.state.finished, timeout=600)
     sim.navigator.state, sim.pose, sim.battery.charge_percent
+
+By hand, :meth:`Simulator.teleop` drives at a given speed and turn rate (within the limits of
+:mod:`cyborg.sim.manual`, and never into what the robot knows: the command passes the motion
+check of :mod:`cyborg.sim.motion_check`) until :meth:`Simulator.end_teleop`, and
+:meth:`Simulator.set_pose` puts the robot somewhere else at once. Both end any goal.
 """
 
 from __future__ import annotations
@@ -22,13 +27,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cyborg.nav.arnl_map import ArnlMap
-from cyborg.nav.geometry import Pose2D
+from cyborg.nav.geometry import Pose2D, normalize_angle
 from cyborg.nav.grid import MapGrid
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
-from cyborg.sim.motion_check import Motion, warm_up
+from cyborg.sim.manual import limit_command, placement_problem
+from cyborg.sim.motion_check import Motion, Surroundings, safest_command, warm_up
 from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
 from cyborg.sim.robot import RobotBase
 from cyborg.sim.start import StartChoice, choose_start
@@ -47,6 +53,16 @@ class SimSettings:
     navigator: NavigatorSettings = field(default_factory=NavigatorSettings)
     dock: DockSettings = field(default_factory=DockSettings)
     seed: int = 0
+
+
+@dataclass(frozen=True)
+class Target:
+    """A goal the robot was sent to: ``name`` ("" for a pose), pose, heading, description."""
+
+    name: str
+    pose: Pose2D
+    use_heading: bool
+    comment: str = ""
 
 
 @dataclass(frozen=True)
@@ -82,6 +98,8 @@ class Simulator:
         self.steps_per_sensor = max(1, round(rates))
         self._command = (0.0, 0.0)
         self._after_dock: tuple[Pose2D, bool] | None = None
+        self._teleop: tuple[float, float] | None = None
+        self._target: Target | None = None
         warm_up()  # the motion check's kernel, before the robot moves
         self.load_map(arnl_map, start)
 
@@ -119,11 +137,13 @@ class Simulator:
         """Switch to a map :meth:`prepare_map` built: quick, so it can hold the lock."""
         settings = self.settings
         self.map, self.world, self.planner = prepared.map, prepared.world, prepared.planner
+        self.bounds = prepared.map.bounds()
         self.base, self.laser = prepared.base, prepared.laser
         self.angles = settings.laser.angles()
         self.navigator = Navigator(prepared.planner, settings.navigator)
         self.docking = Docking(settings.dock)
         self.battery.charging = False
+        self._teleop = self._target = None
         choice = prepared.start_choice
         self.start_choice: StartChoice = choice
         log.log(logging.WARNING if choice.invented else logging.INFO, "%s", choice.reason)
@@ -134,6 +154,13 @@ class Simulator:
     def pose(self) -> Pose2D:
         """The robot's pose now, in the map frame (m, rad)."""
         return self.base.pose
+
+    @property
+    def current_goal(self) -> Target | None:
+        """The goal the robot is on its way to (docking: the dock), or None."""
+        if self._target is None or self.navigator.state.finished:
+            return None
+        return self._target
 
     # ------------------------------------------------------------------ requests
     def resolve(self, goal: Pose2D | str, use_heading: bool | None = None) -> tuple[Pose2D, bool]:
@@ -147,6 +174,9 @@ class Simulator:
     def go_to(self, goal: Pose2D | str, use_heading: bool | None = None) -> PlanResult:
         """Start driving to ``goal``; when docked, undock first (ARNL does the same)."""
         pose, heading = self.resolve(goal, use_heading)
+        self._teleop = None
+        comment = self.map.goal(goal).description if isinstance(goal, str) else ""
+        self._target = Target(goal if isinstance(goal, str) else "", pose, heading, comment)
         if self.docking.state is not DockState.UNDOCKED:
             self._after_dock = (pose, heading)
             result = self.planner.plan(self.pose, pose, use_heading=heading)
@@ -176,8 +206,10 @@ class Simulator:
             self.docking.message = f"{self.map.source} has no Dock"
             return False
         item = docks[0]
-        result = self.navigator.go_to(self.pose, Pose2D(item.x, item.y, item.theta), True,
-                                      self.time)
+        self._teleop = None
+        self._target = Target(item.name, Pose2D(item.x, item.y, item.theta), True,
+                              item.description)
+        result = self.navigator.go_to(self.pose, self._target.pose, True, self.time)
         if not result.found:
             self.docking.message = f"cannot reach the dock: {result.reason}"
             return False
@@ -192,6 +224,57 @@ class Simulator:
         self.battery.charging = False
         self.docking.enter(DockState.UNDOCKING, DockPhase.WAIT, self.time)
         return True
+
+    # ------------------------------------------------------------------ by hand
+    def teleop(self, speed: float, turn_rate: float) -> tuple[float, float]:
+        """Drive by hand at ``speed`` (m/s) and ``turn_rate`` (rad/s) until told otherwise.
+
+        Cancels any goal and docking (as :meth:`cancel`); a command that moves the robot
+        takes it off the dock (charging ends). The command is clamped
+        (:func:`~cyborg.sim.manual.limit_command`; ValueError when not finite), held until the
+        next one or :meth:`end_teleop`, and checked every control period against the walls and
+        the laser's returns: the robot slows and stops rather than touch them. Zero stops.
+        Returns the clamped command.
+        """
+        command = limit_command(speed, turn_rate, self.base.limits)
+        self.cancel()
+        if command != (0.0, 0.0) and self.docking.state in (DockState.DOCKED,
+                                                             DockState.UNDOCKING):
+            self.battery.charging = False
+            self.docking.enter(DockState.UNDOCKED, DockPhase.NONE, self.time)
+            self.docking.message = "driven off the dock by hand"
+        self._teleop = command
+        return command
+
+    @property
+    def teleop_command(self) -> tuple[float, float] | None:
+        """The command driving the robot by hand, or None when it is not driven by hand."""
+        return self._teleop
+
+    def end_teleop(self) -> None:
+        """Stop driving by hand: the robot brakes to a standstill."""
+        self._teleop = None
+
+    def set_pose(self, pose: Pose2D) -> str | None:
+        """Put the robot at ``pose`` at once, standing still; or say why not (None: done).
+
+        Refused (nothing changes) when :func:`~cyborg.sim.manual.placement_problem` finds one.
+        Otherwise any goal, docking and driving by hand end first, and the robot leaves the
+        dock (charging ends).
+        """
+        problem = placement_problem(pose, self.bounds, self.base, self.world)
+        if problem is not None:
+            return problem
+        self.cancel()
+        self._teleop = None
+        if self.docking.state is not DockState.UNDOCKED:
+            self.battery.charging = False
+            self.docking.enter(DockState.UNDOCKED, DockPhase.NONE, self.time)
+            self.docking.message = "moved off the dock"
+        self.base.place(Pose2D(pose.x, pose.y, normalize_angle(pose.theta)))
+        self._command = (0.0, 0.0)
+        self._sense()
+        return None
 
     # ------------------------------------------------------------------ time
     def step(self) -> None:
@@ -237,8 +320,19 @@ class Simulator:
     def _decide(self) -> tuple[float, float]:
         if self.docking.state is not DockState.UNDOCKED:
             return self._dock_step()
+        if self._teleop is not None:
+            return self._drive_by_hand(self._teleop)
         return self.navigator.update(self.time, self.base.pose, self.ranges, self.angles,
                                      self.hits, self._motion(), self._period)
+
+    def _drive_by_hand(self, wanted: tuple[float, float]) -> tuple[float, float]:
+        """The hand-given command, or a gentler one if it would touch a wall or a return."""
+        if wanted == (0.0, 0.0):
+            return wanted
+        base, pose = self.base, self.base.pose
+        around = Surroundings(base.clearance, base.origin, base.resolution, self.hits)
+        return safest_command(pose.x, pose.y, pose.theta, self._motion(), wanted, self._period,
+                              base.footprint, around)
 
     def _dock_step(self) -> tuple[float, float]:
         docking, settings, now = self.docking, self.settings.dock, self.time

@@ -251,6 +251,33 @@ class cyborg_msgs__srv__ReloadTree_Response:
     __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/ReloadTree_Response'
 
 
+@dataclass
+class cyborg_msgs__srv__SetPose_Event:
+    """Class for cyborg_msgs/srv/SetPose_Event."""
+
+    info: service_msgs__msg__ServiceEventInfo
+    request: list[cyborg_msgs__srv__SetPose_Request]
+    response: list[cyborg_msgs__srv__SetPose_Response]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetPose_Event'
+
+
+@dataclass
+class cyborg_msgs__srv__SetPose_Request:
+    """Class for cyborg_msgs/srv/SetPose_Request."""
+
+    pose: geometry_msgs__msg__Pose2D
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetPose_Request'
+
+
+@dataclass
+class cyborg_msgs__srv__SetPose_Response:
+    """Class for cyborg_msgs/srv/SetPose_Response."""
+
+    success: bool
+    message: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetPose_Response'
+
+
 AvailableGoals_Event = cyborg_msgs__srv__AvailableGoals_Event
 AvailableGoals_Request = cyborg_msgs__srv__AvailableGoals_Request
 AvailableGoals_Response = cyborg_msgs__srv__AvailableGoals_Response
@@ -275,6 +302,9 @@ MakePlan_Response = cyborg_msgs__srv__MakePlan_Response
 ReloadTree_Event = cyborg_msgs__srv__ReloadTree_Event
 ReloadTree_Request = cyborg_msgs__srv__ReloadTree_Request
 ReloadTree_Response = cyborg_msgs__srv__ReloadTree_Response
+SetPose_Event = cyborg_msgs__srv__SetPose_Event
+SetPose_Request = cyborg_msgs__srv__SetPose_Request
+SetPose_Response = cyborg_msgs__srv__SetPose_Response
 
 AvailableGoals = ServiceType(
     "cyborg_msgs/srv/AvailableGoals",
@@ -322,4 +352,10 @@ ReloadTree = ServiceType(
     "cyborg_msgs/srv/ReloadTree",
     ReloadTree_Request,
     ReloadTree_Response,
+)
+
+SetPose = ServiceType(
+    "cyborg_msgs/srv/SetPose",
+    SetPose_Request,
+    SetPose_Response,
 )
