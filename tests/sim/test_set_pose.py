@@ -127,7 +127,7 @@ def test_every_pose_is_refused_or_fits(roomy: Simulator, x: float, y: float,
 def running() -> Iterator[tuple[Node, Simulator, SimulationLoop]]:
     with Context(BusConfig.isolated()) as context:
         sim = room()
-        loop = SimulationLoop(sim, speed=5)
+        loop = SimulationLoop(sim, speed=3)
         SimulatorNode(Node("arnl", "/cyborg", context=context), loop)
         loop.start()
         try:

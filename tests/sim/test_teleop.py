@@ -177,19 +177,19 @@ def started(context: Context, speed: float) -> Robot:
 
 
 def test_the_deadman_counts_wall_time_not_simulated_time(bus: Context) -> None:
-    """At 20 times real time, seconds of simulated time pass without a stop; the robot stops
-    once 0.5 s of the (test's) wall clock pass without a command."""
-    it = started(bus, speed=20)
+    """At 10 times real time, simulated seconds pass without a stop; the robot stops once
+    0.5 s of the (test's) wall clock pass without a command."""
+    it = started(bus, speed=10)
     try:
         with it.loop.lock:
-            it.sim.set_pose(Pose2D(6.0, 3.0, math.pi / 2))  # 2.7 m to the wall ahead
-        it.cmd_vel.publish(twist(0.3))
-        assert wait_for(lambda: it.read(lambda sim: sim.base.speed) > 0.25, 10)
+            it.sim.set_pose(Pose2D(7.5, 0.8, math.pi / 2))  # 4.8 m to the wall ahead: 30 s
+        it.cmd_vel.publish(twist(0.15))
+        assert wait_for(lambda: it.read(lambda sim: sim.base.speed) > 0.1, 10)
         at = it.read(lambda sim: sim.time)
         # 3 simulated seconds, the same wall-clock instant: no stop yet
         assert wait_for(lambda: it.read(lambda sim: sim.time) > at + 3.0, 10)
-        assert it.read(lambda sim: (sim.teleop_command, sim.base.speed > 0.25)) == (
-            (0.3, 0.0), True)
+        assert it.read(lambda sim: (sim.teleop_command, sim.base.speed > 0.1)) == (
+            (0.15, 0.0), True)
         it.wall = 0.6
         assert wait_for(lambda: it.read(lambda sim: sim.teleop_command) is None, 10)
         assert wait_for(lambda: it.read(lambda sim: sim.base.speed) == 0.0, 10)
@@ -201,7 +201,7 @@ def test_the_deadman_counts_wall_time_not_simulated_time(bus: Context) -> None:
 def test_a_twist_that_is_not_finite_is_ignored_with_one_warning(
         bus: Context, caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.WARNING, "cyborg.sim")
-    it = started(bus, speed=5)
+    it = started(bus, speed=2)
     try:
         assert wait_for(lambda: it.read(lambda sim: sim.time) > 0.2, 10)
         with it.loop.lock:
@@ -215,14 +215,15 @@ def test_a_twist_that_is_not_finite_is_ignored_with_one_warning(
         warnings = [r for r in caplog.records if "not finite" in r.getMessage()]
         assert len(warnings) == 1 and "/cyborg/cmd_vel" in warnings[0].getMessage()
         assert it.read(lambda sim: sim.teleop_command) is None
-        # the goal runs on
-        assert it.read(lambda sim: sim.navigator.state) is PathState.MOVING_TO_GOAL
+        # the goal runs on (or is reached, on a slow machine), not ended by the bad twists
+        assert it.read(lambda sim: sim.navigator.state) in (PathState.MOVING_TO_GOAL,
+                                                             PathState.REACHED_GOAL)
     finally:
         it.loop.stop()
 
 
 def test_cmd_vel_ends_a_running_move_to_goal_and_current_goal_follows(bus: Context) -> None:
-    it = started(bus, speed=5)
+    it = started(bus, speed=3)
     try:
         assert it.goal_named("").position.x == 0.0  # latched at the start: no goal
         action = robot.MOVE_TO_GOAL.client(it.client)
