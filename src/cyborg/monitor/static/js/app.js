@@ -6,6 +6,8 @@
 // when the tree was last laid out).
 
 import { Connection, keepSeatSecret } from "./connection.js";
+import { Layout } from "./layout.js";
+import { MapPanel } from "./map/map_panel.js";
 import { TreeModel, stateAt } from "./model.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
@@ -49,21 +51,30 @@ const connection = new Connection({
   onMessage: receive,
   onState: (state) => {
     page.connected = state === "open";
+    if (page.connected) mapPanel.connected();
     banner();
   },
   onOpen: () => connection.post({ t: "watch", ns: page.ns || "" }),
+  onUnreadable: (data, error) => mapPanel.unreadable(data, error),
 });
+// The map beside the tree (js/map/); the layout says whether it can be seen.
+const mapPanel = new MapPanel($("map-view"), { post: (message) => connection.post(message) });
+const layout = new Layout({ onMapShown: (shown) => mapPanel.setVisible(shown) });
+mapPanel.onEmpty = (empty) => layout.setMapEmpty(empty);
+new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("tree"));
 
 // ------------------------------------------------------------------ messages
 function receive(message) {
   stats.messages += 1;
+  if (mapPanel.receive(message)) return;
   switch (message.t) {
     case "watching":
       page.ns = message.ns;
+      mapPanel.setTree(page.ns);
       break;
     case "structure":
       stats.structures += 1;
-      if (message.ns !== page.ns) page.ns = message.ns;
+      if (message.ns !== page.ns) mapPanel.setTree(page.ns = message.ns);
       model.reset(message.v, message.tree ? message.tree.root : null);
       page.title = message.tree ? message.tree.title : "";
       if (page.selected && !model.byId.has(page.selected)) page.selected = null;
@@ -386,6 +397,7 @@ function goLive() {
 // ------------------------------------------------------------------ wiring
 $("robot").addEventListener("change", (event) => {
   page.ns = event.target.value;
+  mapPanel.setTree(page.ns);
   page.folded.clear();
   page.opened.clear();
   page.selected = null;

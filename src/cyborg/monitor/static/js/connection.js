@@ -5,15 +5,17 @@
 //
 // `connection.send(command)` returns a promise of the `result` message answering it (commands
 // carry a request number `req`). Every other message goes to `onMessage`. `onState` hears
-// "open" and "closed" so the page can say when it is offline.
+// "open" and "closed" so the page can say when it is offline. A message that is not JSON text
+// goes to `onUnreadable(data, error)`.
 
 const RETRY_FIRST_MS = 300;
 const RETRY_MAX_MS = 5000;
 const SEAT_ITEM = "cyborg-monitor-seat";
 
 export class Connection {
-  constructor({ onMessage, onState, onOpen }) {
+  constructor({ onMessage, onState, onOpen, onUnreadable }) {
     this.onMessage = onMessage;
+    this.onUnreadable = onUnreadable;
     this.onState = onState;
     this.onOpen = onOpen;
     this.pending = new Map();
@@ -44,7 +46,13 @@ export class Connection {
     };
     socket.onopen = opened;
     socket.onmessage = (event) => {
-      const message = JSON.parse(event.data);
+      let message;
+      try {
+        message = JSON.parse(event.data);
+      } catch (error) {
+        this.onUnreadable(event.data, error); // not JSON text: reported, not thrown
+        return;
+      }
       if (message.t === "result" && this.pending.has(message.req)) {
         this.pending.get(message.req)(message);
         this.pending.delete(message.req);

@@ -1,0 +1,119 @@
+// The map's heads-up display, in HTML over the canvas: scale bar, cursor coordinates, layer
+// toggles, warnings and the "no map yet" line. HTML rather than canvas, so it is crisp, takes
+// clicks, and costs nothing per frame: each part is rewritten only when what it shows changes.
+//
+// Layer choices are kept in localStorage, so a reload (or the next visit) shows the same.
+
+export const LAYERS = [
+  ["walls", "Walls"], ["points", "Scanned points"], ["forbidden", "Forbidden lines and areas"],
+  ["goals", "Goals, docks, home"], ["paths", "Paths"], ["laser", "Laser"], ["robots", "Robots"], ["labels", "Labels"],
+];
+const STORE = "cyborg-monitor-map-layers";
+const SCALE_PX = 100; // the scale bar's length is 1, 2 or 5 × 10ⁿ m, near this many pixels
+
+export class Hud {
+  // `root`: the #map-view element. `onLayers(layers)` hears a toggle; `onFit()` the Fit button;
+  // `onFollow(on)` the Follow box.
+  constructor(root, { onLayers, onFit, onFollow }) {
+    const $ = (selector) => root.querySelector(selector);
+    this.status = $("#map-status");
+    this.scaleBar = $("#map-scale .bar");
+    this.scaleLabel = $("#map-scale .label");
+    this.cursor = $("#map-cursor");
+    this.warningBox = $("#map-warnings");
+    this.warningCount = $("#map-warning-count");
+    this.warningList = $("#map-warning-list");
+    this.follow = $("#map-follow");
+    this.layers = loadLayers();
+    this.shown = { scale: null, warnings: "", status: null };
+    const menu = $("#map-layer-list");
+    for (const [name, label] of LAYERS) {
+      const row = document.createElement("label");
+      const box = document.createElement("input");
+      box.type = "checkbox";
+      box.dataset.layer = name;
+      box.checked = this.layers[name];
+      box.addEventListener("change", () => {
+        this.layers = { ...this.layers, [name]: box.checked };
+        try {
+          localStorage.setItem(STORE, JSON.stringify(this.layers));
+        } catch {
+          // storage full or refused (private windows): the choice lasts this page only
+        }
+        onLayers(this.layers);
+      });
+      row.append(box, ` ${label}`);
+      menu.append(row);
+    }
+    $("#map-fit").addEventListener("click", () => onFit());
+    this.follow.addEventListener("change", () => onFollow(this.follow.checked));
+  }
+
+  setFollow(on) {
+    this.follow.checked = on;
+  }
+
+  // "no map yet", "loading columbia.map …", an error, or "" once the map is drawn.
+  showStatus(text) {
+    if (text === this.shown.status) return;
+    this.shown.status = text;
+    this.status.textContent = text;
+    this.status.hidden = !text;
+  }
+
+  // The bar for `scale` px per m.
+  showScale(scale) {
+    if (scale === this.shown.scale) return;
+    this.shown.scale = scale;
+    const metres = niceLength(SCALE_PX / scale);
+    this.scaleBar.style.width = `${Math.round(metres * scale)}px`;
+    this.scaleLabel.textContent = lengthText(metres);
+  }
+
+  // Where the pointer is in the world, in metres with 2 decimals; null: off the map.
+  showCursor(xy) {
+    this.cursor.textContent = xy ? `x ${xy[0].toFixed(2)} m  y ${xy[1].toFixed(2)} m` : "";
+  }
+
+  // The model's warnings, newest first, each with how often it came.
+  showWarnings(warnings) {
+    const key = warnings.map((w) => `${w.at}:${w.count}`).join();
+    if (key === this.shown.warnings) return;
+    this.shown.warnings = key;
+    this.warningBox.hidden = !warnings.length;
+    this.warningCount.textContent = String(warnings.length);
+    this.warningList.replaceChildren(...warnings.map((w) => {
+      const item = document.createElement("li");
+      item.textContent = `${w.ns ? `${w.ns} ` : ""}${w.message}${w.count > 1 ? ` (×${w.count})` : ""}`;
+      item.title = `${w.kind}, last at ${new Date(w.at).toLocaleTimeString()}`;
+      return item;
+    }));
+  }
+}
+
+function loadLayers() {
+  const layers = Object.fromEntries(LAYERS.map(([name]) => [name, true]));
+  try {
+    const saved = JSON.parse(localStorage.getItem(STORE) || "{}");
+    for (const [name] of LAYERS) if (typeof saved[name] === "boolean") layers[name] = saved[name];
+  } catch {
+    // nothing saved, or not readable: all layers on
+  }
+  return layers;
+}
+
+// The 1, 2 or 5 × 10ⁿ m closest to `metres` (on a log scale).
+export function niceLength(metres) {
+  const power = 10 ** Math.floor(Math.log10(metres));
+  let best = power;
+  for (const step of [1, 2, 5, 10]) {
+    if (Math.abs(Math.log(step * power / metres)) < Math.abs(Math.log(best / metres))) best = step * power;
+  }
+  return best;
+}
+
+function lengthText(metres) {
+  if (metres >= 1) return `${Math.round(metres)} m`;
+  if (metres >= 0.01) return `${Math.round(metres * 100)} cm`;
+  return `${Math.round(metres * 1000 * 10) / 10} mm`;
+}

@@ -1,0 +1,276 @@
+// The map panel: wires the model (map_model.js), the view (view_transform.js), the static
+// layers (static_layer.js, drawn in a worker), the per-frame drawing (moving_draw.js) and the
+// HUD (hud.js) to the page's WebSocket.
+//
+// Data flow: a message → MapModel (decoded, checked, or a warning) → a frame is scheduled →
+// on the next animation frame: the static bitmap is asked for if the view outgrew the last
+// one, and the moving layers are drawn over it. Any number of messages between two frames
+// cost one frame; with nothing new, nothing is drawn.
+//
+// The page opts in with {t: "map", on: true} when the panel is visible (and out when it is
+// hidden, so a tree-only page costs the monitor nothing). A monitor without maps answers with
+// an error for "map"; the panel swallows it and keeps saying "no map yet".
+//
+// `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
+// {points, lines, objects}, moving: {robots, laser, paths}, warnings, toScreen(x, y),
+// toWorld(sx, sy), view(), colourOf(ns), fetches, renders, where, frameMs, messageMs}.
+
+import { Hud } from "./hud.js";
+import { MapModel, parseMapBlob } from "./map_model.js";
+import { drawBitmap, drawMoving } from "./moving_draw.js";
+import { StaticLayer } from "./static_layer.js";
+import { ViewTransform } from "./view_transform.js";
+
+const FRAME_SAMPLES = 600;
+
+export class MapPanel {
+  // `root`: the #map-view element; `post(message)`: send to the monitor (when connected).
+  constructor(root, { post }) {
+    this.root = root;
+    this.post = post;
+    this.canvas = root.querySelector("#map-canvas"); // what moves; takes the pointer
+    this.ctx = this.canvas.getContext("2d");
+    this.lower = root.querySelector("#map-static"); // the static bitmap, under it
+    this.lowerCtx = this.lower.getContext("2d");
+    this.lowerKey = ""; // what the lower canvas shows (bitmap and placement)
+    this.model = new MapModel();
+    this.view = new ViewTransform();
+    this.visible = false;
+    this.follow = false;
+    this.userMoved = false; // the user zoomed or panned this map: do not re-fit on resize
+    this.treeNs = null;
+    this.pairs = new Map(); // tree ns -> robot ns, from the monitor's robots list
+    this.shownKey = null;
+    this.loading = new Map(); // key -> promise
+    this.scheduled = false;
+    this.size = { width: 0, height: 0 };
+    this.onEmpty = () => {}; // hears whether there is no map to show (the layout shrinks it)
+    const mainThread = new URLSearchParams(location.search).get("map_worker") === "0";
+    this.staticLayer = new StaticLayer({ onBitmap: () => this.schedule(), mainThread });
+    this.hud = new Hud(root, {
+      onLayers: () => this.schedule(),
+      onFit: () => this.fit(),
+      onFollow: (on) => { this.follow = on; this.schedule(); },
+    });
+    const panel = this; // for the getters below
+    this.stats = window.__map = {
+      firstPaint: null, paints: 0, recordPaints: false, paintTimes: [],
+      drawn: { points: 0, lines: 0, objects: 0 }, moving: { robots: 0, laser: 0, paths: 0 },
+      fetches: 0, frameMs: [], messageMs: 0, messages: 0,
+      get warnings() { return panel.model.warnings.map((w) => ({ ...w })); },
+      get renders() { return panel.staticLayer.renders; },
+      get where() { return panel.staticLayer.where; },
+      toScreen: (x, y) => this.view.toScreen(x, y),
+      toWorld: (sx, sy) => this.view.toWorld(sx, sy),
+      view: () => this.view.snapshot(),
+      colourOf: (ns) => this.model.robots.get(ns)?.colour ?? null,
+    };
+    this.view.attach(this.canvas, {
+      onChange: () => this.schedule(),
+      onUser: (gesture) => {
+        this.userMoved = true;
+        if (gesture !== "zoom" && this.follow) {
+          this.follow = false;
+          this.hud.setFollow(false);
+        }
+      },
+      onCursor: (sx, sy) => this.hud.showCursor(sx === null || !this.shownKey ? null : this.view.toWorld(sx, sy)),
+    });
+    new ResizeObserver(([entry]) => {
+      this.size = { width: entry.contentRect.width, height: entry.contentRect.height };
+      this.schedule();
+    }).observe(root);
+    this.hud.showStatus("no map yet");
+  }
+
+  // ------------------------------------------------------------------ from the page
+  // Handles a message from the monitor; true when it was the map's (app.js then ignores it).
+  receive(message) {
+    const started = performance.now();
+    if (message && message.t === "error" && message.command === "map") return true; // a monitor without maps
+    if (message && message.t === "robots") this.pairRobots(message.robots);
+    const type = this.model.receive(message);
+    if (type === null) return false;
+    if (type === "map_ref") this.loadMaps();
+    this.stats.messages += 1;
+    this.stats.messageMs += performance.now() - started;
+    this.schedule();
+    return true;
+  }
+
+  // A message that was not JSON (or not text) at all: a warning, nothing else.
+  unreadable(text, error) {
+    this.model.warn("", "unreadable", `a message from the monitor could not be read (${error.message}): ${String(text).slice(0, 60)}`);
+    this.schedule();
+  }
+
+  // The socket (re)opened: sequence numbers start again, and the monitor must hear the opt-in.
+  connected() {
+    for (const robot of this.model.robots.values()) robot.seq = null;
+    if (this.visible) this.post({ t: "map", on: true });
+  }
+
+  setVisible(visible) {
+    if (visible === this.visible) return;
+    this.visible = visible;
+    this.post({ t: "map", on: visible });
+    if (visible) this.schedule();
+  }
+
+  // The tree shown in the tree view: its robot becomes the selected one (/x/bt → /x, unless
+  // the monitor's robots list pairs them otherwise).
+  setTree(ns) {
+    this.treeNs = ns;
+    this.schedule();
+  }
+
+  pairRobots(robots) {
+    if (!Array.isArray(robots)) return;
+    for (const entry of robots) {
+      if (entry && typeof entry.ns === "string" && typeof entry.robot === "string") this.pairs.set(entry.ns, entry.robot);
+    }
+  }
+
+  selected() {
+    const robots = this.model.robots;
+    const ns = this.treeNs ? this.pairs.get(this.treeNs) ?? this.treeNs.replace(/\/bt$/, "") : null;
+    if (ns && robots.has(ns)) return ns;
+    return [...robots.keys()].sort()[0] ?? null;
+  }
+
+  fit() {
+    const map = this.model.maps.get(this.shownKey);
+    if (!map) return;
+    this.view.fit(map.bounds);
+    this.userMoved = false;
+    this.schedule();
+  }
+
+  // ------------------------------------------------------------------ maps
+  loadMaps() {
+    for (const ref of this.model.refs.values()) {
+      if (this.model.maps.has(ref.key) || this.loading.has(ref.key)) continue;
+      this.hud.showStatus(`loading ${ref.source || "the map"} …`);
+      this.stats.fetches += 1;
+      const loaded = fetch(ref.url)
+        .then((response) => {
+          if (!response.ok) throw new Error(`HTTP ${response.status}`);
+          return response.arrayBuffer();
+        })
+        .then((buffer) => {
+          const map = parseMapBlob(buffer);
+          for (const warning of map.warnings) this.model.warn("", `map ${ref.key}`, warning);
+          const counts = ref.counts;
+          if (Number.isInteger(counts.points) && counts.points !== map.points.length / 2) {
+            this.model.warn("", `map ${ref.key} counts`, `map ${ref.source}: ${map.points.length / 2} points, the monitor announced ${counts.points}`);
+          }
+          this.model.maps.set(ref.key, map);
+        })
+        .catch((error) => {
+          this.model.warn("", `map ${ref.key}`, `map ${ref.source || ref.key} could not be loaded: ${error.message}`);
+        })
+        .finally(() => {
+          this.loading.delete(ref.key);
+          this.model.version += 1;
+          this.schedule();
+        });
+      this.loading.set(ref.key, loaded);
+    }
+  }
+
+  // The map to show: the selected robot's, else any loaded one. True when the panel went from
+  // no map to a map or back (its size may change with that).
+  pickMap() {
+    const selected = this.selected();
+    const ref = selected ? this.model.refs.get(selected) : null;
+    let key = ref && this.model.maps.has(ref.key) ? ref.key : null;
+    if (!key) key = [...this.model.refs.values()].map((r) => r.key).find((k) => this.model.maps.has(k)) ?? null;
+    if (key === this.shownKey) return false;
+    const emptiness = !key !== !this.shownKey;
+    this.shownKey = key;
+    const map = key ? this.model.maps.get(key) : null;
+    this.staticLayer.setMap(map);
+    if (map && this.view.width) {
+      this.view.fit(map.bounds);
+      this.userMoved = false;
+    }
+    if (emptiness) {
+      this.root.classList.toggle("empty", !key);
+      this.onEmpty(!key);
+    }
+    return emptiness;
+  }
+
+  // ------------------------------------------------------------------ frames
+  schedule() {
+    if (this.scheduled || !this.visible) return;
+    this.scheduled = true;
+    requestAnimationFrame(() => this.frame());
+  }
+
+  frame() {
+    this.scheduled = false;
+    const started = performance.now();
+    const { width, height } = this.size;
+    if (!width || !height) return;
+    const dpr = window.devicePixelRatio || 1;
+    if (this.view.resize(width, height) || this.canvas.width !== Math.round(width * dpr)) {
+      for (const canvas of [this.canvas, this.lower]) {
+        canvas.width = Math.round(width * dpr);
+        canvas.height = Math.round(height * dpr);
+      }
+      this.lowerKey = "";
+      const map = this.model.maps.get(this.shownKey);
+      if (map && !this.userMoved) this.view.fit(map.bounds);
+    }
+    if (this.pickMap()) {
+      // the layout may give the panel another size: draw on the next frame, at that size
+      this.schedule();
+      return;
+    }
+    const selected = this.selected();
+    const followed = this.follow ? this.model.robots.get(selected) : null;
+    if (followed && followed.pose) this.view.centerOn(followed.pose.x, followed.pose.y);
+    const layers = this.hud.layers;
+    const ready = this.staticLayer.update(this.view.snapshot(), dpr, layers);
+    const robots = [...this.model.robots.values()].filter((robot) => {
+      const ref = this.model.refs.get(robot.ns);
+      return !ref || !this.shownKey || ref.key === this.shownKey;
+    });
+    const placement = this.staticLayer.placement(this.view);
+    const lowerKey = placement ? `${placement.serial}:${placement.x}:${placement.y}:${placement.w}:${placement.h}` : "none";
+    if (lowerKey !== this.lowerKey) {
+      this.lowerKey = lowerKey;
+      drawBitmap(this.lowerCtx, this.view, placement, dpr);
+    }
+    this.stats.moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, robots, layers, selected });
+    if (this.staticLayer.current) this.stats.drawn = this.staticLayer.current.drawn;
+    this.hud.showScale(this.view.scale);
+    this.hud.showWarnings(this.model.warnings);
+    this.hud.showStatus(this.statusText());
+    this.stats.paints += 1;
+    const frameMs = this.stats.frameMs;
+    frameMs.push(performance.now() - started);
+    if (frameMs.length > FRAME_SAMPLES) frameMs.splice(0, frameMs.length - FRAME_SAMPLES);
+    this.stamp(placement !== null && ready);
+  }
+
+  statusText() {
+    if (this.shownKey) return "";
+    if (this.loading.size) return this.hud.shown.status;
+    return "no map yet";
+  }
+
+  // A task queued from the next animation frame runs once this frame is on screen: stamp the
+  // paint there (as app.js does for the tree).
+  stamp(withMap) {
+    const firstPaint = withMap && this.stats.firstPaint === null;
+    if (!firstPaint && !this.stats.recordPaints) return;
+    const seqs = this.stats.recordPaints ? [...this.model.robots.values()].map((r) => [r.ns, r.seq]) : null;
+    requestAnimationFrame(() => setTimeout(() => {
+      const now = performance.timeOrigin + performance.now();
+      if (firstPaint && this.stats.firstPaint === null) this.stats.firstPaint = now;
+      if (seqs) this.stats.paintTimes.push([now, seqs]);
+    }, 0));
+  }
+}
