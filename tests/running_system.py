@@ -7,7 +7,7 @@ import signal
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +17,7 @@ from cyborg.bus.component import NodeSpec
 from cyborg.runner.component import RunningTree
 from cyborg.runner.tree_runner import TreeRunnerNode
 from cyborg.sim.component import RunningSimulator
+from cyborg.sim.component import start as start_simulator
 from cyborg.sim.simulator import Simulator
 
 
@@ -43,6 +44,21 @@ class System:
         return client.call(new_message(self.client.types, f"{service}_Request", fields),
                            timeout=10)
 
+    def stop_simulator(self) -> None:
+        """Stops the simulator (the robot leaves the bus); :meth:`start_simulator` brings one
+        back."""
+        old = self._simulator()
+        old.stop()
+        self.launch.running.remove(old)
+
+    def start_simulator(self, **parameters: Any) -> RunningSimulator:
+        """Starts a new simulator with the launch's parameters (and ``parameters``)."""
+        spec = next(spec for spec in self.launch.description.nodes if spec.kind == "simulator")
+        new = start_simulator(self.context, replace(spec, parameters={**spec.parameters,
+                                                                      **parameters}))
+        self.launch.running.append(new)
+        return new
+
     def uid(self, label: str) -> str:
         """The id of the one node with this label."""
         found = [node.uid for node in self.runner.tree if node.label == label]
@@ -62,17 +78,20 @@ def wait_until(predicate: Callable[[], object], timeout: float = 30.0,
 @contextmanager
 def running_system(map_path: Path, tree_path: Path, *, speed: float = 20.0,
                    battery: float = 100.0, start: str = "", rate: float = 10.0,
-                   registry_modules: list[str] | None = None) -> Iterator[System]:
+                   registry_modules: list[str] | None = None,
+                   simulator: bool = True) -> Iterator[System]:
+    """The simulator (unless not ``simulator``: then the tree runs on wall-clock time, its robot
+    missing) and a tree runner under ``/cyborg``, on an isolated bus."""
     with Context(BusConfig.isolated()) as context:
         sim: dict[str, Any] = {"map": str(map_path), "speed": speed, "battery": battery}
         if start:
             sim["start"] = start
-        tree: dict[str, Any] = {"tree_file": str(tree_path), "use_sim_time": True,
+        tree: dict[str, Any] = {"tree_file": str(tree_path), "use_sim_time": simulator,
                                 "robot_namespace": "/cyborg", "rate": rate}
         if registry_modules:
             tree["nodes"] = registry_modules
         launch = Launch(LaunchDescription([
-            NodeSpec("simulator", "arnl", "/cyborg", sim),
+            *([NodeSpec("simulator", "arnl", "/cyborg", sim)] if simulator else []),
             NodeSpec("tree_runner", "tree_runner", "/cyborg/bt", tree)]), context)
         launch.start()
         try:

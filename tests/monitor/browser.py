@@ -48,10 +48,11 @@ class Live:
 
 
 @contextmanager
-def live_system(*, speed: float = 10.0, token: str | None = None,
-                port: int = 0) -> Iterator[Live]:
-    """The campus system with a monitor on a free port, on every interface."""
-    with running_system(CAMPUS_MAP, CAMPUS_TREE, speed=speed) as system:
+def live_system(*, speed: float = 10.0, token: str | None = None, port: int = 0,
+                simulator: bool = True) -> Iterator[Live]:
+    """The campus system with a monitor on a free port, on every interface (without its
+    simulator when not ``simulator``)."""
+    with running_system(CAMPUS_MAP, CAMPUS_TREE, speed=speed, simulator=simulator) as system:
         monitor = Monitor(Node("monitor", "/cyborg", context=system.context),
                           namespaces=["/cyborg/bt"], host="0.0.0.0", port=port, token=token)
         monitor.start()

@@ -1,5 +1,6 @@
 """Helpers for the map data path's tests: a robot's messages built by hand (pose, scan, path,
-battery, map geometry), and a fake robot that publishes them on a bus."""
+battery, footprint, fixed transforms, map geometry), and a fake robot that publishes them on a
+bus."""
 
 from __future__ import annotations
 
@@ -11,10 +12,23 @@ import numpy as np
 from cyborg.bus import Node
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry, MapObject
-from cyborg.bus.msgs.geometry_msgs.msg import Point, Pose, Pose2D, PoseStamped, Quaternion
+from cyborg.bus.msgs.geometry_msgs.msg import (
+    Point,
+    Point32,
+    Polygon,
+    PolygonStamped,
+    Pose,
+    Pose2D,
+    PoseStamped,
+    Quaternion,
+    Transform,
+    TransformStamped,
+    Vector3,
+)
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import Header, String
+from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 from cyborg.interfaces import robot
 
 BEAMS = 541
@@ -57,6 +71,27 @@ def battery(charge: float = 80.0, dock: str = "UNDOCKED") -> BatteryStatus:
                          voltage=25.0, charging=False, dock_state=dock)
 
 
+def footprint(corners: Sequence[tuple[float, float]] = ((0.3, 0.2), (-0.3, 0.2), (-0.3, -0.2),
+                                                       (0.3, -0.2))) -> PolygonStamped:
+    """An outline in the robot's frame (a 60 x 40 cm box unless told)."""
+    return PolygonStamped(header=header("base_link"), polygon=Polygon(points=[
+        Point32(x=x, y=y, z=0.0) for x, y in corners]))
+
+
+def transforms(*links: tuple[str, str, float, float, float]) -> TFMessage:
+    """``/tf_static``'s message: ``(parent, child, x, y, yaw)`` per transform (a yaw that is not
+    finite goes into the quaternion as it is)."""
+    def rotation(yaw: float) -> Quaternion:
+        if not math.isfinite(yaw):
+            return Quaternion(x=0.0, y=0.0, z=yaw, w=yaw)
+        return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+
+    return TFMessage(transforms=[
+        TransformStamped(header=header(parent), child_frame_id=child, transform=Transform(
+            translation=Vector3(x=x, y=y, z=0.1), rotation=rotation(yaw)))
+        for parent, child, x, y, yaw in links])
+
+
 def map_object(name: str = "Office", category: int = MapObject.GOAL, kind: str = "Goal",
                at: tuple[float, float, float] = (1.0, 2.0, 0.0),
                outline: Sequence[float] = ()) -> MapObject:
@@ -91,6 +126,8 @@ class FakeMapRobot:
         self.path_state = robot.PATH_STATE.publisher(node, namespace)
         self.battery = robot.BATTERY_STATUS.publisher(node, namespace)
         self.map = robot.MAP_GEOMETRY.publisher(node, namespace)
+        self.footprint = robot.FOOTPRINT.publisher(node, namespace)
+        self.tf_static = robot.TF_STATIC.publisher(node)
 
     def state(self, text: str) -> None:
         self.path_state.publish(String(data=text))

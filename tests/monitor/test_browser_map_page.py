@@ -1,6 +1,6 @@
 """The page around the map panel in headless Chromium: the layout (splitter and maximise kept
 across reloads, phone tabs with the map first, the map's data asked for only while it can be
-seen), the real monitor's page while it sends no maps, and the figures: first paint of
+seen), the real monitor's page while no robot sends a map, and the figures: first paint of
 columbia.map and the frame cost with three robots at 10 Hz (map_figures.json)."""
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import Any
 import pytest
 from playwright.sync_api import Browser, sync_playwright
 
+from cyborg.monitor.map_store import map_key
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from tests.conftest import shared_dir
 from tests.monitor.browser import ARTIFACTS, launch_chromium, live_system, open_page
@@ -25,7 +26,6 @@ from tests.monitor.map_page import (
     START,
     StandInMonitor,
     first_messages,
-    map_key,
     map_ref,
     on_map,
     open_map_page,
@@ -132,7 +132,7 @@ def test_splitter_and_maximise_are_kept(browser: Browser, server: StandInMonitor
 
 
 def test_a_monitor_without_maps_leaves_the_page_working(browser: Browser) -> None:
-    with live_system() as live:
+    with live_system(simulator=False) as live:  # a tree runner, no robot: no map
         errors: list[str] = []
         page = open_page(browser, live.url, errors)
         assert page.inner_text("#map-status") == "no map yet"

@@ -1,8 +1,9 @@
 """The map's data path end to end, without a browser: a fake robot on an isolated bus publishes
 its map, pose, scans, path, path state and battery; a page that opts in with {"t": "map"} gets
-map_ref (and can fetch the blob), path, rs at most ~12 a second per robot, and robot_warn for
-messages that cannot be drawn, never an error; the robots list names robots, their trees and
-their maps; at most 16 robots are followed."""
+map_ref (and can fetch the blob), path, rs at most ~12 a second per robot (scans with the
+laser's mount from /tf_static, the footprint once per change), and robot_warn for messages that
+cannot be drawn, never an error; the robots list names robots, their trees and their maps; at
+most 16 robots are followed."""
 
 from __future__ import annotations
 
@@ -22,15 +23,18 @@ from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import robot, tree_runner
 from cyborg.monitor import Monitor
 from cyborg.monitor.robot_hub import ROBOT_LIMIT, RS_INTERVAL
+from cyborg.monitor.robot_source import MOUNT_GRACE
 from tests.monitor.monitor_protocol import local_client, next_json, receive_until
 from tests.monitor.robot_messages import (
     BEAMS,
     FakeMapRobot,
     battery,
+    footprint,
     map_geometry,
     path,
     pose,
     scan,
+    transforms,
 )
 from tests.monitor.test_map_store import parse_blob
 from tests.running_system import wait_until
@@ -152,6 +156,47 @@ def test_a_page_that_shows_the_map_gets_the_map_path_and_robot_state() -> None:
         assert len(with_scan["sc"]["r"]) == BEAMS and with_scan["seq"] > state["seq"]
         fake.path.publish(path([(3.0, 4.0)]))
         assert _until(socket, "path")["id"] == 2
+
+
+def test_scans_carry_the_lasers_mount_and_the_footprint_goes_once_per_change() -> None:
+    with robot_bus() as (monitor, fake), local_client(monitor.app) as client, \
+            client.websocket_connect("/ws") as socket:
+        fake.footprint.publish(footprint())
+        fake.tf_static.publish(transforms(("base_link", "laser", 0.267, 0.0, 0.0)))
+        _map_on(socket)
+        _followed(monitor, fake)
+        wait_until(lambda: _subscribed(monitor.node.context.graph, "/tf_static"), timeout=10.0)
+        fake.pose.publish(pose(1.0, 2.0, 0.5))
+        first = _until(socket, "rs", lambda m: "fp" in m)
+        assert first["fp"] == [0.3, 0.2, -0.3, 0.2, -0.3, -0.2, 0.3, -0.2]
+        fake.scan.publish(scan())
+        scanned = _until(socket, "rs", lambda m: "sc" in m)
+        assert scanned["sc"]["m"] == [0.267, 0.0, 0.0] and scanned["sc"]["mx"] == 30000
+        assert "fp" not in scanned, "the footprint goes once, not in every rs"
+        fake.footprint.publish(footprint())  # the same outline again: nothing to send
+        fake.footprint.publish(footprint([(0.5, 0.0), (-0.2, 0.3), (-0.2, -0.3)]))
+        changed = _until(socket, "rs", lambda m: "fp" in m)
+        assert changed["fp"] == [0.5, 0.0, -0.2, 0.3, -0.2, -0.3]
+        fake.pose.publish(pose(1.5, 2.0, 0.5))
+        assert "fp" not in _until(socket, "rs", lambda m: m["p"][0] == 1.5)
+        with client.websocket_connect("/ws") as other:  # a page that starts gets it at once
+            _map_on(other)
+            assert _until(other, "rs")["fp"] == changed["fp"]
+
+
+def test_scans_without_a_mount_are_a_warning_after_a_while() -> None:
+    with robot_bus() as (monitor, fake), local_client(monitor.app) as client, \
+            client.websocket_connect("/ws") as socket:
+        _map_on(socket)
+        _followed(monitor, fake)
+        fake.pose.publish(pose(1.0, 2.0, 0.5))
+        for _ in range(MOUNT_GRACE + 5):  # the monitor keeps the newest 2: not in a burst
+            fake.scan.publish(scan())
+            time.sleep(0.03)
+        warning = _until(socket, "robot_warn")
+        assert warning["kind"] == "scan" and warning["message"] == (
+            "scan: no /tf_static transform to its frame 'laser'; drawn from the robot's centre")
+        assert "m" not in _until(socket, "rs", lambda m: "sc" in m)["sc"]
 
 
 def test_a_fast_robot_is_throttled_to_about_12_states_a_second() -> None:

@@ -13,7 +13,9 @@ except :meth:`RobotHub.notify`, which the bus calls from its threads.
 * **Robot state** goes out as ``rs``, throttled per robot on the leading edge: at once when
   :data:`RS_INTERVAL` has passed since that robot's last one, else then. A 10 Hz robot passes
   unchanged, the simulator's 30 Hz becomes about 12 Hz. An ``rs`` carries the pose, and the
-  scan when a new one came; the path state, battery and the current path's id when known.
+  scan (with the laser's mount) when a new one came; the path state, battery and the current
+  path's id when known; the footprint only when it changed (and in the first ``rs`` a page
+  gets), as pages keep it.
 * **Paths** go out as ``path`` when a new one comes, at most one per :data:`PATH_INTERVAL` per
   robot; **maps** are laid out and gzipped in a worker thread (:mod:`cyborg.monitor.map_store`)
   and announced as ``map_ref`` (``key`` null when the robot's map was refused).
@@ -49,7 +51,7 @@ RS_INTERVAL = 0.08
 """Shortest time between two ``rs`` messages of one robot (s)."""
 PATH_INTERVAL = 0.5
 """Shortest time between two ``path`` messages of one robot (s)."""
-RS_KINDS = frozenset({"pose", "scan", "state", "battery"})
+RS_KINDS = frozenset({"pose", "scan", "state", "battery", "footprint"})
 """Changes that an ``rs`` message tells."""
 
 
@@ -65,6 +67,8 @@ class _Robot:
     """The path id last sent to the pages."""
     path_at: float = -float("inf")
     path_later: bool = False
+    footprint_sent: int = 0
+    """The footprint id last sent to the pages."""
     map: StoredMap | None = None
     building: bool = False
 
@@ -101,6 +105,18 @@ class RobotHub:
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         """Binds the hub to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
+
+    async def detach(self) -> None:
+        """Lets go of the event loop as the server stops.
+
+        Changes are dropped from now on, and maps being laid out are given up, so no work is
+        handed to the closing loop's threads.
+        """
+        self._loop = None
+        tasks = list(self._tasks)
+        for task in tasks:
+            task.cancel()
+        await asyncio.gather(*tasks, return_exceptions=True)
 
     # ------------------------------------------------------------------ robots
     async def periodic(self) -> None:
@@ -223,7 +239,11 @@ class RobotHub:
                 robot.path_later = True
                 self._loop.call_later(wait, self._path_due, source.namespace)
         if viewers and changes & (RS_KINDS | {"path"}):
-            self._send(viewers, self._rs_message(robot, scan="scan" in changes))
+            footprint = source.footprint_id != robot.footprint_sent
+            state = self._rs_message(robot, scan="scan" in changes, footprint=footprint)
+            if state is not None and "fp" in state:
+                robot.footprint_sent = source.footprint_id
+            self._send(viewers, state)
         if "warn" in changes:
             self._send_warnings(robot, viewers)
 
@@ -293,7 +313,7 @@ class RobotHub:
                 self._send([client], self._map_ref(robot))
             if source.path is not None:
                 self._send([client], self._path_message(robot))
-            self._send([client], self._rs_message(robot, scan=True))
+            self._send([client], self._rs_message(robot, scan=True, footprint=True))
             for kind, message, count in source.warnings.latest():
                 self._send([client], {"t": "robot_warn", "ns": source.namespace,
                                       "kind": kind, "message": message, "count": count})
@@ -314,7 +334,7 @@ class RobotHub:
         return {"t": "path", "ns": robot.source.namespace, "id": path["id"], "xy": path["xy"]}
 
     @staticmethod
-    def _rs_message(robot: _Robot, *, scan: bool) -> dict[str, Any] | None:
+    def _rs_message(robot: _Robot, *, scan: bool, footprint: bool) -> dict[str, Any] | None:
         source = robot.source
         pose = source.pose
         if pose is None:
@@ -324,6 +344,8 @@ class RobotHub:
                                    "p": pose}
         if scan and source.scan is not None:
             message["sc"] = source.scan
+        if footprint and source.footprint is not None:
+            message["fp"] = source.footprint
         if source.state is not None:
             message["st"] = source.state
         if source.battery is not None:

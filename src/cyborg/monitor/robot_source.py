@@ -2,19 +2,25 @@
 
 A :class:`RobotSource` subscribes, under the robot's namespace (``/cyborg`` by default; the
 names are those of :mod:`cyborg.interfaces.robot`), to ``pose``, ``scan``, ``path``,
-``arnl_path_state``, ``battery_status`` and ``map_geometry``. Its bus callbacks run on the
-monitor node's thread and only check, store and notify: each message goes through its function
-in :mod:`cyborg.monitor.robot_wire`, the result replaces the one kept (a message that cannot be
-drawn leaves it as it was), any warning goes to the robot's :class:`WarningLog`, and the
-listener hears ``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``, ``"state"``,
-``"battery"``, ``"map"``, ``"warn"``, ``"alive"``). The map is kept as the message itself:
-laying it out and compressing it is the hub's work, off the bus thread
+``arnl_path_state``, ``battery_status``, ``footprint`` and ``map_geometry``, and to the
+absolute ``/tf_static``. Its bus callbacks run on the monitor node's thread and only check,
+store and notify: each message goes through its function in :mod:`cyborg.monitor.robot_wire`,
+the result replaces the one kept (a message that cannot be drawn leaves it as it was), any
+warning goes to the robot's :class:`WarningLog`, and the listener hears
+``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``, ``"state"``,
+``"battery"``, ``"footprint"``, ``"map"``, ``"warn"``, ``"alive"``). The map is kept as the
+message itself: laying it out and compressing it is the hub's work, off the bus thread
 (:mod:`cyborg.monitor.map_store`).
 
-Liveness comes from the bus graph: the robot is alive while something publishes its pose.
+Each scan carries the laser's mount on the robot (``"m"``, see
+:func:`~cyborg.monitor.robot_wire.mount_of`): the ``/tf_static`` transform whose child frame is
+the scan's ``frame_id``, chained up to the robot's frame. ``/tf_static`` is one topic for the
+whole bus, so every robot's source hears every robot's transforms; frames are told apart by
+name only (the latest transform to a child frame wins), as in ROS without per-robot frame
+prefixes. Until the transform is known a scan goes without ``"m"`` (the page draws it from the
+robot's centre); after :data:`MOUNT_GRACE` such scans that is a warning, once per frame.
 
-The robot's footprint and the laser's mount (``tf_static``) join here once they are contracts
-of :mod:`cyborg.interfaces.robot`; until then the page draws the scan from the robot's centre.
+Liveness comes from the bus graph: the robot is alive while something publishes its pose.
 """
 
 from __future__ import annotations
@@ -28,19 +34,26 @@ from typing import Any
 
 from cyborg.bus import Node, Qos, Subscription
 from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry
-from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import robot
 from cyborg.monitor.robot_wire import (
+    FRAMES_KEPT,
+    Transforms,
     Warnings,
     battery_wire,
+    clip_text,
+    footprint_wire,
+    mount_of,
     path_wire,
     pose_wire,
     scan_wire,
     state_wire,
+    transforms_wire,
 )
 
 log = logging.getLogger("cyborg.monitor")
@@ -50,6 +63,9 @@ Listener = Callable[[str, str], None]
 
 WARNING_INTERVAL = 1.0
 """Shortest time between two warnings of one kind about one robot sent to the pages (s)."""
+MOUNT_GRACE = 20
+"""Scans without a known mount (``/tf_static`` may come after the first scans) before that is
+a warning."""
 
 
 @dataclass
@@ -122,7 +138,14 @@ class RobotSource:
         self.state: str | None = None
         """``arnl_path_state``'s text."""
         self.battery: dict[str, Any] | None = None
+        self.footprint: list[float] | None = None
+        """The robot's outline, ``[x0, y0, x1, y1, ...]`` (m, its own frame)."""
+        self.footprint_id = 0
+        """Counts the footprints that changed the one kept: the hub sends it when this grows."""
         self.warnings = WarningLog()
+        self._transforms: Transforms = {}
+        self._unmounted: dict[str, int] = {}
+        """Scans received per frame whose mount was not known yet (-1: warned)."""
         self.alive = False
         self._map: MapGeometry | None = None
         self._changes: set[str] = set()
@@ -135,6 +158,8 @@ class RobotSource:
             robot.PATH.subscription(node, self._on_path, ns),
             robot.PATH_STATE.subscription(node, self._on_state, ns),
             robot.BATTERY_STATUS.subscription(node, self._on_battery, ns),
+            robot.FOOTPRINT.subscription(node, self._on_footprint, ns),
+            robot.TF_STATIC.subscription(node, self._on_transforms),
             robot.MAP_GEOMETRY.subscription(node, self._on_map, ns),
         ]
         self._remove_graph_listener = node.context.graph.on_change(self._check_alive)
@@ -152,8 +177,39 @@ class RobotSource:
         scan, warnings = scan_wire(message)
         self._warn("scan", warnings)
         if scan is not None:
+            frame, _clipped = clip_text(message.header.frame_id)
+            mount = mount_of(frame, self._transforms)
+            if mount is not None:
+                scan["m"] = mount
+            else:
+                self._no_mount(frame)
             self.scan = scan
             self._mark("scan")
+
+    def _no_mount(self, frame: str) -> None:
+        seen = self._unmounted.get(frame, 0)
+        if seen < 0:
+            return
+        if seen + 1 < MOUNT_GRACE:
+            self._unmounted[frame] = seen + 1
+            return
+        self._unmounted[frame] = -1
+        self.warn("scan", f"scan: no /tf_static transform to its frame {frame!r}; drawn from "
+                          "the robot's centre")
+
+    def _on_footprint(self, message: PolygonStamped) -> None:
+        footprint, warnings = footprint_wire(message)
+        self._warn("footprint", warnings)
+        if footprint is not None and footprint != self.footprint:
+            self.footprint = footprint
+            self.footprint_id += 1
+            self._mark("footprint")
+
+    def _on_transforms(self, message: TFMessage) -> None:
+        transforms, warnings = transforms_wire(message)
+        self._warn("tf", warnings)
+        merged = {**self._transforms, **transforms}
+        self._transforms = merged if len(merged) <= FRAMES_KEPT else transforms
 
     def _on_path(self, message: Path) -> None:
         path, warnings = path_wire(message)

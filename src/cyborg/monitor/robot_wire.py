@@ -17,6 +17,9 @@ path           ``{"xy": [x0, y0, x1, y1, ...]}`` in whole mm, at most :data:`PAT
 battery        ``{"pct", "charging", "dock"}``: charge 0-100 (0.1), whether charging, the dock
                state's text
 path state     the text of ``arnl_path_state``
+footprint      ``[x0, y0, x1, y1, ...]``: the robot's outline in its own frame, m (1 mm)
+transforms     ``{child: (parent, [x, y, θ])}`` from ``/tf_static``; :func:`mount_of` chains them
+               into the laser's mount on the robot, ``[x, y, θ]`` (m, rad; 1 mm, 1 mrad)
 =============  ==================================================================================
 """
 
@@ -29,9 +32,10 @@ from typing import Any
 import numpy as np
 
 from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus
-from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
+from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 
 Warnings = list[str]
 
@@ -42,7 +46,22 @@ SCAN_BEAM_LIMIT = 8192
 PATH_LIMIT = 20_000
 """Most poses of a path sent to the page; longer paths are thinned evenly."""
 TEXT_LIMIT = 200
-"""Longest text (dock state, path state) passed on, in characters."""
+"""Longest text (dock state, path state, frame names) passed on, in characters."""
+FOOTPRINT_LIMIT = 256
+"""Most corners a footprint may have to be drawn (the Pioneer LX's has 12)."""
+BODY_LIMIT = 100.0
+"""Farthest a footprint corner or a fixed transform may reach from the robot's origin, in m."""
+TRANSFORM_LIMIT = 256
+"""Most transforms of one ``/tf_static`` message that are read."""
+FRAMES_KEPT = 1024
+"""Most child frames a robot's source remembers; beyond, it keeps only the latest message's."""
+CHAIN_LIMIT = 16
+"""Most transforms chained from the laser's frame up to the robot's (a loop ends there)."""
+
+Mount = list[float]
+"""``[x, y, θ]``: where a frame sits on the robot (m, rad)."""
+Transforms = dict[str, tuple[str, Mount]]
+"""Fixed transforms by child frame: ``{child: (parent, [x, y, θ])}``."""
 _MM = 1000.0
 
 
@@ -180,3 +199,75 @@ def state_wire(text: str) -> tuple[str, Warnings]:
     """The path state's text, clipped to :data:`TEXT_LIMIT` characters (with a warning)."""
     state, clipped = clip_text(text)
     return state, [f"state: arnl_path_state clipped to {TEXT_LIMIT} characters"] if clipped else []
+
+
+def footprint_wire(message: PolygonStamped) -> tuple[list[float] | None, Warnings]:
+    """The outline as ``[x0, y0, x1, y1, ...]`` (m, 1 mm); None with a warning when unusable.
+
+    An outline needs 3 to :data:`FOOTPRINT_LIMIT` corners, all finite and within
+    :data:`BODY_LIMIT` m of the robot's origin; otherwise the page keeps the one it has (the
+    Pioneer LX's until a good one comes).
+    """
+    corners = message.polygon.points
+    if not 3 <= len(corners) <= FOOTPRINT_LIMIT:
+        return None, [f"footprint: {len(corners):,} corners, not 3 to {FOOTPRINT_LIMIT}; "
+                      "footprint not drawn"]
+    xy = np.array([(float(corner.x), float(corner.y)) for corner in corners], np.float64)
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.isfinite(xy) & (np.abs(xy) <= BODY_LIMIT))
+    if bad.any():
+        return None, [f"footprint: {_number(float(xy[bad][0]))} m is not a corner within "
+                      f"{BODY_LIMIT:g} m; footprint not drawn"]
+    return [round(float(value), 3) for value in xy.reshape(-1)], []
+
+
+def _yaw(x: float, y: float, z: float, w: float) -> float:
+    """The rotation about z of the quaternion ``(x, y, z, w)`` (need not be normalised)."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def transforms_wire(message: TFMessage) -> tuple[Transforms, Warnings]:
+    """The transforms of a ``/tf_static`` message as ``{child: (parent, [x, y, θ])}``.
+
+    Only the plane matters to the map (z, roll and pitch are left out). A transform with a
+    value that is not finite, or more than :data:`BODY_LIMIT` m long, is left out with a
+    warning; so is everything past the first :data:`TRANSFORM_LIMIT`.
+    """
+    found: Transforms = {}
+    warnings: Warnings = []
+    transforms = message.transforms
+    if len(transforms) > TRANSFORM_LIMIT:
+        warnings.append(f"tf: {len(transforms):,} transforms in one message; the first "
+                        f"{TRANSFORM_LIMIT} read")
+    for stamped in transforms[:TRANSFORM_LIMIT]:
+        child, _clipped = clip_text(stamped.child_frame_id)
+        parent, _clipped = clip_text(stamped.header.frame_id)
+        shift, turn = stamped.transform.translation, stamped.transform.rotation
+        x, y = float(shift.x), float(shift.y)
+        rotation = (float(turn.x), float(turn.y), float(turn.z), float(turn.w))
+        if not all(_finite(value) for value in (x, y, *rotation)) \
+                or abs(x) > BODY_LIMIT or abs(y) > BODY_LIMIT:
+            warnings.append(f"tf: the transform {parent!r} -> {child!r} is not finite or longer "
+                            f"than {BODY_LIMIT:g} m; left out")
+            continue
+        found[child] = (parent, [x, y, _yaw(*rotation)])
+    return found, warnings
+
+
+def mount_of(frame: str, transforms: Transforms) -> Mount | None:
+    """Where ``frame`` sits on the robot, ``[x, y, θ]`` (1 mm, 1 mrad), or None if unknown.
+
+    The transforms are chained from ``frame`` up through its parents for as long as each parent
+    is itself some frame's child (at most :data:`CHAIN_LIMIT` steps); the last parent is the
+    robot's frame (``base_link`` for the simulator).
+    """
+    if frame not in transforms:
+        return None
+    x = y = theta = 0.0
+    seen: set[str] = set()
+    while frame in transforms and frame not in seen and len(seen) < CHAIN_LIMIT:
+        seen.add(frame)
+        frame, (px, py, ptheta) = transforms[frame]
+        cos, sin = math.cos(ptheta), math.sin(ptheta)
+        x, y, theta = px + cos * x - sin * y, py + sin * x + cos * y, ptheta + theta
+    return [round(x, 3), round(y, 3), round(_angle(theta), 3)]

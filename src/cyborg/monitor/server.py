@@ -70,6 +70,7 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
             periodic.cancel()
             with contextlib.suppress(asyncio.CancelledError):
                 await periodic
+            await hub.robot_hub.detach()
 
     files = files or page_files()
     exports = asyncio.Semaphore(EXPORTS_AT_ONCE)
