@@ -1,27 +1,22 @@
-"""Helpers for the map panel's browser tests: an ARNL map packed as the monitor's map blob,
-synthetic robot messages, and a stand-in monitor that serves the page's own files and lets the
-test speak for the monitor on the page's WebSocket.
-
-The blob layout (docs/monitor.md, "Map"): ``b"CYMAP\\0"``, a u16 version (1), a u32 header
-length, the JSON header (padded with spaces so the floats start on a multiple of 4), then
-float32 lines (x1 y1 x2 y2) and float32 points (x y), little-endian, in metres.
+"""Helpers for the map panel's browser tests: an ARNL map packed as the monitor's map blob (by
+the monitor's own code), synthetic robot messages in the monitor's wire format (docs/monitor.md,
+"The map's data path"), and a stand-in monitor that serves the page's own files and lets the
+test speak for the monitor on the page's WebSocket. The tests against the real system are
+tests/monitor/test_browser_map_live.py.
 """
 
 from __future__ import annotations
 
 import asyncio
-import hashlib
 import json
 import math
 import socket
-import struct
 import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import uvicorn
 from playwright.sync_api import Browser, Page
 from starlette.applications import Starlette
@@ -30,8 +25,10 @@ from starlette.responses import PlainTextResponse, Response
 from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from cyborg.monitor.map_store import map_blob
 from cyborg.monitor.page_files import page_files
 from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.map_message import map_geometry
 
 ROBOT = "/robot1"
 START = (-0.5, 0.8, 1.0)
@@ -42,36 +39,13 @@ PATH_XY = [-182, 176, -1000, 2000, -2500, 3500, -3196, 4846]
 BROKEN_KEY = "0123456789abcdef0123456789abcdef"
 """A map key whose blob is not a map."""
 
-CATEGORY_CODES = {"other": 0, "goal": 1, "goal_with_heading": 2, "dock": 3, "home": 4,
-                  "forbidden_line": 5, "forbidden_area": 6, "sim_obstacle": 7}
-"""MapObject.msg's category constants, by map_objects' category names."""
-
-
 def pack_map_blob(arnl_map: ArnlMap) -> bytes:
-    """``arnl_map`` in the blob layout the monitor serves at ``/api/map/{key}``."""
-    lines = np.ascontiguousarray(arnl_map.lines, dtype="<f4").reshape(-1)
-    points = np.ascontiguousarray(arnl_map.points, dtype="<f4").reshape(-1)
-    objects = []
-    for item in arnl_map.objects:
-        corners = item.corners()
-        objects.append({"kind": item.kind, "category": CATEGORY_CODES[item.category],
-                        "name": item.name, "description": item.description,
-                        "pose": [item.x, item.y, item.theta],
-                        "outline": [] if corners is None else corners.reshape(-1).tolist()})
-    resolution = arnl_map.header.get("Resolution", ["0"])[0]
-    header = json.dumps({
-        "source": Path(arnl_map.source).name, "bounds": list(arnl_map.bounds()),
-        "resolution": float(resolution) / 1000,
-        "counts": {"lines": len(lines) // 4, "points": len(points) // 2, "objects": len(objects)},
-        "objects": objects}, allow_nan=False).encode()
-    header += b" " * (-len(header) % 4)
-    return b"CYMAP\0\1\0" + struct.pack("<I", len(header)) + header + lines.tobytes() \
-        + points.tobytes()
-
-
-def map_key(blob: bytes) -> str:
-    """The monitor's key for a blob: the first 32 hex digits of its SHA-256."""
-    return hashlib.sha256(blob).hexdigest()[:32]
+    """``arnl_map`` as the monitor serves it at ``/api/map/{key}``: the simulator's
+    ``map_geometry`` message laid out by the monitor's own :func:`map_blob`, so the stand-in
+    cannot drift from the real thing."""
+    blob, _header, warnings = map_blob(map_geometry(arnl_map))
+    assert warnings == [], warnings
+    return blob
 
 
 def map_ref(ns: str, key: str, arnl_map: ArnlMap) -> dict[str, Any]:
@@ -88,7 +62,7 @@ def robot_state(ns: str, seq: int, x: float, y: float, theta: float, *,
     nothing (0) or were invalid (-1)."""
     ranges = [0 if i % 97 == 0 else -1 if i % 101 == 0 else
               int(reach_mm * (0.6 + 0.4 * math.sin(i / 23 + seq / 7))) for i in range(beams)]
-    scan = {"a0": -3 * math.pi / 4, "da": 3 * math.pi / 2 / (beams - 1), "mx": 30.0,
+    scan = {"a0": -3 * math.pi / 4, "da": 3 * math.pi / 2 / (beams - 1), "mx": 30000,
             "r": ranges, "m": [0.267, 0.0, 0.0]}
     return {"t": "rs", "ns": ns, "seq": seq, "p": [round(x, 3), round(y, 3), round(theta, 3)],
             "sc": scan, **extra}

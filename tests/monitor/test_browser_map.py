@@ -1,8 +1,10 @@
 """The map panel in headless Chromium (Debian's, driven by Playwright), fed by a stand-in
-monitor (tests/monitor/map_page.py) until the monitor itself publishes maps: columbia.map packed
-as the monitor's map blob, and synthetic robot messages. What is drawn (points, walls, objects,
-the robot in its colour, its scan and path) in the worker and on the main thread; zoom, pan,
-pinch, fit and follow; layer toggles kept; malformed messages as warnings, never errors."""
+monitor (tests/monitor/map_page.py) that speaks the monitor's wire format: columbia.map packed
+as the monitor's map blob (by the monitor's own code), and synthetic robot messages, so each
+case can be made at will (test_browser_map_live.py runs the page against the real system).
+What is drawn (points, walls, objects, the robot in its colour, its scan and path) in the
+worker and on the main thread; zoom, pan, pinch, fit and follow; layer toggles kept; malformed
+messages as warnings, never errors."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, Page, sync_playwright
 
+from cyborg.monitor.map_store import map_key
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from tests.conftest import shared_dir
 from tests.monitor.browser import ARTIFACTS, launch_chromium
@@ -24,7 +27,6 @@ from tests.monitor.map_page import (
     START,
     StandInMonitor,
     first_messages,
-    map_key,
     on_map,
     open_map_page,
     pack_map_blob,

@@ -2,16 +2,24 @@
 // latest state, and the warnings to show. Messages are applied here; the drawing modules
 // only read.
 //
-// Wire format (docs/monitor.md, "Map"), all from the monitor's WebSocket as JSON text:
+// Wire format (docs/monitor.md, "The map's data path"), from the monitor's WebSocket as JSON:
 //   {t:"map_ref", ns, key, url, source, counts:{points, lines, objects}}
-//       the robot `ns` is on the map `key`; its blob is at `url` (GET /api/map/{key}, immutable)
-//   {t:"rs", ns, seq, p:[x, y, θ], sc?, node?, st?, goal?, bat?, pid?, fp?}
+//       the robot `ns` is on the map `key`; its blob is at /api/map/{key} (immutable); key null:
+//       the robot's map was refused (it has none to show now)
+//   {t:"rs", ns, seq, p:[x, y, θ], sc?, st?, bat?, pid?, fp?, node?, goal?}
 //       a robot's state: pose in m and rad; sc = {a0, da, mx, r:[mm], m?:[x, y, θ]} a laser
-//       scan (r: 0 = no return, -1 = invalid, m: the laser's mount on the robot); st the path
-//       state (PLANNING_PATH, MOVING_TO_GOAL, REACHED_GOAL ...); goal = {name?, p:[x, y, θ]};
-//       pid the id of the path being followed; fp the footprint, x y ... in m, robot frame
+//       scan (a0, da in rad; mx range_max in mm; r: 0 = no return, -1 = invalid; m the laser's
+//       mount on the robot, m and rad; none: the robot's centre); st the path state
+//       (PLANNING_PATH, MOVING_TO_GOAL, REACHED_GOAL ...); bat = {pct, charging, dock};
+//       pid the id of the path being followed; fp the footprint, x y ... in m in the robot's
+//       frame, sent when it changed (kept until the next); node (the running node's label) and
+//       goal = {name?, p:[x, y, θ]} are read when present (the monitor does not send them yet)
 //   {t:"path", ns, id, xy:[x y ... in mm]}   the planned path (latched: paired with st, pid)
 //   {t:"robot_warn", ns, kind, message, count}   something the monitor refused or mended
+//   {t:"robots", ..., map_robots:[{ns, tree, alive, map}]}   (app.js's message) which tree drives
+//       which robot, and whether the robot is on the bus; read by MapPanel.pairRobots
+// Old or missing fields are tolerated: bat.charge for bat.pct, a `robot` field in the robots
+// list's tree entries for map_robots.
 //
 // The blob (parseMapBlob): 8 bytes "CYMAP\0" + u16 version 1, a u32 header length H, H bytes of
 // JSON header {source, bounds:[x0, y0, x1, y1], resolution, counts:{lines, points, objects},
@@ -155,6 +163,7 @@ export class MapModel {
     this.refs = new Map(); // robot ns -> {key, url, source, counts}
     this.robots = new Map(); // robot ns -> state (see robot())
     this.warnings = []; // {ns, kind, message, count, at}, newest first
+    this.alive = new Map(); // robot ns -> whether it is on the bus (the monitor's map_robots)
     this.version = 0; // bumped by every change the drawing should see
   }
 
@@ -200,7 +209,7 @@ export class MapModel {
     let robot = this.robots.get(ns);
     if (!robot) {
       robot = {
-        ns, seq: null, pose: null, scan: null, scanCount: 0, footprint: DEFAULT_FOOTPRINT,
+        ns, seq: null, pose: null, scan: null, scanCount: 0, mount: null, footprint: DEFAULT_FOOTPRINT, alive: this.alive.get(ns) ?? true,
         node: "", state: "", goal: null, battery: null, pathId: null, path: null, progress: null, colour: PALETTE[0],
       };
       this.robots.set(ns, robot);
@@ -208,6 +217,17 @@ export class MapModel {
       for (const [name, each] of this.robots) each.colour = PALETTE[names.indexOf(name) % PALETTE.length];
     }
     return robot;
+  }
+
+  // Whether the robot `ns` is on the bus; kept for robots the page has not heard of yet (they
+  // get no colour until they send something to draw).
+  setAlive(ns, alive) {
+    if (this.alive.get(ns) === alive) return;
+    this.alive.set(ns, alive);
+    if (this.alive.size > 64) this.alive.delete(this.alive.keys().next().value);
+    const robot = this.robots.get(ns);
+    if (robot) robot.alive = alive;
+    this.version += 1;
   }
 
   robotState(message) {
@@ -223,13 +243,13 @@ export class MapModel {
     const robot = this.robot(ns);
     robot.seq = seq;
     robot.pose = { x: pose[0], y: pose[1], th: pose[2] };
-    if (scan) [robot.scan, robot.scanCount] = scan;
+    if (scan) [robot.scan, robot.scanCount, robot.mount] = scan;
     else if (message.sc === null) robot.scanCount = 0;
     if (footprint) robot.footprint = footprint;
     if ("node" in message) robot.node = text(message.node);
     if ("st" in message) robot.state = text(message.st, 40);
     if ("goal" in message) robot.goal = goal;
-    if ("bat" in message) robot.battery = message.bat && typeof message.bat === "object" ? message.bat : null;
+    if ("bat" in message) robot.battery = batteryOf(message.bat);
     if ("pid" in message) robot.pathId = message.pid;
     if (robot.path) robot.progress = pathProgress(robot.path, robot.pose, robot.progress);
   }
@@ -252,6 +272,11 @@ export class MapModel {
 
   mapRef(message) {
     const ns = namespace(message);
+    if (message.key === null) {
+      this.refs.delete(ns); // the robot's new map was refused: it is on no map the page has
+      this.robot(ns);
+      return;
+    }
     if (typeof message.key !== "string" || !/^[0-9a-f]{8,64}$/.test(message.key)) throw new Error(`key is not a map key (${short(message.key)})`);
     // The blob comes from this monitor only: /api/map/<key>, whatever the message says.
     const url = `/api/map/${message.key}`;
@@ -271,14 +296,16 @@ export class MapModel {
   }
 }
 
-// The scan's hit points in the map frame, through the laser's mount: [Float32Array, count].
+// The scan's hit points in the map frame, through the laser's mount: [Float32Array, count,
+// the mount [x, y, θ] or null when the monitor gave none].
 function scanEndpoints(scan, pose) {
   if (!scan || typeof scan !== "object") throw new Error("sc is not an object");
   const a0 = finite(scan.a0, "sc.a0"), da = finite(scan.da, "sc.da");
   const ranges = scan.r;
   if (!Array.isArray(ranges)) throw new Error("sc.r is not a list");
   if (ranges.length > MAX_BEAMS) throw new Error(`sc.r has ${ranges.length} beams, more than ${MAX_BEAMS}`);
-  const mount = scan.m === undefined ? [0, 0, 0] : triple(scan.m, "sc.m");
+  const given = scan.m !== undefined && scan.m !== null;
+  const mount = given ? triple(scan.m, "sc.m") : [0, 0, 0];
   const [x, y, th] = pose;
   const cos = Math.cos(th), sin = Math.sin(th);
   const lx = x + cos * mount[0] - sin * mount[1], ly = y + sin * mount[0] + cos * mount[1];
@@ -293,12 +320,19 @@ function scanEndpoints(scan, pose) {
     out[2 * n + 1] = ly + metres * Math.sin(angle);
     n += 1;
   }
-  return [out, n];
+  return [out, n, given ? mount : null];
 }
 
 function outline(value, name) {
   if (!Array.isArray(value) || value.length < 6 || value.length > 512 || value.length % 2) throw new Error(`${name} is not an outline of x y pairs`);
   return Float32Array.from(value, (v, i) => finite(v, `${name}[${i}]`));
+}
+
+// {pct, charging, dock} (pct a finite 0-100 or null); `charge` is the old name of `pct`.
+function batteryOf(bat) {
+  if (!bat || typeof bat !== "object") return null;
+  const pct = Number.isFinite(bat.pct) ? bat.pct : Number.isFinite(bat.charge) ? bat.charge : null;
+  return { pct: pct === null ? null : Math.min(100, Math.max(0, pct)), charging: bat.charging === true, dock: text(bat.dock ?? bat.dock_state, 40) };
 }
 
 function goalOf(goal) {

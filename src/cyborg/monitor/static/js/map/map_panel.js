@@ -13,7 +13,10 @@
 //
 // `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
 // {points, lines, objects}, moving: {robots, laser, paths}, warnings, toScreen(x, y),
-// toWorld(sx, sy), view(), colourOf(ns), fetches, renders, where, frameMs, messageMs}.
+// toWorld(sx, sy), view(), colourOf(ns), robot(ns), fetches, renders, where, frameMs,
+// messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
+// battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
+// is), or null.
 
 import { Hud } from "./hud.js";
 import { MapModel, parseMapBlob } from "./map_model.js";
@@ -64,6 +67,7 @@ export class MapPanel {
       toWorld: (sx, sy) => this.view.toWorld(sx, sy),
       view: () => this.view.snapshot(),
       colourOf: (ns) => this.model.robots.get(ns)?.colour ?? null,
+      robot: (ns) => describe(this.model, this.model.robots.get(ns)),
     };
     this.view.attach(this.canvas, {
       onChange: () => this.schedule(),
@@ -88,7 +92,7 @@ export class MapPanel {
   receive(message) {
     const started = performance.now();
     if (message && message.t === "error" && message.command === "map") return true; // a monitor without maps
-    if (message && message.t === "robots") this.pairRobots(message.robots);
+    if (message && message.t === "robots") this.pairRobots(message);
     const type = this.model.receive(message);
     if (type === null) return false;
     if (type === "map_ref") this.loadMaps();
@@ -124,11 +128,22 @@ export class MapPanel {
     this.schedule();
   }
 
-  pairRobots(robots) {
-    if (!Array.isArray(robots)) return;
-    for (const entry of robots) {
-      if (entry && typeof entry.ns === "string" && typeof entry.robot === "string") this.pairs.set(entry.ns, entry.robot);
+  // The monitor's robots message: map_robots [{ns, tree, alive, map}] pairs each robot with the
+  // tree runner that drives it and says whether it is on the bus (an older monitor's `robot`
+  // field in the tree entries is read too).
+  pairRobots(message) {
+    const robots = Array.isArray(message.map_robots) ? message.map_robots : [];
+    const pairs = new Map();
+    for (const entry of Array.isArray(message.robots) ? message.robots : []) {
+      if (entry && typeof entry.ns === "string" && typeof entry.robot === "string") pairs.set(entry.ns, entry.robot);
     }
+    for (const entry of robots) {
+      if (!entry || typeof entry.ns !== "string") continue;
+      if (typeof entry.tree === "string") pairs.set(entry.tree, entry.ns);
+      if (typeof entry.alive === "boolean") this.model.setAlive(entry.ns, entry.alive);
+    }
+    this.pairs = pairs;
+    this.schedule();
   }
 
   selected() {
@@ -273,4 +288,16 @@ export class MapPanel {
       if (seqs) this.stats.paintTimes.push([now, seqs]);
     }, 0));
   }
+}
+
+function describe(model, robot) {
+  if (!robot) return null;
+  const xy = robot.path?.xy;
+  const end = xy && xy.length ? [xy[xy.length - 2], xy[xy.length - 1]] : null;
+  return {
+    pathShown: model.pathShown(robot), toGo: end && robot.pose ? Math.hypot(end[0] - robot.pose.x, end[1] - robot.pose.y) : null,
+    ns: robot.ns, pose: robot.pose && { ...robot.pose }, mount: robot.mount, footprint: [...robot.footprint],
+    battery: robot.battery && { ...robot.battery }, alive: robot.alive, state: robot.state, pathId: robot.pathId,
+    path: robot.path ? robot.path.xy.length / 2 : 0, scan: robot.scanCount, colour: robot.colour,
+  };
 }

@@ -6,11 +6,14 @@
 // changed: a robot moving does not repaint the map under it. The upper one is cleared and
 // drawn every frame: planned paths (the part already travelled faded), the current goal,
 // laser hits, robots (footprint in the robot's colour, heading as a white arrow), then names.
+// A robot that left the bus (the monitor's map_robots says it is not alive) is drawn faded,
+// without its laser, where it was last seen.
 //
 // Everything here is in CSS pixels: the context is scaled by the device pixel ratio once.
 
 const MIN_ROBOT_PX = 14; // a robot is never drawn smaller than this, however far out
 const DOT_PX = 2;
+const GONE_ALPHA = 0.35;
 
 // The lower canvas: the static bitmap at `placement` (StaticLayer.placement()), or nothing.
 export function drawBitmap(ctx, view, placement, dpr) {
@@ -36,12 +39,14 @@ export function drawMoving(ctx, scene) {
     if (robot.goal && scene.model.travelling(robot)) drawGoal(ctx, view, robot);
   }
   if (layers.laser) {
-    for (const robot of scene.robots) drawn.laser += drawScan(ctx, view, robot);
+    for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
   }
   if (layers.robots) {
     for (const robot of scene.robots) {
       if (!robot.pose) continue;
+      ctx.globalAlpha = robot.alive ? 1 : GONE_ALPHA;
       drawRobot(ctx, view, robot, robot.ns === scene.selected && scene.robots.length > 1);
+      ctx.globalAlpha = 1;
       drawn.robots += 1;
     }
     if (layers.labels) for (const robot of scene.robots) if (robot.pose) drawName(ctx, view, robot);
@@ -165,22 +170,34 @@ function drawRobot(ctx, view, robot, selected) {
   ctx.fill();
 }
 
-// The robot's name, and what it is doing (the running node, the battery) under it.
+// The robot's name with its battery (⚡ while charging, the dock state unless undocked), and
+// what it is doing (the running node) under it.
 function drawName(ctx, view, robot) {
   const [sx, sy] = view.toScreen(robot.pose.x, robot.pose.y);
-  const charge = robot.battery && Number.isFinite(robot.battery.charge) ? ` · ${Math.round(robot.battery.charge)} %` : "";
-  const lines = [robot.ns + charge];
+  const lines = [robot.ns + batteryText(robot.battery) + (robot.alive ? "" : " (offline)")];
   if (robot.node) lines.push(robot.node.length > 40 ? `${robot.node.slice(0, 39)}…` : robot.node);
-  ctx.font = 'bold 12px system-ui, "DejaVu Sans", sans-serif';
+  const fonts = ['bold 12px system-ui, "DejaVu Sans", sans-serif', '11px system-ui, "DejaVu Sans", sans-serif'];
+  // right of the robot, or left of it where the right edge would cut the text
+  const widest = Math.max(...lines.map((text, i) => { ctx.font = fonts[i]; return ctx.measureText(text).width; }));
+  const left = sx + 14 + widest > view.width - 4 && sx - 14 - widest >= 4;
   ctx.textBaseline = "middle";
+  ctx.textAlign = left ? "right" : "left";
   ctx.lineJoin = "round";
   lines.forEach((text, i) => {
-    const px = sx + 14, py = sy - 14 + i * 14;
-    if (i === 1) ctx.font = '11px system-ui, "DejaVu Sans", sans-serif';
+    const px = left ? sx - 14 : sx + 14, py = sy - 14 + i * 14;
+    ctx.font = fonts[i];
     ctx.lineWidth = 3;
     ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
     ctx.strokeText(text, px, py);
     ctx.fillStyle = i === 0 ? robot.colour : "#3c4043";
     ctx.fillText(text, px, py);
   });
+  ctx.textAlign = "left";
+}
+
+function batteryText(battery) {
+  if (!battery) return "";
+  const charge = battery.pct === null ? "" : ` · ${Math.round(battery.pct)} %`;
+  const dock = battery.dock && battery.dock !== "UNDOCKED" ? ` · ${battery.dock.toLowerCase()}` : "";
+  return `${charge}${battery.charging ? " ⚡" : ""}${dock}`;
 }
