@@ -5,10 +5,13 @@
 // latency benchmark (`structures`: structures received; `laidOut`: how many had been received
 // when the tree was last laid out).
 
+import { say, showBanner, showToolbar, showTrees } from "./chrome.js";
 import { Connection, keepSeatSecret } from "./connection.js";
+import { saveView } from "./export.js";
+import { History } from "./history.js";
 import { Layout } from "./layout.js";
 import { MapPanel } from "./map/map_panel.js";
-import { TreeModel, stateAt } from "./model.js";
+import { TreeModel } from "./model.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
 
@@ -33,9 +36,10 @@ const page = {
   matches: [],
   matchAt: -1,
   blackboard: null,
-  history: null, // { ticks, position } while scrubbing
   connected: false,
 };
+const toolbar = () => showToolbar(page, model);
+const banner = () => showBanner(page, model);
 let needsLayout = true;
 let dirty = null; // Set of ids to repaint, or "all"
 let layoutKey = "";
@@ -62,6 +66,8 @@ const mapPanel = new MapPanel($("map-view"), { post: (message) => connection.pos
 const layout = new Layout({ onMapShown: (shown) => mapPanel.setVisible(shown) });
 mapPanel.onEmpty = (empty) => layout.setMapEmpty(empty);
 new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("tree"));
+// The ticks the monitor kept, one at a time (js/history.js); `tickHistory.state` is null while live.
+const tickHistory = new History({ onShow: () => markDirty("all"), say });
 
 // ------------------------------------------------------------------ messages
 function receive(message) {
@@ -95,7 +101,7 @@ function receive(message) {
       stats.frames += 1;
       stats.tick = model.tick;
       if (changed.activeChanged && visibleKey() !== layoutKey) needsLayout = true;
-      if (needsLayout || page.history) {
+      if (needsLayout || tickHistory.state) {
         markDirty(changed);
       } else {
         // Class changes are cheap and the browser draws them in its next frame anyway:
@@ -118,7 +124,7 @@ function receive(message) {
       break;
     case "robots":
       page.robots = message.robots;
-      robotList();
+      showTrees(page);
       break;
     case "seat":
       page.seat = message;
@@ -139,7 +145,7 @@ function receive(message) {
       }
       break;
     case "history":
-      startHistory(message);
+      tickHistory.start(message, model.version);
       break;
     case "error":
       say(message.message, true);
@@ -169,14 +175,14 @@ function schedule() {
 
 function render(fromFrame = false) {
   if (fromFrame) scheduled = false;
-  if (page.history && !needsLayout && dirty !== "all" && !fromFrame) return;
+  if (tickHistory.state && !needsLayout && dirty !== "all" && !fromFrame) return;
   const started = performance.now();
   const relaid = needsLayout;
   if (needsLayout) {
     needsLayout = false;
     dirty = null;
     layoutKey = visibleKey();
-    stats.drawn = model.root ? view.draw(model.root, isOpen, page.history ? historyLook() : liveLook()) : view.clear();
+    stats.drawn = model.root ? view.draw(model.root, isOpen, tickHistory.state ? historyLook() : liveLook()) : view.clear();
     // folded nodes with part of the running path inside are known only once drawn
     dirty = new Set(model.active.flatMap((id) => model.ancestors(id)));
     stats.draws += 1;
@@ -186,7 +192,7 @@ function render(fromFrame = false) {
     if (page.selected) view.markClass("selected", new Set([page.selected]));
   }
   if (dirty !== null) {
-    const shown = page.history ? historyLook() : liveLook();
+    const shown = tickHistory.state ? historyLook() : liveLook();
     view.paint(dirty === "all" ? null : dirty, shown);
     dirty = null;
     if (page.selected) showNode(model, page.selected, page.hooks);
@@ -211,7 +217,7 @@ function liveLook() {
 }
 
 function historyLook() {
-  const state = stateAt(page.history.ticks, page.history.position, model.ids.length);
+  const state = tickHistory.at(model.ids.length);
   const active = new Set(state.active.map((index) => model.ids[index]));
   return { code: (id) => state.codes[model.indexOf.get(id)] ?? 0, active, inside: insideActive([...active]), hooked: new Set(), pausedAt: "" };
 }
@@ -270,65 +276,14 @@ function select(id) {
 
 function tickInfo() {
   const names = ["", "success", "failure", "running", "error"];
-  const source = page.history ? stateAt(page.history.ticks, page.history.position, 0) : model;
-  const root = page.history ? source.root : model.rootStatus;
+  const source = tickHistory.state ? tickHistory.at(0) : model;
+  const root = tickHistory.state ? source.root : model.rootStatus;
   $("tickinfo").textContent = model.root
     ? `${page.title || ""} · tick ${source.tick} · t = ${Number(source.time).toFixed(2)} s · ${Number(source.duration).toFixed(3)} ms · ${names[root] || "–"} · ${stats.drawn} of ${model.ids.length} nodes drawn`
     : "";
 }
 
-// ------------------------------------------------------------------ toolbar and banners
-function toolbar() {
-  const seat = page.seat;
-  const mayAct = seat.control && page.alive;
-  for (const button of document.querySelectorAll("button.control")) button.disabled = !mayAct;
-  const run = $("run");
-  run.textContent = page.enabled === false ? "▶ Run" : "❚❚ Pause";
-  run.dataset.enabled = String(page.enabled);
-  run.disabled = !mayAct || page.enabled === null;
-  const seatLabel = $("seat");
-  seatLabel.className = `seat ${seat.control ? "control" : "view"}`;
-  seatLabel.textContent = seat.control ? "You have control" : seat.may_control ? (seat.holder ? "Another page has control" : "View only") : "View only";
-  $("take").hidden = !(seat.may_control && !seat.control);
-  $("paused").hidden = !page.pausedAt;
-  const pausedNode = model.byId.get(page.pausedAt);
-  $("paused-node").textContent = pausedNode ? pausedNode.label || pausedNode.name : page.pausedAt;
-}
-
-function banner() {
-  const el = $("banner");
-  let text = "";
-  el.className = "";
-  if (!page.connected) text = "Connection to the monitor lost — reconnecting…";
-  else if (page.problem) text = page.problem;
-  else if (!page.alive) {
-    text = `The tree runner ${page.ns || ""} is not running — waiting for it to come back.`;
-    el.className = "info";
-  }
-  el.textContent = text;
-  el.hidden = !text;
-  toolbar();
-}
-
-function robotList() {
-  const select = $("robot");
-  const current = page.ns;
-  select.innerHTML = "";
-  for (const robot of page.robots) {
-    const option = document.createElement("option");
-    option.value = robot.ns;
-    option.textContent = `${robot.ns}${robot.title ? ` — ${robot.title}` : ""}${robot.alive ? "" : " (offline)"}`;
-    select.append(option);
-  }
-  if (current) select.value = current;
-}
-
-function say(text, error = false) {
-  const el = $("message");
-  el.textContent = text;
-  el.className = error ? "error" : "";
-}
-
+// ------------------------------------------------------------------ commands
 async function command(body) {
   const result = await connection.send(body);
   say(result.message, !result.ok);
@@ -367,33 +322,6 @@ function applySearch(jump) {
   }
 }
 
-// ------------------------------------------------------------------ history
-function startHistory(message) {
-  if (message.v !== model.version || !message.ticks.length) { say("no ticks recorded yet"); return; }
-  page.history = { ticks: message.ticks, position: message.ticks.length - 1 };
-  const scrub = $("scrub");
-  scrub.max = String(message.ticks.length - 1);
-  scrub.value = scrub.max;
-  scrub.disabled = false;
-  $("live").disabled = false;
-  showHistory();
-}
-
-function showHistory() {
-  const { ticks, position } = page.history;
-  const [tick, time] = ticks[position];
-  $("scrub-info").textContent = `tick ${tick} (t = ${time.toFixed(2)} s), ${ticks.length - 1 - position} ticks before the latest recorded`;
-  markDirty("all");
-}
-
-function goLive() {
-  page.history = null;
-  $("scrub").disabled = true;
-  $("live").disabled = true;
-  $("scrub-info").textContent = "";
-  markDirty("all");
-}
-
 // ------------------------------------------------------------------ wiring
 $("robot").addEventListener("change", (event) => {
   page.ns = event.target.value;
@@ -401,7 +329,7 @@ $("robot").addEventListener("change", (event) => {
   page.folded.clear();
   page.opened.clear();
   page.selected = null;
-  goLive();
+  tickHistory.live();
   connection.post({ t: "watch", ns: page.ns });
 });
 $("run").addEventListener("click", () => command({ t: "enable", on: page.enabled === false }));
@@ -419,12 +347,6 @@ $("take").addEventListener("click", () => command({ t: "claim", force: true }));
 $("step").addEventListener("click", () => command({ t: "step" }));
 $("resume").addEventListener("click", () => command({ t: "resume" }));
 $("history").addEventListener("click", () => connection.post({ t: "history" }));
-$("live").addEventListener("click", goLive);
-$("scrub").addEventListener("input", (event) => {
-  if (!page.history) return;
-  page.history.position = Number(event.target.value);
-  showHistory();
-});
 $("bb-filter").addEventListener("input", () => { if (page.blackboard) showBlackboard(page.blackboard, $("bb-filter").value, nodeName); });
 for (const button of document.querySelectorAll("#inspector button[data-action]")) {
   button.addEventListener("click", () => {
@@ -443,21 +365,8 @@ async function exportView(format) {
     const node = model.byId.get(id);
     return node && node.children.length && !isOpen(node);
   });
-  const response = await fetch("/api/export", {
-    method: "POST",
-    headers: { "Content-Type": "application/json" },
-    body: JSON.stringify({ ns: page.ns, format, collapsed }),
-  });
-  if (!response.ok) { say((await response.json()).error, true); return; }
-  const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `tree.${format}`;
-  const link = document.createElement("a");
-  link.href = URL.createObjectURL(await response.blob());
-  link.download = name;
-  document.body.append(link);
-  link.click();
-  link.remove();
-  setTimeout(() => URL.revokeObjectURL(link.href), 10000);
-  say(`saved ${name}`);
+  const result = await saveView({ ns: page.ns, format, collapsed });
+  say(result.message, !result.ok);
 }
 
 toolbar();
