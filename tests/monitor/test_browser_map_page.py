@@ -226,3 +226,22 @@ def test_first_paint_and_frame_cost(browser: Browser, columbia: tuple[ArnlMap, b
 def _metrics(cdp: Any) -> dict[str, float]:
     found = cdp.send("Performance.getMetrics")["metrics"]
     return {item["name"]: item["value"] for item in found}
+
+
+def test_the_maps_code_comes_after_the_trees_first_paint(browser: Browser) -> None:
+    """The map panel's modules are fetched only once the tree is on screen (lazy_panel.js), so
+    the map never delays the tree's first paint; the map is drawn all the same."""
+    with live_system() as live:
+        page = browser.new_page(viewport={"width": 1400, "height": 820})
+        page.goto(live.url)
+        page.wait_for_function("window.__map && window.__map.firstPaint !== null",
+                               timeout=30000)
+        first_paint = page.evaluate("window.__monitor.firstPaint - performance.timeOrigin")
+        fetched: dict[str, float] = page.evaluate(  # when each file's request started (ms)
+            "Object.fromEntries(performance.getEntriesByType('resource')"
+            ".map(e => [e.name.split('/').pop(), e.startTime]))")
+        assert "map_panel.js" in fetched and "lazy_panel.js" in fetched
+        assert fetched["map_panel.js"] >= first_paint
+        assert fetched["lazy_panel.js"] < first_paint
+        assert page.evaluate("window.__map.drawn.points") > 0
+        page.close()
