@@ -11,7 +11,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page
 
 from cyborg.app.launchables import KINDS
 from cyborg.bt.node import Node as BtNode
@@ -26,7 +26,6 @@ from tests.monitor.browser import (
     CAMPUS_TREE,
     Live,
     active_on_page,
-    launch_chromium,
     live_system,
     open_page,
     screenshot,
@@ -34,14 +33,6 @@ from tests.monitor.browser import (
 from tests.running_system import wait_until
 
 pytestmark = pytest.mark.heavy
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 @pytest.fixture

@@ -10,55 +10,27 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page
 
-from cyborg.monitor.map_store import map_key
-from cyborg.nav.arnl_map import ArnlMap, read_map
+from cyborg.nav.arnl_map import read_map
 from tests.conftest import shared_dir
-from tests.monitor.browser import ARTIFACTS, launch_chromium
+from tests.monitor.browser import ARTIFACTS
 from tests.monitor.map_page import (
-    BROKEN_KEY,
     PATH_XY,
     ROBOT,
     START,
     StandInMonitor,
-    first_messages,
     on_map,
     open_map_page,
-    pack_map_blob,
     pixel,
     rgb,
     robot_state,
 )
 
 pytestmark = pytest.mark.heavy
-
-
-@pytest.fixture(scope="module")
-def columbia() -> tuple[ArnlMap, bytes, str]:
-    arnl_map = read_map(shared_dir() / "maps" / "columbia.map")
-    blob = pack_map_blob(arnl_map)
-    return arnl_map, blob, map_key(blob)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
-
-
-@pytest.fixture
-def server(columbia: tuple[ArnlMap, bytes, str]) -> Iterator[StandInMonitor]:
-    arnl_map, blob, key = columbia
-    with StandInMonitor({key: blob, BROKEN_KEY: b"GIF89a, not a map at all"},
-                        on_map=first_messages(arnl_map, key)) as running:
-        yield running
 
 
 def _canvas_origin(page: Page) -> tuple[float, float]:

@@ -12,12 +12,11 @@ from __future__ import annotations
 import json
 import math
 import urllib.request
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page
 
 from cyborg.bus import Node
 from cyborg.interfaces import robot
@@ -25,7 +24,6 @@ from cyborg.nav.arnl_map import read_map
 from tests.monitor.browser import (
     CAMPUS_MAP,
     Live,
-    launch_chromium,
     live_system,
     open_page,
     screenshot,
@@ -37,14 +35,6 @@ from tests.running_system import wait_until
 pytestmark = pytest.mark.heavy
 
 ROBOT = "/cyborg"
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 def _open(browser: Browser, live: Live, errors: list[str]) -> Page:

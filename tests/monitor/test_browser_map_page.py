@@ -10,54 +10,25 @@ import math
 import statistics
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from playwright.sync_api import Browser, sync_playwright
+from playwright.sync_api import Browser
 
-from cyborg.monitor.map_store import map_key
-from cyborg.nav.arnl_map import ArnlMap, read_map
-from tests.conftest import shared_dir
-from tests.monitor.browser import ARTIFACTS, launch_chromium, live_system, open_page
+from cyborg.nav.arnl_map import ArnlMap
+from tests.monitor.browser import ARTIFACTS, live_system, open_page
 from tests.monitor.map_page import (
-    BROKEN_KEY,
     START,
     StandInMonitor,
-    first_messages,
     map_ref,
     on_map,
     open_map_page,
-    pack_map_blob,
     robot_state,
     wait_for,
 )
 
 pytestmark = pytest.mark.heavy
-
-
-@pytest.fixture(scope="module")
-def columbia() -> tuple[ArnlMap, bytes, str]:
-    arnl_map = read_map(shared_dir() / "maps" / "columbia.map")
-    blob = pack_map_blob(arnl_map)
-    return arnl_map, blob, map_key(blob)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
-
-
-@pytest.fixture
-def server(columbia: tuple[ArnlMap, bytes, str]) -> Iterator[StandInMonitor]:
-    arnl_map, blob, key = columbia
-    with StandInMonitor({key: blob, BROKEN_KEY: b"GIF89a, not a map at all"},
-                        on_map=first_messages(arnl_map, key)) as running:
-        yield running
 
 
 def test_phone_tabs_map_first(browser: Browser, server: StandInMonitor, tmp_path: Path) -> None:
