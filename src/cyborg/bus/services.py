@@ -41,10 +41,9 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Generic
 
-import numpy as np
 import zenoh
-from rosbags.interfaces import Nodetype
 
+from cyborg.bus.field_check import field_problem, one_line
 from cyborg.bus.typed import RequestT, ResponseT
 from cyborg.bus.wire import (
     Attachment,
@@ -57,7 +56,6 @@ from cyborg.bus.wire import (
 )
 
 if TYPE_CHECKING:
-    from cyborg.bus.message_types import MessageTypes
     from cyborg.bus.node import Node
 
 log = logging.getLogger("cyborg.bus")
@@ -82,7 +80,7 @@ class RequestError(ServiceError):
     """
 
     def __init__(self, field: str, reason: str, service: str = "") -> None:
-        self.field, self.reason, self.service = field, _one_line(reason), service
+        self.field, self.reason, self.service = field, one_line(reason), service
         self.detail = f"{field}: {self.reason}" if field else self.reason
         super().__init__(f"service {service}: bad request: {self.detail}" if service
                          else f"bad request: {self.detail}")
@@ -93,83 +91,6 @@ MAX_PENDING_REQUESTS = 64
 """Requests one server queues while its handler is busy; more are answered "busy" at once
 (a flood of calls must not grow a node's memory without bound). ``server.max_pending`` changes
 it for one server."""
-_MAX_ERROR = 300  # characters of an error text that travel
-
-
-def _one_line(text: str, limit: int = _MAX_ERROR) -> str:
-    """The first line of ``text``, control characters escaped, at most ``limit`` characters.
-
-    That is what may travel between a server and a caller's terminal (never a traceback).
-    """
-    first = text.strip().split("\n", 1)[0].strip()
-    first = "".join(char if char.isprintable() else f"\\x{ord(char):02x}"
-                    if ord(char) < 256 else f"\\u{ord(char):04x}" for char in first)
-    return first if len(first) <= limit else first[: limit - 1] + "…"
-
-
-def field_problem(types: MessageTypes, type_name: str, message: Any,
-                  path: str = "") -> str | None:
-    """Where ``message`` does not fit ``type_name``; None where it fits.
-
-    Names the first field that is wrong, however deep: ``"goal.x: expected a number, got '1'"``.
-    """
-    # by name: the type of each nested field is known only from the definition, at run time
-    if not isinstance(message, types.message_class(type_name)):
-        return f"{path or 'the message'}: expected a {type_name}, got {_shown(message)}"
-    for name, (kind, detail) in types.store.fielddefs[type_name][1]:
-        where = f"{path}.{name}" if path else name
-        problem = _value_problem(types, kind, detail, getattr(message, name, None), where)
-        if problem:
-            return problem
-    return None
-
-
-def _value_problem(types: MessageTypes, kind: Any, detail: Any, value: Any,
-                   where: str) -> str | None:
-    if kind == Nodetype.NAME:
-        return field_problem(types, detail, value, where)
-    if kind == Nodetype.BASE:
-        return _base_problem(detail[0], value, where)
-    (element_kind, element), bound = detail
-    if not isinstance(value, list | tuple | np.ndarray):
-        return f"{where}: expected a list, got {_shown(value)}"
-    if kind == Nodetype.ARRAY and len(value) != bound:
-        return f"{where}: expected {bound} items, got {len(value)}"
-    if kind == Nodetype.SEQUENCE and bound and len(value) > bound:
-        return f"{where}: at most {bound} items, got {len(value)}"
-    if isinstance(value, np.ndarray) and value.dtype != object:
-        return None  # numbers: the serialiser converts the array as a whole
-    for index, item in enumerate(value):
-        problem = _value_problem(types, element_kind, element, item, f"{where}[{index}]")
-        if problem:
-            return problem
-    return None
-
-
-def _base_problem(type_name: str, value: Any, where: str) -> str | None:
-    if type_name in ("string", "wstring"):
-        if not isinstance(value, str):
-            return f"{where}: expected text, got {_shown(value)}"
-        try:
-            value.encode("utf-8")
-        except UnicodeEncodeError as exc:
-            return f"{where}: not valid text (a lone surrogate at character {exc.start})"
-        return None
-    if type_name == "bool":
-        ok = isinstance(value, bool | np.bool_)
-        return None if ok else f"{where}: expected true or false, got {_shown(value)}"
-    if type_name in ("float32", "float64"):
-        ok = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-        return None if ok else f"{where}: expected a number, got {_shown(value)}"
-    ok = isinstance(value, int | np.integer) and not isinstance(value, bool)
-    return None if ok else f"{where}: expected an integer ({type_name}), got {_shown(value)}"
-
-
-def _shown(value: Any) -> str:
-    text = repr(value)
-    return _one_line(text if len(text) <= 40 else text[:39] + "…")
-
-
 class _ServiceEndpoint:
     def __init__(self, node: Node, name: str, service_type: str, kind: EntityKind) -> None:
         context = node.context
@@ -242,7 +163,7 @@ class Responder(Generic[ResponseT]):
             problem = field_problem(server.context.types, response_type, response) \
                 or f"{type(exc).__name__}: {exc}"
             log.error("service %s: the handler's response does not fit %s: %s", server.name,
-                      response_type, _one_line(problem))
+                      response_type, one_line(problem))
             self._send_error(f"bad response from the handler: {problem}")
             return
         if not self._done.acquire(blocking=False):
@@ -265,7 +186,7 @@ class Responder(Generic[ResponseT]):
     def _send_error(self, text: str) -> None:
         if not self._done.acquire(blocking=False):
             return
-        self._query.reply_err(_one_line(text).encode())
+        self._query.reply_err(one_line(text).encode())
         self._query.drop()
 
 
@@ -299,8 +220,8 @@ class ServiceServer(_ServiceEndpoint, Generic[RequestT, ResponseT]):
                 else Attachment(0, 0, bytes(16))
             request = self.context.types.deserialize(payload, f"{self.service_type}_Request")
         except Exception as exc:  # the request's type is checked here, before the handler
-            self.context.drop(f"{self.name}: cannot decode request", _one_line(str(exc)))
-            query.reply_err(_one_line(f"{_BAD_REQUEST}not a {self.service_type} request "
+            self.context.drop(f"{self.name}: cannot decode request", one_line(str(exc)))
+            query.reply_err(one_line(f"{_BAD_REQUEST}not a {self.service_type} request "
                                       f"({len(payload)} bytes): {exc}").encode())
             query.drop()
             return
@@ -310,7 +231,7 @@ class ServiceServer(_ServiceEndpoint, Generic[RequestT, ResponseT]):
                 self._pending += 1
         if busy:
             self.context.drop(f"{self.name}: busy", f"{self.max_pending} requests waiting")
-            query.reply_err(_one_line(f"service {self.name} is busy: {self.max_pending} "
+            query.reply_err(one_line(f"service {self.name} is busy: {self.max_pending} "
                                       "requests are waiting; try again later").encode())
             query.drop()
             return
@@ -335,7 +256,7 @@ class ServiceServer(_ServiceEndpoint, Generic[RequestT, ResponseT]):
             first = type(exc) not in self._traced
             self._traced.add(type(exc))
             log.error("service %s: the handler raised %s: %s%s", self.name, type(exc).__name__,
-                      _one_line(str(exc)), "" if first else " (traceback logged before)",
+                      one_line(str(exc)), "" if first else " (traceback logged before)",
                       exc_info=first)
             responder.fail(exc)
 
@@ -398,9 +319,9 @@ class ServiceClient(_ServiceEndpoint, Generic[RequestT, ResponseT]):
                     return response
                 except Exception as exc:
                     raise ServiceError(f"service {self.name}: cannot decode the response: "
-                                       f"{_one_line(str(exc))}") from exc
+                                       f"{one_line(str(exc))}") from exc
             if reply.err is not None:
-                text = _one_line(reply.err.payload.to_bytes().decode("utf-8", "replace"))
+                text = one_line(reply.err.payload.to_bytes().decode("utf-8", "replace"))
                 if text == "Timeout":
                     break
                 if text.startswith(_BAD_REQUEST):
