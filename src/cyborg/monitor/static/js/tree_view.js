@@ -43,6 +43,13 @@ export class TreeView {
   // markup is built as one string with its classes in place: one parse, one style pass.
   // Returns the number of nodes drawn.
   draw(root, isOpen, look) {
+    // The view's size must be known before the markup goes in, so that fit() (called after
+    // drawing) never asks the DOM: with the new nodes inserted, that question forces a
+    // synchronous layout of every box and of every label, labels that the fit may then hide
+    // (svg.far) before the frame would ever have shown them. Until the ResizeObserver has
+    // spoken (the first frame, while the page's modules and the tree arrive together) the size
+    // is read here, from a view that is still empty and cheap to lay out.
+    if (!this.size.width) this.measure();
     const layoutRoot = hierarchy(root, (node) => (isOpen(node) ? node.children : null));
     layoutRoot.each((d) => {
       const label = displayLabel(d.data, !isOpen(d.data) && d.data.children.length > 0);
@@ -124,10 +131,17 @@ export class TreeView {
     this.svg.classList.toggle("far", k < FAR_SCALE);
   }
 
+  // The view's size, from the DOM (a layout if one is due); the ResizeObserver keeps it after.
+  measure() {
+    const { width, height } = this.svg.getBoundingClientRect();
+    this.size = { width, height };
+  }
+
   fit() {
-    // The size comes from the ResizeObserver: asking the DOM here would force a layout of
-    // everything just drawn.
-    const box = this.size.width ? this.size : this.svg.getBoundingClientRect();
+    // The size comes from the ResizeObserver, or from draw(): asking the DOM here would force a
+    // layout of everything just drawn.
+    if (!this.size.width) this.measure();
+    const box = this.size;
     const width = this.bounds.x1 - this.bounds.x0, height = this.bounds.y1 - this.bounds.y0;
     if (!box.width || !box.height) return;
     const k = Math.min(box.width / width, box.height / height, 1.5);
