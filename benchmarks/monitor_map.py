@@ -1,6 +1,6 @@
 """Map view: three robots at 10 Hz on columbia.map, pose to painted frame in Chromium.
 
-    python3 benchmarks/monitor_map.py              # about 1.5 minutes
+    python3 benchmarks/monitor_map.py              # about a minute
     python3 benchmarks/monitor_map.py --quick      # a few seconds per part
     python3 benchmarks/monitor_map.py --markdown   # the table for docs/benchmarks.md
 
