@@ -309,6 +309,9 @@ def pose_latency(page: Page, floor: FloorClient, published: Published,
             continue
         page_ms.append((painted[(ns, seq)] - sent) * 1000.0)
         floor_ms.append((arrived - sent) * 1000.0)
+    if not page_ms:
+        raise SystemExit(f"no pose was painted in {seconds:g} s ({len(paints)} frames, "
+                         f"{len(floor.received)} rs received): is the map panel drawing?")
     return Latency(page_ms, floor_ms, unmatched, merged)
 
 
