@@ -20,10 +20,22 @@ step         —                                           at a breakpoint: on t
 resume       —                                           at a breakpoint: go on
 map          on                                          show the map (true) or not: the
                                                          robots' state (robot_hub.py)
+go           ns, goal                                    send the robot ``ns`` to a named goal
+go_pose      ns, pose: [x, y] or [x, y, θ]               send it to a pose
+home         ns                                          send it home
+dock         ns                                          dock it
+undock       ns                                          undock it
+set_pose     ns, pose: [x, y] or [x, y, θ]               relocalise it
+stop         ns                                          stop it (needs no seat)
+drive        ns, vx, wz                                  drive it by hand (10 Hz while held)
+tour         ns, points                                  drive it through the points in order
 ping         —                                           answered with pong (for latency)
 ===========  ==========================================  =====================================
 
-``enable``, ``control``, ``step`` and ``resume`` need the control seat.
+``enable``, ``control``, ``step`` and ``resume`` need the control seat; so do the robot
+commands (``go`` … ``tour``) but ``stop``, which any page that may control sends. The robot
+commands, their answers (``result``, ``robot_result``, ``tour``, ``manual_pause``) and why a
+manual goal pauses the tree are in :mod:`cyborg.monitor.robot_commands`.
 
 A message the monitor cannot read or will not carry out is answered with a *located* error::
 
@@ -46,6 +58,9 @@ from typing import Any
 from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import MessageError, check_namespace, decode
+from cyborg.monitor.robot_commands import ROBOT_COMMANDS
+from cyborg.monitor.robot_fields import RobotCommandError
+from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY
 from cyborg.monitor.source import ControlError
 
 log = logging.getLogger("cyborg.monitor")
@@ -113,6 +128,9 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         else:
             client.send({**answer, "ok": True, "message": message})
         return
+    if kind in ROBOT_COMMANDS:
+        await _robot_command(hub, client, kind, command)
+        return
     if kind == "hello":
         secret = command.get("seat")
         if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
@@ -157,15 +175,24 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         raise CommandError(f"unknown command {kind[:40]!r}", "t")
 
 
-VIEW_ONLY = ("view only: control is accepted from the monitor's own page on this machine, or "
-             "with the monitor's token")
+async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
+    """A robot command (:mod:`cyborg.monitor.robot_commands`), answered with ``result``."""
+    answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
+    try:
+        done = await hub.robot_commands.handle(client, kind, command)
+    except RobotCommandError as exc:
+        client.send({**answer, "ok": False, "field": exc.field,
+                     "message": located_error(client, command, exc)["message"]})
+        return
+    if done is not None:
+        client.send({**answer, "ok": True, **done})
 
 
 async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> str:
     if not client.may_control:
         raise CommandError(VIEW_ONLY)
     if not hub.seat.holds(client.number):
-        raise CommandError("another page has control (or none was taken): take control first")
+        raise CommandError(NOT_HOLDER)
     namespace = command.get("ns") or client.watching
     try:
         namespace = check_namespace(namespace)

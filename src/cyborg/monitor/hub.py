@@ -11,18 +11,17 @@ bus ever waits for a browser.
   does not show now: once per version while it stays on one robot, again when it comes back
   to a robot it left (the page keeps only the tree it draws). A restarted runner with the same
   tree only resets the statuses.
-* **Commands** from browsers (run/pause, per-node control, step, resume) are checked against
-  the control seat (:mod:`cyborg.monitor.seat`) and run as blocking service calls in worker
-  threads; each gets a ``result`` reply. The seat knows clients by their connection numbers;
-  its secret goes to its holder and nobody else.
+* **Commands** from browsers are checked against the control seat (:mod:`cyborg.monitor.seat`,
+  which knows pages by connection number and sends its secret to its holder alone) and run as
+  blocking service calls in worker threads; each gets a ``result`` reply.
 * Every :data:`SLOW_PERIOD` the hub sends per-node timings, polls blackboards of watched trees,
   looks for new tree runners on the bus and frees the seat of a holder gone too long.
 * **What viewers cost** is bounded (:mod:`cyborg.monitor.limits`). A tree is followed (one
-  :class:`TreeSource`, its subscriptions shared by every page that watches it) when the monitor
-  was started with it (*pinned*) or while its runner is on the bus; when the runner has left
-  and the last page watching it has gone, it is freed with everything kept for it. Watching a
-  namespace no runner is in subscribes to nothing. Connections are counted per address.
-* **Robots and their maps**, for pages that show the map: :attr:`Hub.robot_hub`.
+  :class:`TreeSource`, shared by every page that watches it) when the monitor was started with
+  it (*pinned*) or while its runner is on the bus; once the runner has left and no page watches
+  it, it is freed with all kept for it. Watching a namespace no runner is in subscribes to
+  nothing. Connections are counted per address.
+* **Robots**: their maps in :attr:`Hub.robot_hub`, acting on them in :attr:`Hub.robot_commands`.
 """
 
 from __future__ import annotations
@@ -40,6 +39,7 @@ from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import Limits, check_namespace
+from cyborg.monitor.robot_commands import RobotCommands
 from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import ControlError, TreeSource
@@ -68,8 +68,7 @@ class Hub:
     def __init__(self, make_source: Callable[[str], TreeSource],
                  discover: Callable[[], list[str]], *, default_namespace: str,
                  seat: ControlSeat, limits: Limits | None = None) -> None:
-        self._make_source = make_source
-        self._discover = discover
+        self._make_source, self._discover = make_source, discover
         self.default_namespace = default_namespace
         self.sources: dict[str, TreeSource] = {}
         self.pinned: set[str] = set()
@@ -82,10 +81,10 @@ class Hub:
         self._last_frame: dict[str, float] = {}
         self._blackboards: dict[str, str] = {}
         self._numbers = itertools.count(1)
-        self._warned_limit = False
-        self.frames = 0
+        self._warned_limit, self.frames = False, 0
         self.robot_hub = RobotHub(self.clients, self.sources,
                                   lambda: self.broadcast(self.robots()))
+        self.robot_commands = RobotCommands(self.clients, seat, self.sources, self.robot_hub)
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
@@ -294,6 +293,7 @@ class Hub:
         Pages that come and go thus cost the pages that stay nothing.
         """
         self.clients.discard(client)
+        self.robot_commands.disconnected(client)
         if self.seat.disconnected(client.number):
             self.announce_seat()
         watched, client.watching = client.watching, None

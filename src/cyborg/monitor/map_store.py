@@ -75,6 +75,8 @@ class StoredMap:
     """The blob's length before gzip, in bytes."""
     source: str
     counts: dict[str, int]
+    objects: tuple[dict[str, Any], ...] = ()
+    """The map's goals, docks, homes and other objects, as the blob's header has them."""
 
     @property
     def url(self) -> str:
@@ -222,7 +224,7 @@ class MapStore:
                 self._maps.move_to_end(key)
                 return found, warnings
         stored = StoredMap(key, gzip.compress(blob, GZIP_LEVEL, mtime=0), len(blob),
-                           header["source"], header["counts"])
+                           header["source"], header["counts"], tuple(header["objects"]))
         with self._lock:
             self._maps[key] = stored
             self._maps.move_to_end(key)

@@ -25,6 +25,7 @@ import logging
 import socket
 import threading
 import time
+from functools import partial
 from typing import Any
 
 import uvicorn
@@ -35,6 +36,7 @@ from cyborg.interfaces import robot, tree_runner
 from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
+from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.server import create_app
@@ -76,6 +78,7 @@ class Monitor:
         for namespace in namespaces:
             self.hub.follow(namespace, pinned=True)
         self.hub.robot_hub.use(self._make_robot, self.discover_robots)
+        self.hub.robot_commands.use(partial(RobotClients, self.node))
         names = [*allow_hosts, host] if host not in EVERY_INTERFACE else list(allow_hosts)
         self.hosts = HostPolicy(names)
         self.app = create_app(self.hub, hosts=self.hosts)
@@ -167,6 +170,7 @@ class Monitor:
             self._thread = None
         for source in list(self.hub.sources.values()):
             source.destroy()
+        self.hub.robot_commands.destroy()
         self.hub.robot_hub.destroy()
         self.node.destroy()
 

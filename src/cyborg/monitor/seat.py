@@ -28,6 +28,11 @@ from dataclasses import dataclass, field
 
 from cyborg.monitor.access import same_secret
 
+VIEW_ONLY = ("view only: control is accepted from the monitor's own page on this machine, or "
+             "with the monitor's token")
+"""Why a page that may not control is refused."""
+NOT_HOLDER = "another page has control (or none was taken): take control first"
+"""Why a page that may control but does not hold the seat is refused."""
 GRACE = 10.0
 """Seconds the seat waits for a disconnected holder to come back."""
 SECRET_BYTES = 16
