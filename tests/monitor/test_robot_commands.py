@@ -47,7 +47,7 @@ def test_a_goal_pauses_the_running_tree_and_every_page_hears_how_it_ended() -> N
         hub.seat.claim(1)
         answer = await _send(hub, holder, {"t": "go", "ns": ROBOT, "goal": "Office", "req": 3})
         assert answer["ok"] is True and answer["req"] == 3 and answer["command"] == "go"
-        assert answer["paused"] == TREE
+        assert answer["paused"] == TREE and answer["goal"] == "'Office'"
         assert answer["message"] == ("/cyborg: going to 'Office'; the tree /cyborg/bt is paused "
                                      "for it")
         assert _enabled(hub) is False, "paused before the goal"

@@ -35,7 +35,8 @@ ends it too, but never pauses the tree.
 
 **Answers.** Each command is answered with ``result`` (``req``, ``ok``, ``message``, and
 ``paused``: the tree paused for it, or null) once the call returns; a goal is answered when
-the robot accepted it, and every page hears how it ended::
+the robot accepted it (its ``result`` adds ``goal``, the goal as the ``robot_result`` will name
+it), and every page hears how it ended::
 
     {"t": "robot_result", "ns": "/cyborg", "command": "go", "goal": "Office",
      "outcome": "reached", "message": "reached the goal", "req": 7}
@@ -164,7 +165,7 @@ class RobotCommands:
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         self._follow(client, command.get("req"), ns, kind, what, moving)
-        return {"message": f"{ns}: going to {what}{note}", "paused": paused}
+        return {"message": f"{ns}: going to {what}{note}", "paused": paused, "goal": what}
 
     def _namespace(self, value: Any) -> str:
         if value is None:

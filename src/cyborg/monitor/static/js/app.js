@@ -26,6 +26,7 @@ const page = {
   enabled: null,
   hooks: new Map(),
   pausedAt: "",
+  manualPause: null, // the tree the monitor paused for a manual goal from the map
   problem: "",
   title: "",
   seat: { may_control: false, control: false, holder: null },
@@ -63,7 +64,7 @@ const connection = new Connection({
 });
 // The map beside the tree (js/map/), loaded once the tree is drawn (js/map/lazy_panel.js); the
 // layout says whether it can be seen.
-const mapPanel = new LazyMapPanel($("map-view"), { post: (message) => connection.post(message) });
+const mapPanel = new LazyMapPanel($("map-view"), { post: (message) => connection.post(message), send: (message) => connection.send(message) });
 const layout = new Layout({ onMapShown: (shown) => mapPanel.setVisible(shown) });
 mapPanel.onEmpty = (empty) => layout.setMapEmpty(empty);
 new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("tree"));
@@ -119,6 +120,7 @@ function receive(message) {
       page.problem = message.problem;
       page.hooks = new Map(message.hooks.map((hook) => [hook.id, hook]));
       page.pausedAt = message.paused_at;
+      if (message.enabled !== false) page.manualPause = null;
       markDirty("all");
       toolbar();
       banner();
@@ -147,6 +149,11 @@ function receive(message) {
       break;
     case "history":
       tickHistory.start(message, model.version);
+      break;
+    case "manual_pause": // the monitor paused a tree before a goal sent from the map
+      page.manualPause = message.tree;
+      if (message.tree === page.ns) page.enabled = false;
+      toolbar();
       break;
     case "error":
       say(message.message, true);
@@ -350,6 +357,7 @@ $("search").addEventListener("keydown", (event) => { if (event.key === "Enter") 
 $("take").addEventListener("click", () => command({ t: "claim", force: true }));
 $("step").addEventListener("click", () => command({ t: "step" }));
 $("resume").addEventListener("click", () => command({ t: "resume" }));
+$("manual-resume").addEventListener("click", () => command({ t: "enable", on: true, ns: page.manualPause || page.ns }));
 $("history").addEventListener("click", () => connection.post({ t: "history" }));
 $("bb-filter").addEventListener("input", () => { if (page.blackboard) showBlackboard(page.blackboard, $("bb-filter").value, nodeName); });
 for (const button of document.querySelectorAll("#inspector button[data-action]")) {

@@ -1,8 +1,8 @@
 // What the page shows around the tree about the runner, the seat and the connection: the
-// toolbar (Run/Pause, who holds the control seat, Take control, where a breakpoint waits), the
-// banner (connection lost, a problem with the tree, the runner gone), the tree selector and the
-// message line. Each function redraws its part from app.js's `page` state and the tree model;
-// none keeps state of its own.
+// toolbar (Run/Pause, who holds the control seat, Take control, where a breakpoint waits, a tree
+// paused for a manual goal from the map), the banner (connection lost, a problem with the tree,
+// the runner gone), the tree selector and the message line. Each function redraws its part
+// from app.js's `page` state and the tree model; none keeps state of its own.
 
 const $ = (id) => document.getElementById(id);
 
@@ -19,6 +19,8 @@ export function showToolbar(page, model) {
   seatLabel.textContent = seat.control ? "You have control" : seat.may_control ? (seat.holder ? "Another page has control" : "View only") : "View only";
   $("take").hidden = !(seat.may_control && !seat.control);
   $("paused").hidden = !page.pausedAt;
+  // "Tree paused for a manual goal — Resume": the monitor paused it before a goal from the map
+  $("manual-pause").hidden = !(page.manualPause && page.manualPause === page.ns && page.enabled === false);
   const pausedNode = model.byId.get(page.pausedAt);
   $("paused-node").textContent = pausedNode ? pausedNode.label || pausedNode.name : page.pausedAt;
 }

@@ -4,21 +4,21 @@
 // fetching and starting them before the tree is drawn made the first paint of a 1,000-node
 // tree half again as slow. This stand-in takes the page's calls from the start and remembers
 // what they said (the tree shown, whether the map can be seen, whether the socket is open, the
-// last robots list); `load()` imports the real MapPanel and hands it that state. Until then no
-// map opt-in is sent, so the monitor sends no map messages: it sends them all, from the map
-// reference to the latest pose, when the panel opts in.
+// last robots list and seat message); `load()` imports the real MapPanel and hands it that
+// state. Until then no map opt-in is sent, so the monitor sends no map messages: it sends them
+// all, from the map reference to the latest pose, when the panel opts in.
 
 const LOAD_ANYWAY_MS = 1500; // a page that shows no tree (a robot without one) loads it anyway
 const UNREADABLE_KEPT = 20;
 
 export class LazyMapPanel {
-  // `root`: the #map-view element; `options`: what MapPanel takes ({post}).
+  // `root`: the #map-view element; `options`: what MapPanel takes ({post, send}).
   constructor(root, options) {
     this.root = root;
     this.options = options;
     this.panel = null;
     this.loading = null;
-    this.state = { tree: null, visible: null, connected: false, robots: null, unreadable: [] };
+    this.state = { tree: null, visible: null, connected: false, robots: null, seat: null, unreadable: [] };
     this.emptyListener = () => {};
     setTimeout(() => this.load(), LOAD_ANYWAY_MS);
   }
@@ -29,9 +29,10 @@ export class LazyMapPanel {
       this.loading = import("./map_panel.js").then(({ MapPanel }) => {
         const panel = new MapPanel(this.root, this.options);
         panel.onEmpty = this.emptyListener;
-        const { tree, visible, connected, robots, unreadable } = this.state;
+        const { tree, visible, connected, robots, seat, unreadable } = this.state;
         if (tree !== null) panel.setTree(tree);
         if (robots !== null) panel.receive(robots);
+        if (seat !== null) panel.receive(seat);
         for (const [text, error] of unreadable) panel.unreadable(text, error);
         if (visible !== null) panel.setVisible(visible);
         if (connected) panel.connected();
@@ -52,10 +53,11 @@ export class LazyMapPanel {
     return this.emptyListener;
   }
 
-  // A message from the monitor: true when the map took it (before loading: none but robots).
+  // A message from the monitor: true when the map took it (before loading: none; the last
+  // robots list and seat message are kept for the panel).
   receive(message) {
     if (this.panel !== null) return this.panel.receive(message);
-    if (message && message.t === "robots") this.state.robots = message;
+    if (message && (message.t === "robots" || message.t === "seat")) this.state[message.t] = message;
     return false;
   }
 

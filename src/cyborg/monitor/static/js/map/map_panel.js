@@ -1,6 +1,7 @@
 // The map panel: wires the model (map_model.js), the view (view_transform.js), the static
 // layers (static_layer.js, drawn in a worker), the per-frame drawing (moving_draw.js) and the
-// HUD (hud.js) to the page's WebSocket.
+// HUD (hud.js) to the page's WebSocket; acting on the robot from the map: the commands and
+// their log (actions.js), the pointer tools (tools.js) and driving by hand (drive.js).
 //
 // Data flow: a message → MapModel (decoded, checked, or a warning) → a frame is scheduled →
 // on the next animation frame: the static bitmap is asked for if the view outgrew the last
@@ -16,19 +17,24 @@
 // toWorld(sx, sy), view(), colourOf(ns), robot(ns), fetches, renders, where, frameMs,
 // messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
 // battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
-// is), or null.
+// is), or null; acting() what acting from the map stands at ({robot, canAct, mode, points}).
 
+import { MapActions } from "./actions.js";
+import { Driver } from "./drive.js";
 import { Hud } from "./hud.js";
-import { MapModel, parseMapBlob } from "./map_model.js";
+import { CATEGORY, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
 import { StaticLayer } from "./static_layer.js";
+import { MapTools } from "./tools.js";
 import { ViewTransform } from "./view_transform.js";
 
 const FRAME_SAMPLES = 600;
+const MARKERS = new Set([CATEGORY.GOAL, CATEGORY.GOAL_WITH_HEADING, CATEGORY.DOCK, CATEGORY.HOME]);
 
 export class MapPanel {
-  // `root`: the #map-view element; `post(message)`: send to the monitor (when connected).
-  constructor(root, { post }) {
+  // `root`: the #map-view element; `post(message)`: send to the monitor (when connected);
+  // `send(command)`: send and get a promise of its result.
+  constructor(root, { post, send }) {
     this.root = root;
     this.post = post;
     this.canvas = root.querySelector("#map-canvas"); // what moves; takes the pointer
@@ -55,6 +61,10 @@ export class MapPanel {
       onFit: () => this.fit(),
       onFollow: (on) => { this.follow = on; this.schedule(); },
     });
+    // acting on the robot: always the robot of the shown tree (selected())
+    this.actions = new MapActions(root, { send, robot: () => this.actingRobot(), onChange: () => this.schedule() });
+    this.tools = new MapTools(this.canvas, { view: this.view, actions: this.actions, markerAt: (sx, sy, px) => this.markerAt(sx, sy, px), schedule: () => this.schedule() });
+    this.driver = new Driver(root, { actions: this.actions, post });
     const panel = this; // for the getters below
     this.stats = window.__map = {
       firstPaint: null, paints: 0, recordPaints: false, paintTimes: [],
@@ -68,8 +78,10 @@ export class MapPanel {
       view: () => this.view.snapshot(),
       colourOf: (ns) => this.model.robots.get(ns)?.colour ?? null,
       robot: (ns) => describe(this.model, this.model.robots.get(ns)),
+      acting: () => ({ robot: this.actingRobot(), canAct: this.actions.canAct, mode: this.tools.mode, points: this.tools.points.map((p) => [...p]) }),
     };
     this.view.attach(this.canvas, {
+      claim: (event) => this.tools.claim(event),
       onChange: () => this.schedule(),
       onUser: (gesture) => {
         this.userMoved = true;
@@ -93,6 +105,15 @@ export class MapPanel {
     const started = performance.now();
     if (message && message.t === "error" && message.command === "map") return true; // a monitor without maps
     if (message && message.t === "robots") this.pairRobots(message);
+    if (message && message.t === "seat") {
+      this.actions.setSeat(message);
+      this.tools.showTour();
+      return false; // the page's toolbar shows it too
+    }
+    if (message && this.actions.receive(message)) {
+      this.schedule();
+      return true;
+    }
     const type = this.model.receive(message);
     if (type === null) return false;
     if (type === "map_ref") this.loadMaps();
@@ -153,6 +174,32 @@ export class MapPanel {
     return [...robots.keys()].sort()[0] ?? null;
   }
 
+  // The robot the map's actions go to: the one of the shown tree (the robot selector's choice),
+  // while it is on the bus.
+  actingRobot() {
+    const ns = this.selected();
+    const robot = ns ? this.model.robots.get(ns) : null;
+    return robot && robot.alive ? ns : null;
+  }
+
+  // The named goal, dock or home of the shown map nearest the screen point (sx, sy), within
+  // `px` pixels, as {name, home}; or null.
+  markerAt(sx, sy, px) {
+    const map = this.model.maps.get(this.shownKey);
+    if (!map || !this.hud.layers.goals) return null;
+    let best = null, nearest = px;
+    for (const item of map.objects) {
+      if (!MARKERS.has(item.category) || (!item.name && item.category !== CATEGORY.HOME)) continue;
+      const [x, y] = this.view.toScreen(item.x, item.y);
+      const distance = Math.hypot(x - sx, y - sy);
+      if (distance <= nearest) {
+        nearest = distance;
+        best = { name: item.name || "home", home: item.category === CATEGORY.HOME };
+      }
+    }
+    return best;
+  }
+
   fit() {
     const map = this.model.maps.get(this.shownKey);
     if (!map) return;
@@ -205,6 +252,7 @@ export class MapPanel {
     this.shownKey = key;
     const map = key ? this.model.maps.get(key) : null;
     this.staticLayer.setMap(map);
+    this.actions.setGoals(map ? map.objects : []);
     if (map && this.view.width) {
       this.view.fit(map.bounds);
       this.userMoved = false;
@@ -259,6 +307,8 @@ export class MapPanel {
       drawBitmap(this.lowerCtx, this.view, placement, dpr);
     }
     this.stats.moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, robots, layers, selected });
+    this.tools.draw(this.ctx);
+    this.actions.refresh();
     if (this.staticLayer.current) this.stats.drawn = this.staticLayer.current.drawn;
     this.hud.showScale(this.view.scale);
     this.hud.showWarnings(this.model.warnings);

@@ -95,7 +95,9 @@ export class ViewTransform {
 
   // Wheel, drag and pinch on `element`. `onUser` hears each gesture that moved the view (the
   // panel turns "follow" off on a pan); `onCursor(sx, sy)` the pointer's position, or null.
-  attach(element, { onChange, onUser, onCursor }) {
+  // `claim(event)`, when given, may take a press for itself (a tool's drag): the view then
+  // leaves that pointer alone.
+  attach(element, { onChange, onUser, onCursor, claim }) {
     const local = (event) => {
       const box = element.getBoundingClientRect();
       return [event.clientX - box.left, event.clientY - box.top];
@@ -118,6 +120,7 @@ export class ViewTransform {
     };
     element.addEventListener("pointerdown", (event) => {
       if (event.button !== 0 && event.pointerType === "mouse") return;
+      if (claim && claim(event)) return;
       try {
         element.setPointerCapture(event.pointerId); // keep the drag when the pointer leaves
       } catch {

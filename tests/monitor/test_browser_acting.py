@@ -1,0 +1,174 @@
+"""Acting from the map against the real system, in headless Chromium: the simulator on the
+campus map, its patrol tree and the monitor on an isolated bus. The page takes control; a
+click on the goal "Office" on the map sends the robot there, the tree is shown paused for the
+manual goal and Resume runs it again; a drag with "Set pose" relocalises the robot with the
+heading of the drag; Stop ends a goal sent with "Go to pose"; a page without the seat has its
+tools disabled and says why, but its Stop works. Screenshots: acting_goal.png,
+acting_stop.png, acting_phone.png."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import pytest
+from playwright.sync_api import Browser, Page
+
+from tests.monitor.browser import Live, live_system, open_page, screenshot
+from tests.monitor.map_page import on_map
+from tests.running_system import wait_until
+
+pytestmark = pytest.mark.heavy
+
+ROBOT = "/cyborg"
+OFFICE = (11.0, 3.0)
+"""The campus map's goal "Office"."""
+CORRIDOR = (17.0, 7.0)
+"""A free spot in the campus corridor (its goal "Corridor")."""
+
+
+def _acting_page(browser: Browser, live: Live, errors: list[str], *,
+                 viewport: dict[str, int] | None = None) -> Page:
+    """The monitor's page once its map is drawn, the robot is on it and the page may act."""
+    page = open_page(browser, live.url, errors)
+    if viewport:
+        page.set_viewport_size(viewport)
+    page.wait_for_function("window.__map && window.__map.firstPaint !== null && "
+                           f"window.__map.robot({ROBOT!r})?.pose && "
+                           "window.__map.acting().canAct", timeout=30000)
+    return page
+
+
+def _acting(page: Page) -> dict[str, Any]:
+    found: dict[str, Any] = on_map(page, "m.acting()")
+    return found
+
+
+def _canvas_point(page: Page, x: float, y: float) -> tuple[float, float]:
+    """Where the world point (x, y) is on the page, in CSS px."""
+    box = page.locator("#map-canvas").bounding_box()
+    assert box is not None
+    sx, sy = on_map(page, f"m.toScreen({x}, {y})")
+    return box["x"] + sx, box["y"] + sy
+
+
+def _bring_to_middle(page: Page, x: float, y: float) -> tuple[float, float]:
+    """Pans the map (a drag from its middle) until the world point (x, y) is in the middle,
+    clear of the map's buttons; returns where it is on the page."""
+    box = page.locator("#map-canvas").bounding_box()
+    assert box is not None
+    middle = (box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    at = _canvas_point(page, x, y)
+    page.mouse.move(*middle)
+    page.mouse.down()
+    page.mouse.move(middle[0] + middle[0] - at[0], middle[1] + middle[1] - at[1], steps=8)
+    page.mouse.up()
+    at = _canvas_point(page, x, y)
+    assert math.hypot(at[0] - middle[0], at[1] - middle[1]) < 2, (at, middle)
+    return at
+
+
+def _drag(page: Page, start: tuple[float, float], end: tuple[float, float]) -> None:
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.mouse.move(*end, steps=10)
+    page.mouse.up()
+
+
+def _log(page: Page) -> list[str]:
+    rows: list[str] = page.eval_on_selector_all("#map-log li", "items => items.map("
+                                                "i => `${i.className}: ${i.textContent}`)")
+    return rows
+
+
+def _distance(live: Live, x: float, y: float) -> float:
+    pose = live.system.sim.pose
+    return math.hypot(pose.x - x, pose.y - y)
+
+
+def test_a_click_on_a_goal_sends_the_robot_there_and_the_tree_waits(browser: Browser) -> None:
+    with live_system() as live:
+        errors: list[str] = []
+        page = _acting_page(browser, live, errors)
+        assert _acting(page)["robot"] == ROBOT, "the robot of the shown tree"
+        wait_until(lambda: live.system.runner.enabled, 10, "the patrol to run")
+        at = _bring_to_middle(page, *OFFICE)
+        page.mouse.move(*at)
+        assert page.get_attribute("#map-canvas", "title") == ("Office: click to send /cyborg to "
+                                                              "Office")
+        page.mouse.click(*at)
+        page.wait_for_selector("#manual-pause", state="visible", timeout=20000)
+        assert "Tree paused for a manual goal" in page.inner_text("#manual-pause")
+        assert not live.system.runner.enabled, "the patrol waits while the operator drives"
+        assert page.inner_text("#run") == "▶ Run"
+        wait_until(lambda: _distance(live, *OFFICE) < 0.5, 120, "the robot to reach Office")
+        page.wait_for_function("[...document.querySelectorAll('#map-log li.ok')].some("
+                               "li => li.textContent.includes(\"'Office' reached\"))",
+                               timeout=30000)
+        screenshot(page, "acting_goal")
+        page.click("#manual-resume")
+        wait_until(lambda: live.system.runner.enabled, 20, "Resume to run the tree again")
+        page.wait_for_selector("#manual-pause", state="hidden", timeout=20000)
+        assert errors == [], json.dumps(errors)
+
+
+def test_set_pose_by_dragging_and_stop_ending_a_goal(browser: Browser) -> None:
+    with live_system() as live:
+        errors: list[str] = []
+        page = _acting_page(browser, live, errors)
+        page.click("#run")  # pause the patrol, so the robot stays where it is put
+        wait_until(lambda: not live.system.runner.enabled, 20, "the tree to pause")
+        at = _bring_to_middle(page, *CORRIDOR)
+        page.click("#map-act button[data-tool='set']")
+        assert _acting(page)["mode"] == "set"
+        _drag(page, at, (at[0], at[1] - 60))  # up on screen: north, heading π/2
+        wait_until(lambda: _distance(live, *CORRIDOR) < 0.15, 20, "the robot to be put there")
+        heading = live.system.sim.pose.theta
+        assert abs(math.remainder(heading - math.pi / 2, math.tau)) < 0.05, heading
+        assert _acting(page)["mode"] is None, "one use, then the map pans again"
+        page.wait_for_function("[...document.querySelectorAll('#map-log li.ok')].some("
+                               "li => li.textContent.includes('set pose (17.0'))",
+                               timeout=20000)
+        # go to a pose far east, then stop on the way
+        page.click("#map-act button[data-tool='pose']")
+        target = _canvas_point(page, CORRIDOR[0] + 8.0, CORRIDOR[1])
+        _drag(page, target, (target[0] + 40, target[1]))
+        wait_until(lambda: _distance(live, *CORRIDOR) > 0.3, 60, "the robot to set off")
+        page.click("#map-stop")
+        page.wait_for_function("[...document.querySelectorAll('#map-log li.error')].some("
+                               "li => li.textContent.includes('failed'))", timeout=30000)
+        wait_until(lambda: live.system.sim.base.speed == 0, 20, "the robot to brake")
+        stopped = live.system.sim.pose
+        page.wait_for_timeout(500)
+        moved = math.hypot(live.system.sim.pose.x - stopped.x, live.system.sim.pose.y - stopped.y)
+        assert moved < 0.05, "the robot stays stopped"
+        assert any("STOP" in row for row in _log(page)), _log(page)
+        screenshot(page, "acting_stop")
+        assert errors == [], json.dumps(errors)
+
+
+def test_a_page_without_the_seat_says_why_and_its_stop_still_works(browser: Browser) -> None:
+    with live_system() as live:
+        errors: list[str] = []
+        holder = _acting_page(browser, live, errors)
+        other = open_page(browser, live.url, errors)
+        other.set_viewport_size({"width": 390, "height": 760})  # a phone
+        other.click("#tabs button[data-tab='map']")
+        other.wait_for_function("window.__map && window.__map.firstPaint !== null && "
+                                f"window.__map.robot({ROBOT!r})?.pose", timeout=30000)
+        assert _acting(other)["canAct"] is False
+        assert other.is_disabled("#map-home") and other.is_disabled("#map-goal")
+        assert "take control" in (other.get_attribute("#map-home", "title") or "")
+        assert other.is_visible("#map-stop") and not other.is_disabled("#map-stop")
+        holder.select_option("#map-goal", "Cafeteria")
+        wait_until(lambda: not live.system.runner.enabled, 20, "the goal to pause the tree")
+        start = live.system.sim.pose
+        wait_until(lambda: _distance(live, start.x, start.y) > 0.3, 60, "the robot to set off")
+        other.click("#map-stop")
+        holder.wait_for_function("[...document.querySelectorAll('#map-log li.error')].some("
+                                 "li => li.textContent.includes('Cafeteria'))", timeout=30000)
+        screenshot(other, "acting_phone")
+        box = other.locator("#map-stop").bounding_box()
+        assert box is not None and box["x"] + box["width"] <= 390, "Stop fits a phone"
+        assert errors == [], json.dumps(errors)
