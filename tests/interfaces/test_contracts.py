@@ -18,6 +18,7 @@ from cyborg.bus.wire import Durability, EntityKind
 from cyborg.interfaces import detector, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
+from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.source import TreeSource
 from cyborg.nav.arnl_map import read_map
 from cyborg.robot.bus_robot import BusRobot
@@ -145,6 +146,30 @@ def test_bus_robot_follows_the_robot_under_another_namespace(bus: Context, share
                contract_names("/robot2", robot.TOPICS, robot.SERVICES, [robot.MOVE_TO_GOAL])))
     used = assert_client_is_served(graph, "/elsewhere/bt", "/robot2/arnl")
     assert all(name.startswith("/robot2/") for name in used)
+
+
+MONITOR_ROBOT_ENDPOINTS = 10
+"""stop, dock, undock, set_pose, nav/get_available_goals, and move_to_goal's three services and
+two topics."""
+
+
+def test_the_simulator_serves_everything_the_monitor_acts_with(bus: Context,
+                                                               shared: Path) -> None:
+    sim = Simulator(read_map(shared / "maps" / "AMROffice.map"), start="Dock")
+    SimulatorNode(Node("arnl", "/robot2", context=bus), SimulationLoop(sim))
+    RobotClients(Node("monitor", "/cyborg", context=bus), "/robot2")
+    graph = bus.graph
+    contract = contract_names("/robot2", robot.TOPICS, robot.SERVICES, [robot.MOVE_TO_GOAL])
+    settle(graph, lambda: len(endpoints(graph, "/cyborg/monitor", USING))
+           >= MONITOR_ROBOT_ENDPOINTS
+           and len(endpoints(graph, "/robot2/arnl", SERVING)) >= len(contract))
+    used = assert_client_is_served(graph, "/cyborg/monitor", "/robot2/arnl")
+    assert used <= contract and all(name.startswith("/robot2/") for name in used)
+    assert robot.SET_POSE.full_name("/robot2") in used
+    published = {(entity.topic, entity.type_name)
+                 for entity in endpoints(graph, "/cyborg/monitor", [EntityKind.PUBLISHER])}
+    assert published == {(robot.CMD_VEL.full_name("/robot2"), robot.CMD_VEL.type_name)}
+    assert_subscribes(graph, "/robot2/arnl", "/robot2", [robot.CMD_VEL])
 
 
 # ---------------------------------------------------------------------- the tree runner
