@@ -28,12 +28,9 @@ CORRIDOR = (17.0, 7.0)
 """A free spot in the campus corridor (its goal "Corridor")."""
 
 
-def _acting_page(browser: Browser, live: Live, errors: list[str], *,
-                 viewport: dict[str, int] | None = None) -> Page:
+def _acting_page(browser: Browser, live: Live, errors: list[str]) -> Page:
     """The monitor's page once its map is drawn, the robot is on it and the page may act."""
     page = open_page(browser, live.url, errors)
-    if viewport:
-        page.set_viewport_size(viewport)
     page.wait_for_function("window.__map && window.__map.firstPaint !== null && "
                            f"window.__map.robot({ROBOT!r})?.pose && "
                            "window.__map.acting().canAct", timeout=30000)
