@@ -3,8 +3,9 @@ campus map, its patrol tree and the monitor on an isolated bus. The page takes c
 click on the goal "Office" on the map sends the robot there, the tree is shown paused for the
 manual goal and Resume runs it again; a drag with "Set pose" relocalises the robot with the
 heading of the drag; Stop ends a goal sent with "Go to pose"; a page without the seat has its
-tools disabled and says why, but its Stop works. Screenshots: acting_goal.png,
-acting_stop.png, acting_phone.png."""
+tools disabled and says why, but its Stop works; a tour of two clicked points is driven to the
+end; the arrow keys and the joystick drive the robot, which stops when they are let go.
+Screenshots: acting_goal.png, acting_stop.png, acting_phone.png, acting_tour.png."""
 
 from __future__ import annotations
 
@@ -168,4 +169,47 @@ def test_a_page_without_the_seat_says_why_and_its_stop_still_works(browser: Brow
         screenshot(other, "acting_phone")
         box = other.locator("#map-stop").bounding_box()
         assert box is not None and box["x"] + box["width"] <= 390, "Stop fits a phone"
+        assert errors == [], json.dumps(errors)
+
+
+def test_a_tour_of_clicked_points_then_driving_by_keys_and_joystick(browser: Browser) -> None:
+    with live_system() as live:
+        errors: list[str] = []
+        page = _acting_page(browser, live, errors)
+        middle = _bring_to_middle(page, (OFFICE[0] + CORRIDOR[0]) / 2,
+                                  (OFFICE[1] + CORRIDOR[1]) / 2)
+        page.click("#map-act button[data-tool='tour']")
+        for point in (OFFICE, CORRIDOR):
+            page.mouse.click(*_canvas_point(page, *point))
+        drawn = _acting(page)["points"]
+        assert len(drawn) == 2 and all(th is None for _x, _y, th in drawn)
+        for (x, y, _th), (want_x, want_y) in zip(drawn, (OFFICE, CORRIDOR), strict=True):
+            assert math.hypot(x - want_x, y - want_y) < 0.2
+        assert page.inner_text("#map-tour-go") == "Go (2)"
+        page.click("#map-tour-go")
+        page.wait_for_function("[...document.querySelectorAll('#map-log li.ok')].some("
+                               "li => li.textContent.includes('tour, done'))", timeout=120000)
+        assert _distance(live, *CORRIDOR) < 0.5
+        assert not live.system.runner.enabled, "the tour paused the patrol"
+        screenshot(page, "acting_tour")
+        # the arrow keys, while the map has focus
+        page.mouse.click(*middle)
+        start = live.system.sim.pose
+        page.keyboard.down("ArrowLeft")  # turn on the spot
+        wait_until(lambda: abs(math.remainder(live.system.sim.pose.theta - start.theta,
+                                              math.tau)) > 0.3, 30, "the robot to turn")
+        page.keyboard.up("ArrowLeft")
+        wait_until(lambda: live.system.sim.base.turn_rate == 0, 10, "the robot to stop turning")
+        # the joystick: pushed up, the robot drives forwards
+        page.click("#map-drive")
+        pad = page.locator("#map-joystick").bounding_box()
+        assert pad is not None
+        centre = (pad["x"] + pad["width"] / 2, pad["y"] + pad["height"] / 2)
+        start = live.system.sim.pose
+        page.mouse.move(*centre)
+        page.mouse.down()
+        page.mouse.move(centre[0], centre[1] - pad["height"] / 4, steps=4)
+        wait_until(lambda: _distance(live, start.x, start.y) > 0.2, 30, "the robot to drive")
+        page.mouse.up()
+        wait_until(lambda: live.system.sim.base.speed == 0, 10, "the robot to stop on release")
         assert errors == [], json.dumps(errors)

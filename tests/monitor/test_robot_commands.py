@@ -283,3 +283,18 @@ def test_stop_ends_a_tour_and_a_new_goal_replaces_one() -> None:
                                                           "of 1")
 
     asyncio.run(scenario())
+
+
+def test_the_clients_of_a_robot_that_left_are_withdrawn() -> None:
+    hub, buses = acting_hub()
+
+    async def scenario() -> None:
+        client = page(hub, 1)
+        hub.seat.claim(1)
+        await _send(hub, client, {"t": "stop", "ns": ROBOT})
+        hub.robot_hub.robots["/robot2"] = hub.robot_hub.robots.pop(ROBOT)
+        await _send(hub, client, {"t": "stop", "ns": "/robot2"})
+
+    asyncio.run(scenario())
+    assert buses[ROBOT].calls == [("stop",), ("destroy",)]
+    assert buses["/robot2"].calls == [("stop",)]

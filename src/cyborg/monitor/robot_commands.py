@@ -183,6 +183,14 @@ class RobotCommands:
         return ns
 
     def _clients_for(self, ns: str) -> RobotClients:
+        """The bus clients for ``ns``, made on first use.
+
+        Those of robots the hub no longer follows are withdrawn first, so robots that come and
+        go cost nothing lasting.
+        """
+        for gone in [name for name in self._bus if name not in self._robots.robots]:
+            self._end_tour(gone, "the robot left")
+            self._bus.pop(gone).destroy()
         found = self._bus.get(ns)
         if found is None:
             if self._make is None:
