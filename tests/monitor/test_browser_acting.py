@@ -146,29 +146,40 @@ def test_set_pose_by_dragging_and_stop_ending_a_goal(browser: Browser) -> None:
         assert errors == [], json.dumps(errors)
 
 
-def test_a_page_without_the_seat_says_why_and_its_stop_still_works(browser: Browser) -> None:
+def test_a_phone_takes_control_and_taps_a_goal_and_a_page_without_the_seat_stops_it(
+        browser: Browser) -> None:
     with live_system() as live:
         errors: list[str] = []
-        holder = _acting_page(browser, live, errors)
-        other = open_page(browser, live.url, errors)
-        other.set_viewport_size({"width": 390, "height": 760})  # a phone
-        other.click("#tabs button[data-tab='map']")
-        other.wait_for_function("window.__map && window.__map.firstPaint !== null && "
+        desk = _acting_page(browser, live, errors)
+        phone_context = browser.new_context(viewport={"width": 390, "height": 760},
+                                            has_touch=True, is_mobile=True)
+        phone = phone_context.new_page()
+        phone.on("console", lambda message: errors.append(message.text)
+                 if message.type == "error" else None)
+        phone.on("pageerror", lambda error: errors.append(str(error)))
+        phone.goto(live.url)
+        phone.wait_for_function("window.__map && window.__map.firstPaint !== null && "
                                 f"window.__map.robot({ROBOT!r})?.pose", timeout=30000)
-        assert _acting(other)["canAct"] is False
-        assert other.is_disabled("#map-home") and other.is_disabled("#map-goal")
-        assert "take control" in (other.get_attribute("#map-home", "title") or "")
-        assert other.is_visible("#map-stop") and not other.is_disabled("#map-stop")
-        holder.select_option("#map-goal", "Cafeteria")
-        wait_until(lambda: not live.system.runner.enabled, 20, "the goal to pause the tree")
+        assert _acting(phone)["canAct"] is False, "the desk page holds the seat"
+        assert phone.is_disabled("#map-home") and phone.is_disabled("#map-goal")
+        assert "take control" in (phone.get_attribute("#map-home", "title") or "")
+        assert phone.is_visible("#map-stop") and not phone.is_disabled("#map-stop")
+        phone.click("#take")
+        phone.wait_for_function("window.__map.acting().canAct", timeout=20000)
+        desk.wait_for_function("!window.__map.acting().canAct", timeout=20000)
+        assert desk.is_disabled("#map-home") and not desk.is_disabled("#map-stop")
+        phone.touchscreen.tap(*_canvas_point(phone, 15.0, 11.0))  # the goal "Library"
+        wait_until(lambda: not live.system.runner.enabled, 20, "the tapped goal to pause the tree")
         start = live.system.sim.pose
         wait_until(lambda: _distance(live, start.x, start.y) > 0.3, 60, "the robot to set off")
-        other.click("#map-stop")
-        holder.wait_for_function("[...document.querySelectorAll('#map-log li.error')].some("
-                                 "li => li.textContent.includes('Cafeteria'))", timeout=30000)
-        screenshot(other, "acting_phone")
-        box = other.locator("#map-stop").bounding_box()
+        screenshot(phone, "acting_phone")
+        desk.click("#map-stop")  # no seat, and yet it stops the robot
+        phone.wait_for_function("[...document.querySelectorAll('#map-log li.error')].some("
+                                "li => li.textContent.includes(\"'Library' failed\"))",
+                                timeout=30000)
+        box = phone.locator("#map-stop").bounding_box()
         assert box is not None and box["x"] + box["width"] <= 390, "Stop fits a phone"
+        phone_context.close()
         assert errors == [], json.dumps(errors)
 
 
