@@ -1,6 +1,6 @@
 """Helpers for the map data path's tests: a robot's messages built by hand (pose, scan, path,
-battery, footprint, fixed transforms, map geometry), and a fake robot that publishes them on a
-bus."""
+battery, current goal, footprint, fixed transforms, map geometry), and a fake robot that
+publishes them on a bus."""
 
 from __future__ import annotations
 
@@ -11,7 +11,12 @@ import numpy as np
 
 from cyborg.bus import Node
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry, MapObject
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BatteryStatus,
+    GoalWithHeading,
+    MapGeometry,
+    MapObject,
+)
 from cyborg.bus.msgs.geometry_msgs.msg import (
     Point,
     Point32,
@@ -71,6 +76,13 @@ def battery(charge: float = 80.0, dock: str = "UNDOCKED") -> BatteryStatus:
                          voltage=25.0, charging=False, dock_state=dock)
 
 
+def goal(name: str = "Office", x: float = 1.0, y: float = 2.0, theta: float = 0.5, *,
+         heading: bool = True) -> GoalWithHeading:
+    """``current_goal``'s message: the goal ``name`` at ``(x, y)``; "" for no goal."""
+    return GoalWithHeading(name=name, comment="", position=Pose2D(x=x, y=y, theta=theta),
+                           has_heading=heading)
+
+
 def footprint(corners: Sequence[tuple[float, float]] = ((0.3, 0.2), (-0.3, 0.2), (-0.3, -0.2),
                                                        (0.3, -0.2))) -> PolygonStamped:
     """An outline in the robot's frame (a 60 x 40 cm box unless told)."""
@@ -127,6 +139,7 @@ class FakeMapRobot:
         self.battery = robot.BATTERY_STATUS.publisher(node, namespace)
         self.map = robot.MAP_GEOMETRY.publisher(node, namespace)
         self.footprint = robot.FOOTPRINT.publisher(node, namespace)
+        self.goal = robot.CURRENT_GOAL.publisher(node, namespace)
         self.tf_static = robot.TF_STATIC.publisher(node)
 
     def state(self, text: str) -> None:

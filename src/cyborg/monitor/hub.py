@@ -149,9 +149,8 @@ class Hub:
 
     def robots(self) -> dict[str, Any]:
         """The ``robots`` message: every followed tree's description, and the seat's holder."""
-        return {"t": "robots", "robots": [source.describe() for source in
-                                          sorted(self.sources.values(),
-                                                 key=lambda source: source.namespace)],
+        return {"t": "robots", "robots": [self.sources[name].describe()
+                                          for name in sorted(self.sources)],
                 "seat": self.seat.holder.client if self.seat.holder else None,
                 "map_robots": self.robot_hub.describe()}
 
@@ -176,7 +175,9 @@ class Hub:
                 self._loop.call_later(delay, self._flush, namespace)
             else:
                 self._flush(namespace)
-        elif what == "structure":
+            return
+        self.robot_hub.tree_changed(namespace)  # (a tick: in _flush, with the newest state)
+        if what == "structure":
             for client in self._watchers(namespace):
                 self.send_tree(client, namespace)
             self.broadcast(self.robots())
@@ -193,6 +194,7 @@ class Hub:
         self._last_frame[namespace] = time.monotonic()
         source = self.sources.get(namespace)
         state = source.state if source is not None else None
+        self.robot_hub.tree_changed(namespace)
         watchers = self._watchers(namespace)
         if state is None or not watchers:
             return  # a page that starts watching gets a snapshot

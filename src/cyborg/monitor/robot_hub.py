@@ -14,8 +14,12 @@ except :meth:`RobotHub.notify`, which the bus calls from its threads.
   :data:`RS_INTERVAL` has passed since that robot's last one, else then. A 10 Hz robot passes
   unchanged, the simulator's 30 Hz becomes about 12 Hz. An ``rs`` carries the pose, and the
   scan (with the laser's mount) when a new one came; the path state, battery and the current
-  path's id when known; the footprint only when it changed (and in the first ``rs`` a page
-  gets), as pages keep it.
+  path's id when known; the footprint, the current goal and the running node only when they
+  changed (and in the first ``rs`` a page gets), as pages keep them.
+* **The running node** of the tree that drives a robot (``/robot1/bt`` drives ``/robot1``) is
+  the deepest node of its active path
+  (:meth:`~cyborg.monitor.tree_state.TreeState.running_label`); :meth:`RobotHub.tree_changed`
+  hears of each tree's frames and sends the label in ``rs`` as ``node`` when it changed.
 * **Paths** go out as ``path`` when a new one comes, at most one per :data:`PATH_INTERVAL` per
   robot; **maps** are laid out and gzipped in a worker thread (:mod:`cyborg.monitor.map_store`)
   and announced as ``map_ref`` (``key`` null when the robot's map was refused).
@@ -42,6 +46,7 @@ from cyborg.monitor.limits import check_namespace
 from cyborg.monitor.map_store import MapStore, StoredMap
 from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.robot_wire import wire_text
+from cyborg.monitor.source import TreeSource
 
 log = logging.getLogger("cyborg.monitor")
 
@@ -51,7 +56,7 @@ RS_INTERVAL = 0.08
 """Shortest time between two ``rs`` messages of one robot (s)."""
 PATH_INTERVAL = 0.5
 """Shortest time between two ``path`` messages of one robot (s)."""
-RS_KINDS = frozenset({"pose", "scan", "state", "battery", "footprint"})
+RS_KINDS = frozenset({"pose", "scan", "state", "battery", "goal", "footprint"})
 """Changes that an ``rs`` message tells."""
 
 
@@ -69,6 +74,11 @@ class _Robot:
     path_later: bool = False
     footprint_sent: int = 0
     """The footprint id last sent to the pages."""
+    node: str = ""
+    """The label of the node running now in the robot's tree ("" for none)."""
+    node_sent: str = ""
+    goal_sent: dict[str, Any] | None = None
+    """The current goal last sent to the pages."""
     map: StoredMap | None = None
     building: bool = False
 
@@ -81,7 +91,7 @@ class RobotHub:
     by the functions given to :meth:`use` (none until then).
     """
 
-    def __init__(self, clients: Collection[Client], trees: Mapping[str, object],
+    def __init__(self, clients: Collection[Client], trees: Mapping[str, TreeSource],
                  changed: Callable[[], None], store: MapStore | None = None) -> None:
         self._clients, self._trees, self._changed = clients, trees, changed
         self.store = store or MapStore()
@@ -155,6 +165,7 @@ class RobotHub:
                 return False
             self._release(gone)
         self.robots[namespace] = _Robot(self._make(namespace))
+        self.tree_changed(self._tree_of(namespace) or "")  # what its tree runs now
         self._request(namespace)  # what arrived while the source was being made
         return True
 
@@ -176,6 +187,22 @@ class RobotHub:
     def _tree_of(self, namespace: str) -> str | None:
         return next((tree for tree in sorted(self._trees)
                      if robot_of_runner(tree) == namespace), None)
+
+    def tree_changed(self, tree: str) -> None:
+        """The tree runner under ``tree`` ticked, restarted or left: its robot's running node.
+
+        Its robot (``/x`` for ``/x/bt``) is sent the new label when it changed; the label is ""
+        when the runner is gone or nothing runs.
+        """
+        robot = self.robots.get(robot_of_runner(tree) or "")
+        if robot is None:
+            return
+        source = self._trees.get(tree)
+        state = source.state if source is not None and source.alive else None
+        label = state.running_label() if state is not None else ""
+        if label != robot.node:
+            robot.node = label
+            self._request(robot.source.namespace)
 
     def destroy(self) -> None:
         """Stops following every robot."""
@@ -238,11 +265,11 @@ class RobotHub:
             elif not robot.path_later and self._loop is not None:
                 robot.path_later = True
                 self._loop.call_later(wait, self._path_due, source.namespace)
-        if viewers and changes & (RS_KINDS | {"path"}):
-            footprint = source.footprint_id != robot.footprint_sent
-            state = self._rs_message(robot, scan="scan" in changes, footprint=footprint)
-            if state is not None and "fp" in state:
-                robot.footprint_sent = source.footprint_id
+        if viewers and (changes & (RS_KINDS | {"path"}) or robot.node != robot.node_sent):
+            state = self._rs_message(robot, scan="scan" in changes)
+            if state is not None:
+                robot.footprint_sent, robot.node_sent = source.footprint_id, robot.node
+                robot.goal_sent = source.goal
             self._send(viewers, state)
         if "warn" in changes:
             self._send_warnings(robot, viewers)
@@ -313,7 +340,7 @@ class RobotHub:
                 self._send([client], self._map_ref(robot))
             if source.path is not None:
                 self._send([client], self._path_message(robot))
-            self._send([client], self._rs_message(robot, scan=True, footprint=True))
+            self._send([client], self._rs_message(robot, scan=True, everything=True))
             for kind, message, count in source.warnings.latest():
                 self._send([client], {"t": "robot_warn", "ns": source.namespace,
                                       "kind": kind, "message": message, "count": count})
@@ -334,7 +361,13 @@ class RobotHub:
         return {"t": "path", "ns": robot.source.namespace, "id": path["id"], "xy": path["xy"]}
 
     @staticmethod
-    def _rs_message(robot: _Robot, *, scan: bool, footprint: bool) -> dict[str, Any] | None:
+    def _rs_message(robot: _Robot, *, scan: bool, everything: bool = False
+                    ) -> dict[str, Any] | None:
+        """The robot's ``rs``, or None before its first pose.
+
+        With the scan if ``scan``; with what pages keep (footprint, goal, node) when it changed
+        since the last ``rs`` to every page, or always if ``everything``.
+        """
         source = robot.source
         pose = source.pose
         if pose is None:
@@ -344,8 +377,13 @@ class RobotHub:
                                    "p": pose}
         if scan and source.scan is not None:
             message["sc"] = source.scan
-        if footprint and source.footprint is not None:
+        if source.footprint is not None and (
+                everything or source.footprint_id != robot.footprint_sent):
             message["fp"] = source.footprint
+        if (everything and source.goal is not None) or source.goal != robot.goal_sent:
+            message["goal"] = source.goal
+        if (everything and robot.node) or robot.node != robot.node_sent:
+            message["node"] = robot.node
         if source.state is not None:
             message["st"] = source.state
         if source.battery is not None:

@@ -2,14 +2,15 @@
 
 A :class:`RobotSource` subscribes, under the robot's namespace (``/cyborg`` by default; the
 names are those of :mod:`cyborg.interfaces.robot`), to ``pose``, ``scan``, ``path``,
-``arnl_path_state``, ``battery_status``, ``footprint`` and ``map_geometry``, and to the
-absolute ``/tf_static``. Its bus callbacks run on the monitor node's thread and only check,
-store and notify: each message goes through its function in :mod:`cyborg.monitor.robot_wire`,
-the result replaces the one kept (a message that cannot be drawn leaves it as it was), any
-warning goes to the robot's :class:`WarningLog`, and the listener hears
-``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``, ``"state"``,
-``"battery"``, ``"footprint"``, ``"map"``, ``"warn"``, ``"alive"``). The map is kept as the
-message itself: laying it out and compressing it is the hub's work, off the bus thread
+``arnl_path_state``, ``battery_status``, ``current_goal``, ``footprint`` and ``map_geometry``,
+and to the absolute ``/tf_static``. Its bus callbacks run on the monitor node's thread and
+only check, store and notify: each message goes through its function in
+:mod:`cyborg.monitor.robot_wire`, the result replaces the one kept (a message that cannot be
+drawn leaves it as it was), any warning goes to the robot's :class:`WarningLog`, and the
+listener hears ``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``,
+``"state"``, ``"battery"``, ``"goal"``, ``"footprint"``, ``"map"``, ``"warn"``, ``"alive"``).
+The map is kept as the message itself: laying it out and compressing it is the hub's work,
+off the bus thread
 (:mod:`cyborg.monitor.map_store`).
 
 Each scan carries the laser's mount on the robot (``"m"``, see
@@ -33,7 +34,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bus import Node, Qos, Subscription
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, MapGeometry
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, GoalWithHeading, MapGeometry
 from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
@@ -48,6 +49,7 @@ from cyborg.monitor.robot_wire import (
     battery_wire,
     clip_text,
     footprint_wire,
+    goal_wire,
     mount_of,
     path_wire,
     pose_wire,
@@ -138,6 +140,8 @@ class RobotSource:
         self.state: str | None = None
         """``arnl_path_state``'s text."""
         self.battery: dict[str, Any] | None = None
+        self.goal: dict[str, Any] | None = None
+        """The goal the robot drives to, ``{"name", "p", "h"}``; None when it has none."""
         self.footprint: list[float] | None = None
         """The robot's outline, ``[x0, y0, x1, y1, ...]`` (m, its own frame)."""
         self.footprint_id = 0
@@ -158,6 +162,7 @@ class RobotSource:
             robot.PATH.subscription(node, self._on_path, ns),
             robot.PATH_STATE.subscription(node, self._on_state, ns),
             robot.BATTERY_STATUS.subscription(node, self._on_battery, ns),
+            robot.CURRENT_GOAL.subscription(node, self._on_goal, ns),
             robot.FOOTPRINT.subscription(node, self._on_footprint, ns),
             robot.TF_STATIC.subscription(node, self._on_transforms),
             robot.MAP_GEOMETRY.subscription(node, self._on_map, ns),
@@ -229,6 +234,13 @@ class RobotSource:
         if battery is not None:
             self.battery = battery
             self._mark("battery")
+
+    def _on_goal(self, message: GoalWithHeading) -> None:
+        goal, warnings = goal_wire(message)
+        self._warn("goal", warnings)
+        if goal != self.goal:
+            self.goal = goal
+            self._mark("goal")
 
     def _on_map(self, message: MapGeometry) -> None:
         with self._lock:

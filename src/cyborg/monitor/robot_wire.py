@@ -20,6 +20,8 @@ path state     the text of ``arnl_path_state``
 footprint      ``[x0, y0, x1, y1, ...]``: the robot's outline in its own frame, m (1 mm)
 transforms     ``{child: (parent, [x, y, θ])}`` from ``/tf_static``; :func:`mount_of` chains them
                into the laser's mount on the robot, ``[x, y, θ]`` (m, rad; 1 mm, 1 mrad)
+current goal   ``{"name", "p": [x, y, θ], "h"}``: the goal's name, where it is (as a pose) and
+               whether the robot turns to its heading there; None when there is no goal
 =============  ==================================================================================
 """
 
@@ -31,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, GoalWithHeading
 from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
@@ -199,6 +201,26 @@ def state_wire(text: str) -> tuple[str, Warnings]:
     """The path state's text, clipped to :data:`TEXT_LIMIT` characters (with a warning)."""
     state, clipped = clip_text(text)
     return state, [f"state: arnl_path_state clipped to {TEXT_LIMIT} characters"] if clipped else []
+
+
+def goal_wire(message: GoalWithHeading) -> tuple[dict[str, Any] | None, Warnings]:
+    """The current goal as ``{"name", "p": [x, y, θ], "h"}``; None when there is none.
+
+    An empty ``name`` says the robot drives to no goal (None, no warning). A goal whose position
+    is not finite or lies more than :data:`WORLD_LIMIT` m away is not shown either, with a
+    warning; the name is clipped to :data:`TEXT_LIMIT` characters.
+    """
+    name, clipped = clip_text(message.name)
+    if not name:
+        return None, []
+    position, problems = pose_wire(message.position)
+    if position is None:
+        problem = problems[0].removeprefix("pose: ").removesuffix("; last good pose kept")
+        return None, [f"goal: {name[:40]!r} not shown: {problem}"]
+    warnings: Warnings = []
+    if clipped:
+        warnings.append(f"goal: name clipped to {TEXT_LIMIT} characters")
+    return {"name": name, "p": position, "h": bool(message.has_heading)}, warnings
 
 
 def footprint_wire(message: PolygonStamped) -> tuple[list[float] | None, Warnings]:

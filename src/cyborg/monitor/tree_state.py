@@ -85,6 +85,8 @@ class TreeState:
         """Identifies the structure: same text, same version."""
         self.ids: list[str] = []
         self.parents: list[int] = []
+        self.labels: list[str] = []
+        """Each node's label (its title with the properties filled in), else its name."""
         self._index_nodes(root, -1)
         self.index_of = {uid: index for index, uid in enumerate(self.ids)}
         count = len(self.ids)
@@ -123,6 +125,7 @@ class TreeState:
                 raise StructureError(f"node {len(self.ids)} has no {exc}") from None
             self.ids.append(uid)
             self.parents.append(parent_index)
+            self.labels.append(str(current.get("label") or current.get("name") or uid))
             index = len(self.ids) - 1
             stack.extend((child, index) for child in reversed(children))
 
@@ -237,6 +240,24 @@ class TreeState:
         with self._lock:
             entries = list(self.history)
         return [entry.to_json() for entry in entries]
+
+    def running_label(self) -> str:
+        """The label of the node running now: the deepest node of the active path, or "".
+
+        The active path holds every node RUNNING after the latest tick, root first; the node
+        that does the work is the deepest of them (a leaf, or a decorator whose child did not
+        run). Where a parallel runs several branches, the first of the deepest (in pre-order)
+        is named. "" when nothing runs (the tree is idle, or finished its tick).
+        """
+        with self._lock:
+            active = self.active
+        if not active:
+            return ""
+        depth: dict[int, int] = {}
+        for index in active:  # root first: a node's active parent came before it
+            depth[index] = depth.get(self.parents[index], -1) + 1
+        deepest = max(active, key=lambda index: (depth[index], -index))
+        return self.labels[deepest]
 
     def statuses_by_id(self) -> dict[str, str]:
         """Last status of every node that has run, by id (for exports)."""

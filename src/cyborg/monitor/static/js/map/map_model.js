@@ -12,8 +12,9 @@
 //       mount on the robot, m and rad; none: the robot's centre); st the path state
 //       (PLANNING_PATH, MOVING_TO_GOAL, REACHED_GOAL ...); bat = {pct, charging, dock};
 //       pid the id of the path being followed; fp the footprint, x y ... in m in the robot's
-//       frame, sent when it changed (kept until the next); node (the running node's label) and
-//       goal = {name?, p:[x, y, θ]} are read when present (the monitor does not send them yet)
+//       frame, sent when it changed (kept until the next); node the label of the node running
+//       in the robot's tree ("" for none) and goal = {name, p:[x, y, θ], h} the goal it drives
+//       to (h: whether it turns to θ there; null for none), both sent when they changed
 //   {t:"path", ns, id, xy:[x y ... in mm]}   the planned path (latched: paired with st, pid)
 //   {t:"robot_warn", ns, kind, message, count}   something the monitor refused or mended
 //   {t:"robots", ..., map_robots:[{ns, tree, alive, map}]}   (app.js's message) which tree drives
@@ -338,11 +339,11 @@ function batteryOf(bat) {
 function goalOf(goal) {
   if (Array.isArray(goal)) {
     const [x, y, th] = triple(goal, "goal");
-    return { name: "", x, y, th };
+    return { name: "", x, y, th, heading: true };
   }
   if (typeof goal !== "object") throw new Error("goal is not an object");
   const [x, y, th] = triple(goal.p, "goal.p");
-  return { name: text(goal.name), x, y, th };
+  return { name: text(goal.name), x, y, th, heading: goal.h !== false };
 }
 
 // Where along its path the robot is: the closest point on the path's segments, searched near

@@ -17,7 +17,8 @@
 // toWorld(sx, sy), view(), colourOf(ns), robot(ns), fetches, renders, where, frameMs,
 // messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
 // battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
-// is), or null; acting() what acting from the map stands at ({robot, canAct, mode, points}).
+// is, the running node, the current goal), or null; acting() what acting from the map stands
+// at ({robot, canAct, mode, points}).
 
 import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
@@ -349,5 +350,6 @@ function describe(model, robot) {
     ns: robot.ns, pose: robot.pose && { ...robot.pose }, mount: robot.mount, footprint: [...robot.footprint],
     battery: robot.battery && { ...robot.battery }, alive: robot.alive, state: robot.state, pathId: robot.pathId,
     path: robot.path ? robot.path.xy.length / 2 : 0, scan: robot.scanCount, colour: robot.colour,
+    node: robot.node, goal: robot.goal && { ...robot.goal },
   };
 }

@@ -24,19 +24,19 @@ export function drawBitmap(ctx, view, placement, dpr) {
 
 // The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), robots (the robots
 // to draw, [robot]), layers, selected (ns or null)}. Returns what it drew: {robots, laser,
-// paths}.
+// paths, goals}.
 export function drawMoving(ctx, scene) {
   const { view, dpr, layers } = scene;
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, view.width, view.height);
-  const drawn = { robots: 0, laser: 0, paths: 0 };
+  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0 };
   if (layers.paths) {
     for (const robot of scene.robots) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
     }
   }
   for (const robot of scene.robots) {
-    if (robot.goal && scene.model.travelling(robot)) drawGoal(ctx, view, robot);
+    if (robot.goal && scene.model.travelling(robot)) drawn.goals += drawGoal(ctx, view, robot, layers.labels);
   }
   if (layers.laser) {
     for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
@@ -100,19 +100,37 @@ function lineTo(ctx, view, x, y, first) {
   else ctx.lineTo(sx, sy);
 }
 
-// The goal the robot is on its way to: a ring in its colour, with its heading.
-function drawGoal(ctx, view, robot) {
-  const [sx, sy] = view.toScreen(robot.goal.x, robot.goal.y);
+// The goal the robot is on its way to: a ring in its colour, a tick for its heading (when the
+// robot turns to it there), and its name when labels are on.
+function drawGoal(ctx, view, robot, labels) {
+  const goal = robot.goal;
+  const [sx, sy] = view.toScreen(goal.x, goal.y);
   ctx.beginPath();
   ctx.arc(sx, sy, 10, 0, 2 * Math.PI);
   ctx.strokeStyle = robot.colour;
   ctx.lineWidth = 3;
   ctx.stroke();
-  ctx.beginPath();
-  ctx.moveTo(sx, sy);
-  ctx.lineTo(sx + 18 * Math.cos(robot.goal.th), sy - 18 * Math.sin(robot.goal.th));
-  ctx.lineWidth = 2;
-  ctx.stroke();
+  if (goal.heading) {
+    ctx.beginPath();
+    ctx.moveTo(sx, sy);
+    ctx.lineTo(sx + 18 * Math.cos(goal.th), sy - 18 * Math.sin(goal.th));
+    ctx.lineWidth = 2;
+    ctx.stroke();
+  }
+  if (labels && goal.name) {
+    const name = goal.name.length > 40 ? `${goal.name.slice(0, 39)}…` : goal.name;
+    ctx.font = 'bold 11px system-ui, "DejaVu Sans", sans-serif';
+    ctx.textBaseline = "top";
+    ctx.textAlign = "center";
+    ctx.lineJoin = "round";
+    ctx.lineWidth = 3;
+    ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
+    ctx.strokeText(name, sx, sy + 13);
+    ctx.fillStyle = robot.colour;
+    ctx.fillText(name, sx, sy + 13);
+    ctx.textAlign = "left";
+  }
+  return 1;
 }
 
 // Laser hits as 2 px squares in the robot's colour (those off screen are skipped), as one
