@@ -12,6 +12,7 @@ import { History } from "./history.js";
 import { Layout } from "./layout.js";
 import { LazyMapPanel } from "./map/lazy_panel.js";
 import { TreeModel } from "./model.js";
+import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { TreeView } from "./tree_view.js";
 
@@ -283,6 +284,7 @@ function select(id) {
   page.selected = id;
   view.markClass("selected", new Set(id ? [id] : []));
   showNode(model, id, page.hooks);
+  mapPanel.highlightGoal(goalNames(model.byId.get(id))); // its goal ringed on the map
 }
 
 function tickInfo() {

@@ -18,7 +18,7 @@ export class LazyMapPanel {
     this.options = options;
     this.panel = null;
     this.loading = null;
-    this.state = { tree: null, visible: null, connected: false, robots: null, seat: null, unreadable: [] };
+    this.state = { tree: null, visible: null, connected: false, robots: null, seat: null, unreadable: [], goal: null };
     this.emptyListener = () => {};
     setTimeout(() => this.load(), LOAD_ANYWAY_MS);
   }
@@ -29,8 +29,9 @@ export class LazyMapPanel {
       this.loading = import("./map_panel.js").then(({ MapPanel }) => {
         const panel = new MapPanel(this.root, this.options);
         panel.onEmpty = this.emptyListener;
-        const { tree, visible, connected, robots, seat, unreadable } = this.state;
+        const { tree, visible, connected, robots, seat, unreadable, goal } = this.state;
         if (tree !== null) panel.setTree(tree);
+        if (goal !== null) panel.highlightGoal(goal);
         if (robots !== null) panel.receive(robots);
         if (seat !== null) panel.receive(seat);
         for (const [text, error] of unreadable) panel.unreadable(text, error);
@@ -78,6 +79,13 @@ export class LazyMapPanel {
 
   setTree(ns) {
     if (this.panel !== null) return this.panel.setTree(ns);
+    if (ns !== this.state.tree) this.state.goal = null;
     this.state.tree = ns;
+  }
+
+  // The goal names of the node selected in the tree (see MapPanel.highlightGoal).
+  highlightGoal(names) {
+    if (this.panel !== null) return this.panel.highlightGoal(names);
+    this.state.goal = names;
   }
 }

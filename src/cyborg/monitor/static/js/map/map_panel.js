@@ -18,10 +18,12 @@
 // messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
 // battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
 // is, the running node, the current goal), or null; acting() what acting from the map stands
-// at ({robot, canAct, mode, points}).
+// at ({robot, canAct, mode, points}); highlight() the goal ringed for the node selected in
+// the tree ({name, x, y, th, category}, or null).
 
 import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
+import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
 import { CATEGORY, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
@@ -52,6 +54,7 @@ export class MapPanel {
     this.pairs = new Map(); // tree ns -> robot ns, from the monitor's robots list
     this.shownKey = null;
     this.loading = new Map(); // key -> promise
+    this.goalHighlight = new GoalHighlight(); // the goal the node selected in the tree names
     this.scheduled = false;
     this.size = { width: 0, height: 0 };
     this.onEmpty = () => {}; // hears whether there is no map to show (the layout shrinks it)
@@ -80,6 +83,7 @@ export class MapPanel {
       colourOf: (ns) => this.model.robots.get(ns)?.colour ?? null,
       robot: (ns) => describe(this.model, this.model.robots.get(ns)),
       acting: () => ({ robot: this.actingRobot(), canAct: this.actions.canAct, mode: this.tools.mode, points: this.tools.points.map((p) => [...p]) }),
+      highlight: () => this.goalHighlight.target && { ...this.goalHighlight.target },
     };
     this.view.attach(this.canvas, {
       claim: (event) => this.tools.claim(event),
@@ -146,7 +150,16 @@ export class MapPanel {
   // The tree shown in the tree view: its robot becomes the selected one (/x/bt → /x, unless
   // the monitor's robots list pairs them otherwise).
   setTree(ns) {
+    if (ns !== this.treeNs) this.goalHighlight.set([]); // the selection was in another tree
     this.treeNs = ns;
+    this.schedule();
+  }
+
+  // A node was selected in the tree: `names` are the goal names its properties give
+  // (js/node_goals.js), most likely first; the first that is on the map is ringed and brought
+  // into view. [] (a node that names none, or none selected) clears it.
+  highlightGoal(names) {
+    this.goalHighlight.set(names);
     this.schedule();
   }
 
@@ -295,6 +308,12 @@ export class MapPanel {
     const selected = this.selected();
     const followed = this.follow ? this.model.robots.get(selected) : null;
     if (followed && followed.pose) this.view.centerOn(followed.pose.x, followed.pose.y);
+    this.goalHighlight.resolve(this.model.maps.get(this.shownKey) ?? null);
+    if (this.goalHighlight.reveal(this.view)) {
+      this.userMoved = true;
+      this.follow = false; // the goal asked for is shown, not the robot
+      this.hud.setFollow(false);
+    }
     const layers = this.hud.layers;
     const ready = this.staticLayer.update(this.view.snapshot(), dpr, layers);
     const robots = [...this.model.robots.values()].filter((robot) => {
@@ -310,6 +329,7 @@ export class MapPanel {
     this.stats.moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, robots, layers, selected });
     this.tools.draw(this.ctx);
     this.actions.refresh();
+    if (this.goalHighlight.draw(this.ctx, this.view)) this.schedule(); // pulsing
     if (this.staticLayer.current) this.stats.drawn = this.staticLayer.current.drawn;
     this.hud.showScale(this.view.scale);
     this.hud.showWarnings(this.model.warnings);
