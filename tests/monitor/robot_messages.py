@@ -1,6 +1,6 @@
 """Helpers for the map data path's tests: a robot's messages built by hand (pose, scan, path,
-battery, current goal, footprint, fixed transforms, map geometry), and a fake robot that
-publishes them on a bus."""
+battery, current goal, footprint, fixed transforms, map geometry, the detector's detections
+and predictions), and a fake robot that publishes them on a bus."""
 
 from __future__ import annotations
 
@@ -16,6 +16,8 @@ from cyborg.bus.msgs.cyborg_msgs.msg import (
     GoalWithHeading,
     MapGeometry,
     MapObject,
+    Prediction,
+    Predictions,
 )
 from cyborg.bus.msgs.geometry_msgs.msg import (
     Point,
@@ -25,6 +27,7 @@ from cyborg.bus.msgs.geometry_msgs.msg import (
     Pose,
     Pose2D,
     PoseStamped,
+    PoseWithCovariance,
     Quaternion,
     Transform,
     TransformStamped,
@@ -34,7 +37,16 @@ from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import Header, String
 from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
-from cyborg.interfaces import robot
+from cyborg.bus.msgs.vision_msgs.msg import (
+    BoundingBox2D,
+    Detection2D,
+    Detection2DArray,
+    ObjectHypothesis,
+    ObjectHypothesisWithPose,
+    Point2D,
+)
+from cyborg.bus.msgs.vision_msgs.msg import Pose2D as VisionPose2D
+from cyborg.interfaces import detector, robot
 
 BEAMS = 541
 INCREMENT = math.radians(0.5)
@@ -127,6 +139,29 @@ def map_geometry(lines: Sequence[float] | np.ndarray = (0.0, 0.0, 10.0, 0.0, 10.
                        points=np.asarray(points, np.float32), objects=list(objects))
 
 
+def detections(*objects: tuple[str, float, float], frame: str = "camera_left"
+               ) -> Detection2DArray:
+    """The detector's ``detections``: ``(class, score, distance)`` per object, boxes made up."""
+    return Detection2DArray(header=header(frame), detections=[Detection2D(
+        header=header(frame), results=[ObjectHypothesisWithPose(
+            hypothesis=ObjectHypothesis(class_id=label, score=score),
+            pose=PoseWithCovariance(pose=Pose(position=Point(x=0.0, y=0.0, z=distance),
+                                              orientation=Quaternion(x=0.0, y=0.0, z=0.0,
+                                                                     w=1.0)),
+                                    covariance=np.zeros(36, np.float64)))],
+        bbox=BoundingBox2D(center=VisionPose2D(position=Point2D(x=320.0, y=240.0), theta=0.0),
+                           size_x=40.0, size_y=80.0), id=str(index))
+        for index, (label, score, distance) in enumerate(objects)])
+
+
+def predictions(*objects: tuple[str, float, float], frame: str = "camera_left") -> Predictions:
+    """The detector's 2018 ``predictions``: ``(label, confidence, distance)`` per object."""
+    return Predictions(header=header(frame), image_header=header(frame), predictions=[
+        Prediction(label=label, confidence=score, distance=distance, bounding_box=Polygon(
+            points=[Point32(x=x, y=y, z=0.0) for x, y in ((0, 0), (9, 0), (9, 9), (0, 9))]))
+        for label, score, distance in objects])
+
+
 class FakeMapRobot:
     """Publishes a robot's topics under ``namespace`` on ``node``'s bus, by hand."""
 
@@ -140,6 +175,9 @@ class FakeMapRobot:
         self.map = robot.MAP_GEOMETRY.publisher(node, namespace)
         self.footprint = robot.FOOTPRINT.publisher(node, namespace)
         self.goal = robot.CURRENT_GOAL.publisher(node, namespace)
+        seeing = detector.detector_of_robot(namespace)
+        self.detections = detector.DETECTIONS.publisher(node, seeing)
+        self.predictions = detector.PREDICTIONS.publisher(node, seeing)
         self.tf_static = robot.TF_STATIC.publisher(node)
 
     def state(self, text: str) -> None:

@@ -60,3 +60,16 @@ IOU_THRESHOLD = "iou_threshold"
 """Overlap above which boxes of one class merge (0..1); settable at runtime."""
 CLASSES = "classes"
 """Labels to keep (empty: every class); settable at runtime."""
+
+# ---------------------------------------------------------------------- where it runs
+DETECTOR_UNDER_ROBOT = "/detector"
+"""Where a robot's detector lives under the robot's namespace (``/cyborg`` →
+``/cyborg/detector``, :data:`DETECTOR_NAMESPACE`), as ``cyborg up`` places it."""
+
+
+def detector_of_robot(namespace: str) -> str:
+    """The namespace of the detector that looks out of the robot under ``namespace``.
+
+    By the convention of :data:`DETECTOR_UNDER_ROBOT`: ``/robot1`` → ``/robot1/detector``.
+    """
+    return namespace.rstrip("/") + DETECTOR_UNDER_ROBOT

@@ -23,6 +23,10 @@ except :meth:`RobotHub.notify`, which the bus calls from its threads.
 * **Paths** go out as ``path`` when a new one comes, at most one per :data:`PATH_INTERVAL` per
   robot; **maps** are laid out and gzipped in a worker thread (:mod:`cyborg.monitor.map_store`)
   and announced as ``map_ref`` (``key`` null when the robot's map was refused).
+* **Detections**: while some page shows the map, each robot's detector (``/robot1/detector``
+  for ``/robot1``, :func:`cyborg.interfaces.detector.detector_of_robot`) is listened to, and
+  what it saw goes out placed on the map as ``det``, at most one per
+  :data:`DETECTIONS_INTERVAL` per robot (:mod:`cyborg.monitor.detection_wire`).
 * **Warnings** about a robot's messages go out as ``robot_warn``, at most one per second per
   kind, with how often it happened.
 
@@ -37,13 +41,13 @@ import contextlib
 import logging
 import time
 from collections.abc import Callable, Collection, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from cyborg.interfaces.tree_runner import robot_of_runner
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import check_namespace
-from cyborg.monitor.map_store import MapStore, StoredMap
+from cyborg.monitor.map_store import MapStore
+from cyborg.monitor.robot_outbox import RobotOutbox, Throttle
 from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.robot_wire import wire_text
 from cyborg.monitor.source import TreeSource
@@ -56,31 +60,10 @@ RS_INTERVAL = 0.08
 """Shortest time between two ``rs`` messages of one robot (s)."""
 PATH_INTERVAL = 0.5
 """Shortest time between two ``path`` messages of one robot (s)."""
+DETECTIONS_INTERVAL = 0.2
+"""Shortest time between two ``det`` messages of one robot (s): at most 5 a second."""
 RS_KINDS = frozenset({"pose", "scan", "state", "battery", "goal", "footprint"})
 """Changes that an ``rs`` message tells."""
-
-
-@dataclass
-class _Robot:
-    """What the hub keeps about one followed robot."""
-
-    source: RobotSource
-    seq: int = 0
-    last: float = -float("inf")
-    """When the robot's changes were last sent (monotonic s)."""
-    path_sent: int = 0
-    """The path id last sent to the pages."""
-    path_at: float = -float("inf")
-    path_later: bool = False
-    footprint_sent: int = 0
-    """The footprint id last sent to the pages."""
-    node: str = ""
-    """The label of the node running now in the robot's tree ("" for none)."""
-    node_sent: str = ""
-    goal_sent: dict[str, Any] | None = None
-    """The current goal last sent to the pages."""
-    map: StoredMap | None = None
-    building: bool = False
 
 
 class RobotHub:
@@ -95,7 +78,7 @@ class RobotHub:
                  changed: Callable[[], None], store: MapStore | None = None) -> None:
         self._clients, self._trees, self._changed = clients, trees, changed
         self.store = store or MapStore()
-        self.robots: dict[str, _Robot] = {}
+        self.robots: dict[str, RobotOutbox] = {}
         self._make: Callable[[str], RobotSource] | None = None
         self._discover: Callable[[], list[str]] = list
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -141,6 +124,7 @@ class RobotHub:
                     changed = self._found(namespace) or changed
                 if changed:
                     self._changed()
+            self._follow_detections()  # robots found, pages gone
             for robot in list(self.robots.values()):
                 if robot.source.warnings.pending():
                     self._send_warnings(robot, self._viewers())
@@ -164,7 +148,8 @@ class RobotHub:
                     self._warned_limit = True
                 return False
             self._release(gone)
-        self.robots[namespace] = _Robot(self._make(namespace))
+        self.robots[namespace] = RobotOutbox(self._make(namespace), Throttle(PATH_INTERVAL),
+                                             Throttle(DETECTIONS_INTERVAL))
         self.tree_changed(self._tree_of(namespace) or "")  # what its tree runs now
         self._request(namespace)  # what arrived while the source was being made
         return True
@@ -246,41 +231,53 @@ class RobotHub:
         except Exception:
             log.exception("monitor: could not send the state of robot %s", namespace)
 
-    def _send_changes(self, robot: _Robot) -> None:
+    def _send_changes(self, robot: RobotOutbox) -> None:
         source = robot.source
-        now = robot.last = time.monotonic()
+        robot.last = time.monotonic()
         changes = source.take_changes()
         if "map" in changes:
             self._build(robot)
         if "alive" in changes:
             self._changed()
         viewers = self._viewers()
-        path_id = source.path_id
-        if path_id != robot.path_sent:
-            wait = robot.path_at + PATH_INTERVAL - now
-            if not viewers or wait <= 0:
-                robot.path_sent, robot.path_at = path_id, now
-                self._send(viewers, self._path_message(robot))
-                changes.add("path")
-            elif not robot.path_later and self._loop is not None:
-                robot.path_later = True
-                self._loop.call_later(wait, self._path_due, source.namespace)
-        if viewers and (changes & (RS_KINDS | {"path"}) or robot.node != robot.node_sent):
-            state = self._rs_message(robot, scan="scan" in changes)
+        if self._throttled(robot, robot.path_throttle, source.path_id, viewers,
+                           robot.path_message):
+            changes.add("path")
+        if viewers and (changes & (RS_KINDS | {"path"}) or robot.unsent()):
+            state = robot.rs_message(scan="scan" in changes)
             if state is not None:
-                robot.footprint_sent, robot.node_sent = source.footprint_id, robot.node
-                robot.goal_sent = source.goal
+                robot.sent_to_all()
             self._send(viewers, state)
+        self._throttled(robot, robot.detections_throttle, source.detections_id, viewers,
+                        robot.detections_message)
         if "warn" in changes:
             self._send_warnings(robot, viewers)
 
-    def _path_due(self, namespace: str) -> None:
-        robot = self.robots.get(namespace)
-        if robot is not None:
-            robot.path_later = False
+    def _throttled(self, robot: RobotOutbox, throttle: Throttle, newest: int,
+                   viewers: list[Client], message: Callable[[], dict[str, Any] | None]) -> bool:
+        """Sends ``message()`` if item ``newest`` is due by ``throttle``; whether it went out.
+
+        When it is not due yet, the robot is looked at again when it will be.
+        """
+        now = time.monotonic()
+        wait = throttle.wait(newest, now)
+        if wait is None:
+            return False
+        if not viewers or wait <= 0:
+            throttle.mark(newest, now)
+            self._send(viewers, message())
+            return True
+        if not throttle.later and self._loop is not None:
+            throttle.later = True
+            self._loop.call_later(wait, self._due, robot.namespace, throttle)
+        return False
+
+    def _due(self, namespace: str, throttle: Throttle) -> None:
+        throttle.later = False
+        if namespace in self.robots:
             self._request(namespace)
 
-    def _build(self, robot: _Robot) -> None:
+    def _build(self, robot: RobotOutbox) -> None:
         if robot.building or self._loop is None:
             return  # the build under way takes the newest message when it is done
         robot.building = True
@@ -288,7 +285,7 @@ class RobotHub:
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
 
-    async def _build_maps(self, robot: _Robot) -> None:
+    async def _build_maps(self, robot: RobotOutbox) -> None:
         source = robot.source
         try:
             while (message := source.take_map()) is not None:
@@ -300,7 +297,7 @@ class RobotHub:
                     return  # released meanwhile
                 if (stored.key if stored else None) != (robot.map.key if robot.map else None):
                     robot.map = stored
-                    self._send(self._viewers(), self._map_ref(robot))
+                    self._send(self._viewers(), robot.map_ref())
                     self._changed()
         except Exception:
             log.exception("monitor: could not keep the map of robot %s", source.namespace)
@@ -319,7 +316,7 @@ class RobotHub:
         for client in clients:
             client.send(text)
 
-    def _send_warnings(self, robot: _Robot, viewers: list[Client]) -> None:
+    def _send_warnings(self, robot: RobotOutbox, viewers: list[Client]) -> None:
         for kind, message, count in robot.source.warnings.due():
             self._send(viewers, {"t": "robot_warn", "ns": robot.source.namespace,
                                  "kind": kind, "message": message, "count": count})
@@ -327,8 +324,18 @@ class RobotHub:
     def view(self, client: Client, on: bool) -> None:
         """Makes ``client`` show the map (``on``) or not; a page that starts gets everything."""
         was, client.map_view = client.map_view, on
+        self._follow_detections()
         if on and not was:
             self.resend(client)
+
+    def _follow_detections(self) -> None:
+        """Listens to the robots' detectors while some page shows the map, and only then.
+
+        A detector works only while someone listens to it.
+        """
+        wanted = any(client.map_view for client in self._clients)
+        for robot in self.robots.values():
+            robot.source.follow_detections(wanted)
 
     def resend(self, client: Client) -> None:
         """Sends ``client``, if it shows the map, every robot's map, path, state and warnings."""
@@ -337,58 +344,11 @@ class RobotHub:
         for robot in [robot for _name, robot in sorted(self.robots.items())]:
             source = robot.source
             if robot.map is not None:
-                self._send([client], self._map_ref(robot))
+                self._send([client], robot.map_ref())
             if source.path is not None:
-                self._send([client], self._path_message(robot))
-            self._send([client], self._rs_message(robot, scan=True, everything=True))
+                self._send([client], robot.path_message())
+            self._send([client], robot.rs_message(scan=True, everything=True))
+            self._send([client], robot.detections_message())
             for kind, message, count in source.warnings.latest():
                 self._send([client], {"t": "robot_warn", "ns": source.namespace,
                                       "kind": kind, "message": message, "count": count})
-
-    @staticmethod
-    def _map_ref(robot: _Robot) -> dict[str, Any]:
-        stored = robot.map
-        return {"t": "map_ref", "ns": robot.source.namespace,
-                "key": stored.key if stored else None, "url": stored.url if stored else None,
-                "source": stored.source if stored else None,
-                "counts": stored.counts if stored else None}
-
-    @staticmethod
-    def _path_message(robot: _Robot) -> dict[str, Any] | None:
-        path = robot.source.path
-        if path is None:
-            return None
-        return {"t": "path", "ns": robot.source.namespace, "id": path["id"], "xy": path["xy"]}
-
-    @staticmethod
-    def _rs_message(robot: _Robot, *, scan: bool, everything: bool = False
-                    ) -> dict[str, Any] | None:
-        """The robot's ``rs``, or None before its first pose.
-
-        With the scan if ``scan``; with what pages keep (footprint, goal, node) when it changed
-        since the last ``rs`` to every page, or always if ``everything``.
-        """
-        source = robot.source
-        pose = source.pose
-        if pose is None:
-            return None  # nothing to place the rest on yet
-        robot.seq += 1
-        message: dict[str, Any] = {"t": "rs", "ns": source.namespace, "seq": robot.seq,
-                                   "p": pose}
-        if scan and source.scan is not None:
-            message["sc"] = source.scan
-        if source.footprint is not None and (
-                everything or source.footprint_id != robot.footprint_sent):
-            message["fp"] = source.footprint
-        if (everything and source.goal is not None) or source.goal != robot.goal_sent:
-            message["goal"] = source.goal
-        if (everything and robot.node) or robot.node != robot.node_sent:
-            message["node"] = robot.node
-        if source.state is not None:
-            message["st"] = source.state
-        if source.battery is not None:
-            message["bat"] = source.battery
-        path = source.path
-        if path is not None:
-            message["pid"] = path["id"]
-        return message

@@ -34,14 +34,16 @@ from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bus import Node, Qos, Subscription
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, GoalWithHeading, MapGeometry
+from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, GoalWithHeading, MapGeometry, Predictions
 from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
+from cyborg.bus.msgs.vision_msgs.msg import Detection2DArray
 from cyborg.bus.wire import EntityKind
-from cyborg.interfaces import robot
+from cyborg.interfaces import detector, robot
+from cyborg.monitor.detection_wire import Found, detections_wire, place, predictions_wire
 from cyborg.monitor.robot_wire import (
     FRAMES_KEPT,
     Transforms,
@@ -65,6 +67,9 @@ Listener = Callable[[str, str], None]
 
 WARNING_INTERVAL = 1.0
 """Shortest time between two warnings of one kind about one robot sent to the pages (s)."""
+PREFER_DETECTIONS = 2.0
+"""Seconds after a ``detections`` message during which ``predictions`` (the same objects, in
+the 2018 message) are ignored; a detector that publishes only those is followed through them."""
 MOUNT_GRACE = 20
 """Scans without a known mount (``/tf_static`` may come after the first scans) before that is
 a warning."""
@@ -146,6 +151,11 @@ class RobotSource:
         """The robot's outline, ``[x0, y0, x1, y1, ...]`` (m, its own frame)."""
         self.footprint_id = 0
         """Counts the footprints that changed the one kept: the hub sends it when this grows."""
+        self.detections: dict[str, Any] | None = None
+        """What the robot's detector saw last, placed on the map: ``{"id", "d"}`` (``d`` as
+        :func:`~cyborg.monitor.detection_wire.place` gives it); ``id`` counts them from 1."""
+        self._detections_at = -float("inf")
+        self._detector: list[Subscription[Any]] = []
         self.warnings = WarningLog()
         self._transforms: Transforms = {}
         self._unmounted: dict[str, int] = {}
@@ -247,6 +257,44 @@ class RobotSource:
             self._map = message
         self._mark("map")
 
+    def follow_detections(self, on: bool) -> None:
+        """Subscribes to the robot's detector (``on``), or withdraws from it.
+
+        The detector is under ``/robot1/detector`` for ``/robot1``
+        (:func:`~cyborg.interfaces.detector.detector_of_robot`); its ``detections`` are read,
+        and its 2018 ``predictions`` when no ``detections`` came for :data:`PREFER_DETECTIONS`
+        s. Call it from one thread only (the hub's loop).
+        """
+        if on == bool(self._detector):
+            return
+        if not on:
+            for subscription in self._detector:
+                subscription.destroy()
+            self._detector = []
+            return
+        ns = detector.detector_of_robot(self.namespace)
+        self._detector = [
+            detector.DETECTIONS.subscription(self.node, self._on_detections, ns),
+            detector.PREDICTIONS.subscription(self.node, self._on_predictions, ns),
+        ]
+
+    def _on_detections(self, message: Detection2DArray) -> None:
+        self._detections_at = time.monotonic()
+        self._place(*detections_wire(message))
+
+    def _on_predictions(self, message: Predictions) -> None:
+        if time.monotonic() - self._detections_at >= PREFER_DETECTIONS:
+            self._place(*predictions_wire(message))
+
+    def _place(self, found: list[Found], frame: str, warnings: Warnings) -> None:
+        self._warn("detections", warnings)
+        pose = self.pose
+        if pose is None:
+            return  # nowhere to place them yet
+        mount = mount_of(frame, self._transforms) if frame else None
+        self.detections = {"id": self.detections_id + 1, "d": place(found, pose, mount)}
+        self._mark("det")
+
     def _check_alive(self) -> None:
         alive = self.node.context.graph.count(robot.POSE.full_name(self.namespace),
                                               EntityKind.PUBLISHER) > 0
@@ -260,6 +308,12 @@ class RobotSource:
         """The latest path's id; 0 before the first."""
         path = self.path
         return int(path["id"]) if path is not None else 0
+
+    @property
+    def detections_id(self) -> int:
+        """The latest detections' id; 0 before the first."""
+        seen = self.detections
+        return int(seen["id"]) if seen is not None else 0
 
     def _warn(self, kind: str, warnings: Warnings) -> None:
         for message in warnings:
@@ -293,6 +347,7 @@ class RobotSource:
     def destroy(self) -> None:
         """Withdraws the subscriptions; the listener hears nothing more."""
         self._remove_graph_listener()
+        self.follow_detections(False)
         for subscription in self._subscriptions:
             subscription.destroy()
         self._subscriptions = []

@@ -6,7 +6,8 @@
 
 export const LAYERS = [
   ["walls", "Walls"], ["points", "Scanned points"], ["forbidden", "Forbidden lines and areas"],
-  ["goals", "Goals, docks, home"], ["paths", "Paths"], ["laser", "Laser"], ["robots", "Robots"], ["labels", "Labels"],
+  ["goals", "Goals, docks, home"], ["paths", "Paths"], ["laser", "Laser"], ["detections", "Detected objects"],
+  ["robots", "Robots"], ["labels", "Labels"],
 ];
 const STORE = "cyborg-monitor-map-layers";
 const SCALE_PX = 100; // the scale bar's length is 1, 2 or 5 × 10ⁿ m, near this many pixels

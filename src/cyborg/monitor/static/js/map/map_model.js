@@ -16,6 +16,8 @@
 //       in the robot's tree ("" for none) and goal = {name, p:[x, y, θ], h} the goal it drives
 //       to (h: whether it turns to θ there; null for none), both sent when they changed
 //   {t:"path", ns, id, xy:[x y ... in mm]}   the planned path (latched: paired with st, pid)
+//   {t:"det", ns, id, d:[{label, score, p:[x, y]}]}   what the robot's detector saw last, placed
+//       on the map by the monitor (m); shown for DETECTIONS_SHOWN_MS after it came
 //   {t:"robot_warn", ns, kind, message, count}   something the monitor refused or mended
 //   {t:"robots", ..., map_robots:[{ns, tree, alive, map}]}   (app.js's message) which tree drives
 //       which robot, and whether the robot is on the bus; read by MapPanel.pairRobots
@@ -43,6 +45,8 @@ const MAGIC = [67, 89, 77, 65, 80, 0]; // "CYMAP\0"
 const MAX_BEAMS = 8192;
 const MAX_PATH_NUMBERS = 2 * 20000 + 2;
 const MAX_WARNINGS = 50;
+const MAX_DETECTIONS = 256;
+export const DETECTIONS_SHOWN_MS = 3000; // a detector that stopped leaves nothing behind for long
 const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
 
 // ------------------------------------------------------------------ the blob
@@ -172,10 +176,11 @@ export class MapModel {
   // it was malformed), null otherwise.
   receive(message) {
     const type = message && typeof message === "object" ? message.t : undefined;
-    if (!["rs", "path", "map_ref", "robot_warn"].includes(type)) return null;
+    if (!["rs", "path", "det", "map_ref", "robot_warn"].includes(type)) return null;
     try {
       if (type === "rs") this.robotState(message);
       else if (type === "path") this.path(message);
+      else if (type === "det") this.detections(message);
       else if (type === "map_ref") this.mapRef(message);
       else this.serverWarning(message);
       this.version += 1;
@@ -212,6 +217,7 @@ export class MapModel {
       robot = {
         ns, seq: null, pose: null, scan: null, scanCount: 0, mount: null, footprint: DEFAULT_FOOTPRINT, alive: this.alive.get(ns) ?? true,
         node: "", state: "", goal: null, battery: null, pathId: null, path: null, progress: null, colour: PALETTE[0],
+        seen: null, // {at (ms), items: [{label, score, x, y}]}: the detector's objects
       };
       this.robots.set(ns, robot);
       const names = [...this.robots.keys()].sort();
@@ -269,6 +275,24 @@ export class MapModel {
     const robot = this.robot(ns);
     robot.path = { id: message.id ?? null, xy: points, cumulative };
     robot.progress = robot.pose ? pathProgress(robot.path, robot.pose, null) : null;
+  }
+
+  detections(message) {
+    const ns = namespace(message);
+    const items = message.d;
+    if (!Array.isArray(items)) throw new Error("d is not a list of objects");
+    if (items.length > MAX_DETECTIONS) throw new Error(`${items.length} objects, more than the ${MAX_DETECTIONS} drawn`);
+    const seen = items.map((item, i) => {
+      if (!item || typeof item !== "object") throw new Error(`d[${i}] is not an object`);
+      if (!Array.isArray(item.p) || item.p.length !== 2) throw new Error(`d[${i}].p is not [x, y] (${short(item.p)})`);
+      return { label: text(item.label, 60), score: Number.isFinite(item.score) ? item.score : null, x: finite(item.p[0], `d[${i}].p[0]`), y: finite(item.p[1], `d[${i}].p[1]`) };
+    });
+    this.robot(ns).seen = { at: Date.now(), items: seen };
+  }
+
+  // The detector's objects still worth showing for `robot` (none once they are old).
+  seenNow(robot, now = Date.now()) {
+    return robot.seen && now - robot.seen.at < DETECTIONS_SHOWN_MS ? robot.seen.items : [];
   }
 
   mapRef(message) {

@@ -13,7 +13,7 @@
 // an error for "map"; the panel swallows it and keeps saying "no map yet".
 //
 // `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
-// {points, lines, objects}, moving: {robots, laser, paths}, warnings, toScreen(x, y),
+// {points, lines, objects}, moving: {robots, laser, paths, goals, detections}, warnings, toScreen(x, y),
 // toWorld(sx, sy), view(), colourOf(ns), robot(ns), fetches, renders, where, frameMs,
 // messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
 // battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
@@ -25,7 +25,7 @@ import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
 import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
-import { CATEGORY, MapModel, parseMapBlob } from "./map_model.js";
+import { CATEGORY, DETECTIONS_SHOWN_MS, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
 import { StaticLayer } from "./static_layer.js";
 import { MapTools } from "./tools.js";
@@ -122,6 +122,7 @@ export class MapPanel {
     const type = this.model.receive(message);
     if (type === null) return false;
     if (type === "map_ref") this.loadMaps();
+    if (type === "det") setTimeout(() => this.schedule(), DETECTIONS_SHOWN_MS + 50); // to wipe them
     this.stats.messages += 1;
     this.stats.messageMs += performance.now() - started;
     this.schedule();
@@ -370,6 +371,6 @@ function describe(model, robot) {
     ns: robot.ns, pose: robot.pose && { ...robot.pose }, mount: robot.mount, footprint: [...robot.footprint],
     battery: robot.battery && { ...robot.battery }, alive: robot.alive, state: robot.state, pathId: robot.pathId,
     path: robot.path ? robot.path.xy.length / 2 : 0, scan: robot.scanCount, colour: robot.colour,
-    node: robot.node, goal: robot.goal && { ...robot.goal },
+    node: robot.node, goal: robot.goal && { ...robot.goal }, seen: model.seenNow(robot).map((item) => ({ ...item })),
   };
 }

@@ -5,7 +5,7 @@
 // and scaled to the current view while a new one is drawn) only when the view or the bitmap
 // changed: a robot moving does not repaint the map under it. The upper one is cleared and
 // drawn every frame: planned paths (the part already travelled faded), the current goal,
-// laser hits, robots (footprint in the robot's colour, heading as a white arrow), then names.
+// laser hits, detected objects, robots (footprint in the robot's colour, heading as a white arrow), then names.
 // A robot that left the bus (the monitor's map_robots says it is not alive) is drawn faded,
 // without its laser, where it was last seen.
 //
@@ -14,6 +14,7 @@
 const MIN_ROBOT_PX = 14; // a robot is never drawn smaller than this, however far out
 const DOT_PX = 2;
 const GONE_ALPHA = 0.35;
+const DIAMOND_PX = 6;
 
 // The lower canvas: the static bitmap at `placement` (StaticLayer.placement()), or nothing.
 export function drawBitmap(ctx, view, placement, dpr) {
@@ -24,12 +25,12 @@ export function drawBitmap(ctx, view, placement, dpr) {
 
 // The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), robots (the robots
 // to draw, [robot]), layers, selected (ns or null)}. Returns what it drew: {robots, laser,
-// paths, goals}.
+// paths, goals, detections}.
 export function drawMoving(ctx, scene) {
   const { view, dpr, layers } = scene;
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, view.width, view.height);
-  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0 };
+  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, detections: 0 };
   if (layers.paths) {
     for (const robot of scene.robots) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
@@ -40,6 +41,11 @@ export function drawMoving(ctx, scene) {
   }
   if (layers.laser) {
     for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
+  }
+  if (layers.detections) {
+    for (const robot of scene.robots) {
+      if (robot.alive) drawn.detections += drawDetections(ctx, view, robot, scene.model.seenNow(robot), layers.labels);
+    }
   }
   if (layers.robots) {
     for (const robot of scene.robots) {
@@ -152,6 +158,41 @@ function drawScan(ctx, view, robot) {
   }
   ctx.fill();
   ctx.globalAlpha = 1;
+  return count;
+}
+
+// The objects the robot's detector saw: a diamond outlined in the robot's colour on white,
+// with the class and score beside it when labels are on.
+function drawDetections(ctx, view, robot, items, labels) {
+  let count = 0;
+  ctx.font = '11px system-ui, "DejaVu Sans", sans-serif';
+  ctx.textBaseline = "middle";
+  ctx.textAlign = "left";
+  ctx.lineJoin = "round";
+  for (const item of items) {
+    const [sx, sy] = view.toScreen(item.x, item.y);
+    if (sx < -DIAMOND_PX || sy < -DIAMOND_PX || sx > view.width + DIAMOND_PX || sy > view.height + DIAMOND_PX) continue;
+    ctx.beginPath();
+    ctx.moveTo(sx, sy - DIAMOND_PX);
+    ctx.lineTo(sx + DIAMOND_PX, sy);
+    ctx.lineTo(sx, sy + DIAMOND_PX);
+    ctx.lineTo(sx - DIAMOND_PX, sy);
+    ctx.closePath();
+    ctx.fillStyle = "#ffffff";
+    ctx.fill();
+    ctx.strokeStyle = robot.colour;
+    ctx.lineWidth = 2.5;
+    ctx.stroke();
+    if (labels && item.label) {
+      const text = item.score === null ? item.label : `${item.label} ${Math.round(item.score * 100)} %`;
+      ctx.lineWidth = 3;
+      ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
+      ctx.strokeText(text, sx + DIAMOND_PX + 3, sy);
+      ctx.fillStyle = "#3c4043";
+      ctx.fillText(text, sx + DIAMOND_PX + 3, sy);
+    }
+    count += 1;
+  }
   return count;
 }
 
