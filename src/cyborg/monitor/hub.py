@@ -39,6 +39,7 @@ from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import Limits, check_namespace
+from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.robot_commands import RobotCommands
 from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
@@ -148,7 +149,7 @@ class Hub:
             self.broadcast(self.robots())
 
     def robots(self) -> dict[str, Any]:
-        """The ``robots`` message: every followed tree's description, and the seat's holder."""
+        """The ``robots`` message: the followed trees, the seat's holder, the map's robots."""
         return {"t": "robots", "robots": [self.sources[name].describe()
                                           for name in sorted(self.sources)],
                 "seat": self.seat.holder.client if self.seat.holder else None,
@@ -328,12 +329,14 @@ class Hub:
             await asyncio.sleep(SLOW_PERIOD)
             try:
                 await self._periodic()
+            except ShutdownError:
+                return  # the process exits (the server's thread outlives the executors)
             except Exception:
                 log.exception("monitor periodic work failed")
 
     async def _periodic(self) -> None:
         changed = False
-        for namespace in await asyncio.to_thread(self._discover):
+        for namespace in await in_thread(self._discover):
             changed = self._found(namespace) or changed
         for namespace in list(self.sources):  # runners that left, and nobody watches
             changed = self._release(namespace) or changed
@@ -361,7 +364,7 @@ class Hub:
             source = self.sources.get(namespace)
             if source is not None:
                 try:
-                    await asyncio.to_thread(source.control, node_id, "clear")
+                    await in_thread(source.control, node_id, "clear")
                 except ControlError as exc:
                     log.warning("could not release hook on %s: %s", node_id, exc)
         log.info("the control seat is free (its holder left); %d hook(s) released",
@@ -392,7 +395,7 @@ class Hub:
 
     async def _poll_blackboard(self, source: TreeSource) -> None:
         try:
-            data = await asyncio.to_thread(source.blackboard)
+            data = await in_thread(source.blackboard)
         except ControlError:
             return
         text = encode({"t": "blackboard", "ns": source.namespace, "data": data})

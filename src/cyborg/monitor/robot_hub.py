@@ -47,6 +47,7 @@ from cyborg.interfaces.tree_runner import robot_of_runner
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import check_namespace
 from cyborg.monitor.map_store import MapStore
+from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.robot_outbox import RobotOutbox, Throttle
 from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.robot_wire import wire_text
@@ -102,8 +103,9 @@ class RobotHub:
     async def detach(self) -> None:
         """Lets go of the event loop as the server stops.
 
-        Changes are dropped from now on, and maps being laid out are given up, so no work is
-        handed to the closing loop's threads.
+        Changes are dropped from now on, :meth:`periodic` does nothing, and maps being laid out
+        are given up, so no work is handed to the closing loop's threads. (Work refused because
+        the process exits first ends quietly too: :mod:`cyborg.monitor.off_loop`.)
         """
         self._loop = None
         tasks = list(self._tasks)
@@ -117,10 +119,12 @@ class RobotHub:
 
         Never raises: a failure is logged, and the hub's other periodic work goes on.
         """
+        if self._loop is None:
+            return  # detached: the server stops
         try:
             if self._make is not None:
                 changed = False
-                for namespace in await asyncio.to_thread(self._discover):
+                for namespace in await in_thread(self._discover):
                     changed = self._found(namespace) or changed
                 if changed:
                     self._changed()
@@ -128,6 +132,8 @@ class RobotHub:
             for robot in list(self.robots.values()):
                 if robot.source.warnings.pending():
                     self._send_warnings(robot, self._viewers())
+        except ShutdownError:
+            return
         except Exception:
             log.exception("monitor: could not look for robots")
 
@@ -290,7 +296,7 @@ class RobotHub:
         try:
             while (message := source.take_map()) is not None:
                 in_use = {other.map.key for other in self.robots.values() if other.map}
-                stored, warnings = await asyncio.to_thread(self.store.put, message, in_use)
+                stored, warnings = await in_thread(self.store.put, message, in_use)
                 for warning in warnings:
                     source.warn("map", warning)
                 if self.robots.get(source.namespace) is not robot:
@@ -299,6 +305,8 @@ class RobotHub:
                     robot.map = stored
                     self._send(self._viewers(), robot.map_ref())
                     self._changed()
+        except ShutdownError:
+            return  # the process exits: the map is not needed any more
         except Exception:
             log.exception("monitor: could not keep the map of robot %s", source.namespace)
         finally:
