@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from cyborg.bus import BusConfig, Context, Node
+from cyborg.bus.msgs.cyborg_msgs.msg import MapGeometry
 from cyborg.monitor import Monitor
 from tests.monitor.robot_messages import FakeMapRobot, map_geometry, pose
 from tests.running_system import wait_until
@@ -25,7 +26,7 @@ BIG_POINTS = 1_900_000
 """Points of a map that takes the monitor a while to lay out (the limit is 2,000,000)."""
 
 
-def _big_map() -> object:
+def _big_map() -> MapGeometry:
     points = np.random.default_rng(7).uniform(-50.0, 50.0, 2 * BIG_POINTS).astype(np.float32)
     return map_geometry(points=points)
 
@@ -60,6 +61,7 @@ def test_a_process_that_exits_while_a_map_is_laid_out_prints_no_traceback(
         import sys, time
         sys.path[:0] = [{str(ROOT / "src")!r}, {str(ROOT)!r}]
         from cyborg.bus import BusConfig, Context, Node
+from cyborg.bus.msgs.cyborg_msgs.msg import MapGeometry
         from cyborg.monitor import Monitor
         from tests.monitor.robot_messages import FakeMapRobot, pose
         from tests.monitor.test_monitor_shutdown import _big_map
