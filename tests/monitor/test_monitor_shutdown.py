@@ -61,7 +61,6 @@ def test_a_process_that_exits_while_a_map_is_laid_out_prints_no_traceback(
         import sys, time
         sys.path[:0] = [{str(ROOT / "src")!r}, {str(ROOT)!r}]
         from cyborg.bus import BusConfig, Context, Node
-from cyborg.bus.msgs.cyborg_msgs.msg import MapGeometry
         from cyborg.monitor import Monitor
         from tests.monitor.robot_messages import FakeMapRobot, pose
         from tests.monitor.test_monitor_shutdown import _big_map
