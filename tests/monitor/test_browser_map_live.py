@@ -86,6 +86,14 @@ def test_the_campus_map_and_the_robot_on_its_patrol(browser: Browser) -> None:
         assert 0 < shown["battery"]["pct"] <= 100 and shown["battery"]["dock"] == "UNDOCKED"
         assert shown["state"] == "MOVING_TO_GOAL" and shown["path"] > 1 and shown["scan"] > 100
         assert shown["alive"] is True
+        # the tree and the map speak: the running MoveTo beside the robot, its goal ringed
+        page.wait_for_function(f"(() => {{ const r = window.__map.robot({ROBOT!r}); return "
+                               "r.goal !== null && r.node === 'MoveTo ' + r.goal.name; })()")
+        goal = on_map(page, f"m.robot({ROBOT!r}).goal")
+        where = {item.name: (item.x, item.y) for item in campus.objects if item.name}
+        assert (goal["x"], goal["y"]) == pytest.approx(where[goal["name"]], abs=0.002), \
+            "the current goal where the map has it"
+        assert on_map(page, "m.moving.goals") == 1
         screenshot(page, "map_campus")
         # pause the tree: the robot stops, and the page shows it where the simulator has it
         page.click("#run")
