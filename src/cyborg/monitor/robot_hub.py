@@ -10,8 +10,9 @@ except :meth:`RobotHub.notify`, which the bus calls from its threads.
   (:func:`cyborg.interfaces.tree_runner.robot_of_runner`).
 * **Pages opt in** with ``{"t": "map", "on": true}``; the rest of this goes only to them. A page
   that opts in gets, per robot, its ``map_ref``, its ``path``, an ``rs`` and its warnings.
-* **Robot state** goes out as ``rs``, throttled per robot on the leading edge: at once when
-  :data:`RS_INTERVAL` has passed since that robot's last one, else then. A 10 Hz robot passes
+* **Robot state** goes out as ``rs``, throttled per robot: :data:`RS_GATHER` after the first
+  change when :data:`RS_INTERVAL` has passed since that robot's last one, else then; the short
+  wait gathers a pose and the scan published right after it into one ``rs``. A 10 Hz robot passes
   unchanged, the simulator's 30 Hz becomes about 12 Hz. An ``rs`` carries the pose, and the
   scan (with the laser's mount) when a new one came; the path state, battery and the current
   path's id when known; the footprint, the current goal and the running node only when they
@@ -59,6 +60,10 @@ ROBOT_LIMIT = 16
 """Most robots the monitor follows at once."""
 RS_INTERVAL = 0.08
 """Shortest time between two ``rs`` messages of one robot (s)."""
+RS_GATHER = 0.005
+"""How long a robot's first change waits for the ones published with it (s): a pose and its
+scan come back to back, and sent apart the scan's ``rs`` would hold the next pose back by up to
+:data:`RS_INTERVAL`."""
 PATH_INTERVAL = 0.5
 """Shortest time between two ``path`` messages of one robot (s)."""
 DETECTIONS_INTERVAL = 0.2
@@ -221,11 +226,8 @@ class RobotHub:
         if robot is None or self._loop is None:
             self._pending.discard(namespace)
             return
-        delay = robot.last + RS_INTERVAL - time.monotonic()
-        if delay > 0:
-            self._loop.call_later(delay, self._flush, namespace)
-        else:
-            self._flush(namespace)
+        delay = max(robot.last + RS_INTERVAL - time.monotonic(), RS_GATHER)
+        self._loop.call_later(delay, self._flush, namespace)
 
     def _flush(self, namespace: str) -> None:
         self._pending.discard(namespace)
