@@ -72,6 +72,26 @@ def test_a_goal_pauses_the_running_tree_and_every_page_hears_how_it_ended() -> N
     asyncio.run(scenario())
 
 
+def test_a_page_that_comes_later_hears_of_the_manual_pause_until_the_tree_runs_again() -> None:
+    hub, _buses = acting_hub()
+
+    async def scenario() -> None:
+        holder = page(hub, 1)
+        hub.seat.claim(1)
+        assert (await _send(hub, holder, {"t": "go", "ns": ROBOT, "goal": "Office"}))["ok"]
+        late = page(hub, 2)
+        await receive(hub, late, json.dumps({"t": "hello"}))
+        assert of_kind(late, "manual_pause") == [{"t": "manual_pause", "tree": TREE,
+                                                  "ns": ROBOT}]
+        resumed = await _send(hub, holder, {"t": "enable", "on": True, "ns": TREE})
+        assert resumed["ok"], resumed
+        later = page(hub, 3)
+        await receive(hub, later, json.dumps({"t": "hello"}))
+        assert of_kind(later, "manual_pause") == [], "the tree runs again: no banner"
+
+    asyncio.run(scenario())
+
+
 def test_stop_needs_no_seat_but_every_other_command_does() -> None:
     hub, buses = acting_hub(token="s3cret")
     commands: list[dict[str, Any]] = [

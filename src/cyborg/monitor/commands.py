@@ -139,6 +139,7 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         else:
             client.send(hub.seat_message(client))
         client.send(hub.robots())
+        hub.robot_commands.resend(client)
     elif kind == "watch":
         try:
             hub.watch(client, command.get("ns") or hub.default_namespace)

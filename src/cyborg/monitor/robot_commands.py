@@ -111,6 +111,8 @@ class RobotCommands:
         self._driven: dict[int, tuple[str, float]] = {}
         """Connection number → (robot, when it last sent ``drive``, monotonic s)."""
         self._tasks: set[asyncio.Task[None]] = set()
+        self._manual: dict[str, str] = {}
+        """Trees paused for a manual goal → the robot they drive, until they run again."""
 
     def use(self, make_clients: Callable[[str], RobotClients]) -> None:
         """Acts on robots from now on, through ``make_clients(namespace)``."""
@@ -285,9 +287,22 @@ class RobotCommands:
             except ControlError as exc:
                 raise RobotCommandError(f"the tree {tree} could not be paused, so nothing was "
                                         f"sent: {exc}") from None
+            self._manual[tree] = ns
             self._broadcast({"t": "manual_pause", "tree": tree, "ns": ns})
             return tree
         return None
+
+    def resend(self, client: Client) -> None:
+        """Tells a page that just came which trees are still paused for a manual goal.
+
+        A tree that runs again since (resumed from any page or the command line) is forgotten.
+        """
+        for tree, ns in list(self._manual.items()):
+            source = self._trees.get(tree)
+            if source is None or source.enabled is not False:
+                del self._manual[tree]
+                continue
+            client.send({"t": "manual_pause", "tree": tree, "ns": ns})
 
     # ------------------------------------------------------------------ goals and tours
     def _follow(self, client: Client, req: Any, ns: str, kind: str, what: str,
