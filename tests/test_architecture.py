@@ -45,13 +45,15 @@ ALLOWED = {"interfaces": ("cyborg.interfaces", "cyborg.bus"),
                       "cyborg.interfaces"),
            "monitor": ("cyborg.monitor", "cyborg.bus", "cyborg.bt.dot", "cyborg.bt.status",
                        "cyborg.bt.json_text", "cyborg.interfaces"),
-           "vision": ("cyborg.vision", "cyborg.bus", "cyborg.interfaces")}
+           "vision": ("cyborg.vision", "cyborg.bus", "cyborg.interfaces"),
+           "record": ("cyborg.record", "cyborg.bus", "cyborg.interfaces")}
 """The contracts (topic, service and action names, types, constants) build only on the bus, so
 that both sides of each can import them; navigation may use the bus (its services); the
 simulator builds on navigation and the bus; the robot's nodes glue the engine to the bus, with
 navigation's pose types (not its planner); the monitor watches trees over the bus and borrows
 only the engine's DOT writer, statuses and JSON-text checks; vision publishes and subscribes on
-the bus and knows nothing of trees or navigation. All but the contracts use the contracts."""
+the bus and knows nothing of trees or navigation; the recorder takes any topic's raw bytes
+from the bus and names the contracts' topics only to describe the run. All but the contracts use the contracts."""
 
 
 @pytest.mark.parametrize("package", sorted(ALLOWED))

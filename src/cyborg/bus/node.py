@@ -33,6 +33,7 @@ from cyborg.bus.context import Context
 from cyborg.bus.executor import CallbackThread
 from cyborg.bus.message_types import MessageTypes
 from cyborg.bus.parameters import Parameters
+from cyborg.bus.raw import RawMessage, RawSubscription
 from cyborg.bus.services import Responder, ServiceClient, ServiceServer
 from cyborg.bus.topics import Publisher, Subscription
 from cyborg.bus.typed import ActionType, ServiceType
@@ -44,7 +45,6 @@ if TYPE_CHECKING:
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _NAMESPACE = re.compile(r"^(/[A-Za-z][A-Za-z0-9_]*)*/?$")
-
 
 
 class _Entity(Protocol):
@@ -165,6 +165,16 @@ class Node:
         """
         return self._keep(Subscription, topic, self.types.type_name(message_type), callback,
                           qos or Qos(depth=10), with_info=with_info, inline=inline)
+
+    def create_raw_subscription(self, topic: str, type_name: str,
+                                callback: Callable[[RawMessage], object],
+                                qos: Qos | None = None) -> RawSubscription:
+        """Call ``callback(RawMessage)`` with each message's CDR bytes, never decoded.
+
+        For recorders: the bytes are the message as it travelled (see :mod:`cyborg.bus.raw`);
+        ``type_name`` (a known type) makes the key, ``qos`` as for :meth:`create_subscription`.
+        """
+        return self._keep(RawSubscription, topic, type_name, callback, qos or Qos(depth=10))
 
     # ------------------------------------------------------------------ services
     @overload

@@ -1,0 +1,84 @@
+"""The file under a recording: whole writes, or a clean stop at the last whole one.
+
+The MCAP writer hands its stream whole records (a chunk, its message indexes, a metadata
+record) one ``write`` at a time. :class:`GuardedStream` passes each on to the file unbuffered,
+so what the writer has written is with the operating system at once (a killed recorder loses
+only what it had not handed over), and remembers where the last complete write ended. When a
+write fails — a full disk (``ENOSPC``), a quota, an I/O error — the partial write is cut off
+again, so the file ends on a record boundary, and :class:`StorageError` says what happened:
+the recording stops there with a file that :mod:`cyborg.record.completion` can finish.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+from pathlib import Path
+from typing import BinaryIO
+
+REASONS = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is used up",
+           errno.EFBIG: "the file is larger than the file system allows",
+           errno.EIO: "an input/output error"}
+"""What a failed write is called in the message, by errno."""
+
+
+class StorageError(OSError):
+    """A write to a recording failed; the message names the file and the reason."""
+
+
+class GuardedStream:
+    """A binary file opened for a recording; see the module. ``raw`` defaults to ``path``'s."""
+
+    def __init__(self, path: Path, raw: BinaryIO | None = None) -> None:
+        self.path = path
+        self._file: BinaryIO = raw if raw is not None else open(path, "xb", buffering=0)  # noqa: SIM115
+        self.good = 0
+        """Bytes of whole writes: the file's length after the last complete write."""
+        self.failed: StorageError | None = None
+
+    def write(self, data: bytes | bytearray | memoryview) -> int:
+        """Writes all of ``data`` or raises :class:`StorageError` with the file cut back."""
+        if self.failed is not None:
+            raise self.failed
+        view = memoryview(data).cast("B")
+        done = 0
+        try:
+            while done < len(view):
+                written = self._file.write(view[done:])
+                if not written:
+                    raise OSError(errno.EIO, "the file took no bytes")
+                done += written
+        except OSError as exc:
+            self._cut_back()
+            reason = REASONS.get(exc.errno or 0, exc.strerror or str(exc))
+            self.failed = StorageError(exc.errno, f"{self.path}: {reason}; the recording "
+                                                  f"stopped after {self.good} bytes")
+            raise self.failed from exc
+        self.good += done
+        return done
+
+    def _cut_back(self) -> None:
+        try:
+            self._file.truncate(self.good)
+            self._file.seek(self.good)
+        except OSError:
+            pass  # the file then ends in a partial record, which a scan stops before
+
+    def tell(self) -> int:
+        """The position the next write goes to (the MCAP writer asks for chunk offsets)."""
+        return self.good
+
+    def flush(self) -> None:
+        """Nothing is buffered here; present because the MCAP writer calls it."""
+
+    def sync(self) -> None:
+        """Waits until what was written is on the disk (``fsync``), so power loss keeps it."""
+        if self.failed is None:
+            # not a real file (a test's), or a file system without fsync: nothing to wait for
+            with contextlib.suppress(OSError, ValueError):
+                os.fsync(self._file.fileno())
+
+    def close(self) -> None:
+        """Closes the file."""
+        self._file.close()

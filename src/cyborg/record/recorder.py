@@ -1,0 +1,223 @@
+"""The recorder on the bus: finds topics in the graph, takes their raw CDR, writes it down.
+
+A :class:`Recorder` is one bus node (``recorder`` by default) that
+
+* looks at the bus graph at once and then every :data:`DISCOVERY_INTERVAL` seconds, so
+  topics that appear after the start are recorded from their first message; each topic the
+  :class:`~cyborg.record.selection.TopicSelection` accepts gets a raw subscription
+  (:meth:`~cyborg.bus.node.Node.create_raw_subscription`): its messages are written as the
+  CDR bytes they travelled in, never decoded and encoded again;
+* subscribes transient-local where a publisher is latched, so the latched value (the map,
+  the tree's structure, the battery) is recorded even when it was published before the start;
+* writes each message with the time it was received as its log time and the sender's
+  timestamp (from the sample's attachment) as its publish time, on the node's one thread;
+* closes the open chunk at least every second (:mod:`cyborg.record.mcap_file`);
+* pauses and resumes: :meth:`Recorder.set_paused`, and the service ``<node>/pause``
+  (``std_srvs/srv/SetBool``: true pauses, false resumes), so ``cyborg service call
+  /recorder/pause "{data: true}"`` pauses a recording from anywhere; messages that arrive while
+  paused are not written;
+* stops cleanly on a failed write (a full disk): :attr:`Recorder.failure` says why, and the
+  file is finished in place so that it stays readable.
+
+Topics whose type the bus does not know are skipped and listed in
+:attr:`RecordingStats.skipped`. A metadata record ``cyborg`` names the cyborg version and
+what the caller knows of the run (the map and tree files); the map a simulator publishes
+(``map_geometry``) is named too, in a ``cyborg.map`` record, when it is recorded.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError, version
+
+from cyborg.bus import Context, Durability, Node, Qos
+from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
+from cyborg.bus.raw import RawMessage
+from cyborg.bus.wire import EntityKind
+from cyborg.interfaces import robot
+from cyborg.record.guarded_stream import StorageError
+from cyborg.record.selection import IMAGE_TYPES, TopicSelection
+from cyborg.record.split import RecordingFiles
+
+log = logging.getLogger(__name__)
+
+NAME = "recorder"
+"""The recorder's node name; its pause service is ``<namespace>/recorder/pause``."""
+DISCOVERY_INTERVAL = 0.5
+"""Seconds between two looks at the graph for new topics."""
+FLUSH_CHECK = 0.25
+"""Seconds between two checks whether the open chunk is due to be written."""
+QUEUE_DEPTH = 1000
+"""Messages of a topic that may wait for the writer before the oldest are dropped."""
+IMAGE_QUEUE_DEPTH = 30
+"""The same for image topics: about a second of a camera, without holding gigabytes."""
+RUN_METADATA = "cyborg"
+"""Name of the metadata record that names the version, map and tree of the run."""
+MAP_METADATA = "cyborg.map"
+"""Name of the metadata record written for each map the recorded simulator published."""
+
+
+def cyborg_version() -> str:
+    """The installed cyborg's version, or ``unknown``."""
+    try:
+        return version("cyborg")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+@dataclass
+class RecordingStats:
+    """What a recording has done so far; read from any thread."""
+
+    messages: int = 0
+    bytes: int = 0
+    """CDR bytes written (before compression)."""
+    topics: dict[str, int] = field(default_factory=dict)
+    """Messages written, by topic (every topic subscribed is here, from 0)."""
+    skipped: dict[str, str] = field(default_factory=dict)
+    """Topics not recorded, with the reason (an unknown type)."""
+    paused_drops: int = 0
+    """Messages that arrived while paused."""
+
+
+class Recorder:
+    """Records the bus into ``files``; see the module. Stop it with :meth:`close`.
+
+    ``run`` adds values to the ``cyborg`` metadata record (``map``, ``tree``, ``command``);
+    the version and the start time are always there.
+    """
+
+    def __init__(self, context: Context, files: RecordingFiles, selection: TopicSelection, *,
+                 name: str = NAME, namespace: str = "/",
+                 run: dict[str, str] | None = None) -> None:
+        self.context, self.files, self.selection = context, files, selection
+        self.stats = RecordingStats()
+        self.failure: str | None = None
+        self.paused = False
+        self._lock = threading.Lock()
+        self._types: dict[str, str] = {}
+        self._maps: dict[str, str] = {}
+        self._closed = False
+        files.add_metadata(RUN_METADATA, {
+            "cyborg_version": cyborg_version(),
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(run or {})})
+        self.node = Node(name, namespace, context=context)
+        self.node.create_service(f"{name}/pause", SetBool, self._on_pause)
+        self.node.create_timer(DISCOVERY_INTERVAL, self.discover)
+        self.node.create_timer(FLUSH_CHECK, self._flush_if_due)
+        self.discover()
+
+    # ------------------------------------------------------------------ topics
+    def discover(self) -> None:
+        """Subscribes to every new topic of the graph that the selection accepts."""
+        offered: dict[str, list[tuple[str, str]]] = {}
+        for entity in self.context.graph.entities([EntityKind.PUBLISHER]):
+            offered.setdefault(entity.topic, []).append((entity.type_name, entity.qos))
+        for topic, publishers in sorted(offered.items()):
+            if topic in self._types or topic in self.stats.skipped:
+                continue
+            type_name = sorted(type_name for type_name, _ in publishers)[0]
+            if not self.selection.accepts(topic, type_name):
+                continue
+            if type_name not in self.context.types:
+                self.stats.skipped[topic] = f"unknown type {type_name}"
+                log.warning("not recording %s: its type %s is not known here", topic,
+                            type_name)
+                continue
+            self._subscribe(topic, type_name, [qos for name, qos in publishers
+                                               if name == type_name])
+
+    def _subscribe(self, topic: str, type_name: str, offered: list[str]) -> None:
+        latched = any(len(qos.split(":")) > 1 and qos.split(":")[1] == "1" for qos in offered)
+        depth = IMAGE_QUEUE_DEPTH if type_name in IMAGE_TYPES else QUEUE_DEPTH
+        qos = Qos(durability=Durability.TRANSIENT_LOCAL if latched else Durability.VOLATILE,
+                  depth=depth)
+        with self._lock:
+            if self.failure is not None or self._closed:
+                return
+            self.files.add_topic(topic, type_name, offered)
+            self._types[topic] = type_name
+            self.stats.topics[topic] = 0
+        self.node.create_raw_subscription(
+            topic, type_name, lambda raw: self._on_message(topic, raw), qos)
+
+    # ------------------------------------------------------------------ messages
+    def _on_message(self, topic: str, raw: RawMessage) -> None:
+        if self.paused:
+            self.stats.paused_drops += 1
+            return
+        sent = raw.info.timestamp_ns if raw.info is not None else raw.received_ns
+        with self._lock:
+            if self.failure is not None or self._closed:
+                return
+            try:
+                self.files.write(topic, raw.received_ns, sent, raw.data)
+            except StorageError as exc:
+                self._fail(exc)
+                return
+        self.stats.messages += 1
+        self.stats.bytes += len(raw.data)
+        self.stats.topics[topic] += 1
+        if self._types[topic] == robot.MAP_GEOMETRY.type_name:
+            self._note_map(topic, raw.data)
+
+    def _note_map(self, topic: str, data: bytes) -> None:
+        """Names a map the simulator published in a ``cyborg.map`` metadata record."""
+        try:
+            geometry = self.context.types.deserialize(data, robot.MAP_GEOMETRY.type_name)
+        except Exception:  # not ours to judge: it is recorded as it came
+            return
+        if self._maps.get(topic) == geometry.hash:
+            return
+        self._maps[topic] = geometry.hash
+        with self._lock:
+            if self.failure is None and not self._closed:
+                self.files.add_metadata(MAP_METADATA, {"topic": topic, "source": geometry.source,
+                                                       "hash": geometry.hash})
+
+    def _flush_if_due(self) -> None:
+        with self._lock:
+            if self.failure is not None or self._closed:
+                return
+            try:
+                self.files.flush_if_due()
+            except StorageError as exc:
+                self._fail(exc)
+
+    def _fail(self, exc: StorageError) -> None:
+        """A write failed (the lock is held): stop recording, finish the file as it is."""
+        self.failure = str(exc)
+        log.error("recording stopped: %s", exc)
+        self.files.close()
+
+    # ------------------------------------------------------------------ pause
+    def set_paused(self, paused: bool) -> None:
+        """Pauses (True) or resumes (False) writing; messages meanwhile are not written."""
+        if paused != self.paused:
+            self.paused = paused
+            log.info("recording %s", "paused" if paused else "resumed")
+
+    def toggle_pause(self) -> None:
+        """Pauses a running recording, resumes a paused one (``SIGUSR1``, a key)."""
+        self.set_paused(not self.paused)
+
+    def _on_pause(self, request: SetBool_Request) -> SetBool_Response:
+        self.set_paused(request.data)
+        return SetBool_Response(success=True, message="paused" if self.paused else "recording")
+
+    # ------------------------------------------------------------------ end
+    def close(self) -> None:
+        """Leaves the bus and finishes the files (summary, indexes). Safe to call twice."""
+        self.node.destroy()
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            if self.failure is None:
+                try:
+                    self.files.close()
+                except StorageError as exc:
+                    self._fail(exc)

@@ -1,0 +1,154 @@
+"""A recording's files: one, or a series split by size or by duration.
+
+Without a split the recording is the one file named (``run.mcap``). With ``--split-size`` or
+``--split-duration`` it is a series named as rosbag2 names its files, the index before the
+suffix from 0: ``run_0.mcap``, ``run_1.mcap``, ... A new file starts before the message that
+would go over the limit is written, between two messages on the recorder's one writing thread,
+so no message is lost or written twice at a split. Every file is complete on its own: it
+repeats the schemas, the channels of every topic recorded so far and the metadata, so each
+opens alone in Foxglove or ``ros2 bag``. Latched messages are not repeated: a file after the
+first holds the latched topics' messages only if they were published again during it.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from cyborg.bus import MessageTypes
+from cyborg.record.mcap_file import McapFile
+
+_SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]?i?B?)\s*$", re.IGNORECASE)
+_SIZE_UNITS = {"": 1, "B": 1, "K": 1e3, "KB": 1e3, "M": 1e6, "MB": 1e6, "G": 1e9, "GB": 1e9,
+               "T": 1e12, "TB": 1e12, "KIB": 2**10, "MIB": 2**20, "GIB": 2**30, "TIB": 2**40}
+_DURATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(s|m|min|h)?\s*$", re.IGNORECASE)
+_DURATION_UNITS = {"": 1, "s": 1, "m": 60, "min": 60, "h": 3600}
+MIN_SPLIT_SIZE = 1024 * 1024
+"""The smallest split size: a file holds at least a chunk."""
+
+
+def parse_size(text: str) -> int:
+    """``1GiB``, ``500MB``, ``2G`` -> bytes; ValueError naming the option for anything else."""
+    match = _SIZE.match(text)
+    if not match or match.group(2).upper() not in _SIZE_UNITS:
+        raise ValueError(f"--split-size {text!r}: expected a size such as 500MB or 1GiB")
+    size = int(float(match.group(1)) * _SIZE_UNITS[match.group(2).upper()])
+    if size < MIN_SPLIT_SIZE:
+        raise ValueError(f"--split-size {text!r}: at least 1MiB")
+    return size
+
+
+def parse_duration(text: str) -> float:
+    """``10m``, ``90s``, ``1h``, ``30`` (seconds) -> seconds; ValueError naming the option."""
+    match = _DURATION.match(text)
+    if not match:
+        raise ValueError(f"--split-duration {text!r}: expected a duration such as 90s, 10m "
+                         "or 1h")
+    seconds = float(match.group(1)) * _DURATION_UNITS[(match.group(2) or "").lower()]
+    if seconds <= 0:
+        raise ValueError(f"--split-duration {text!r}: must be more than 0")
+    return seconds
+
+
+def split_name(path: Path, index: int) -> Path:
+    """The name of file ``index`` of a split recording: ``run.mcap`` -> ``run_0.mcap``."""
+    suffix = path.suffix or ".mcap"
+    return path.with_name(f"{path.stem if path.suffix else path.name}_{index}{suffix}")
+
+
+@dataclass(frozen=True)
+class SplitPolicy:
+    """When a new file starts: past ``size`` bytes or ``duration`` seconds (None: never)."""
+
+    size: int | None = None
+    duration: float | None = None
+
+    @property
+    def splits(self) -> bool:
+        """Whether the recording is a series of files."""
+        return self.size is not None or self.duration is not None
+
+
+@dataclass
+class _Topic:
+    type_name: str
+    offered_qos: list[str]
+
+
+@dataclass
+class RecordingFiles:
+    """The files of one recording; writes go to the current one, which rolls over by policy.
+
+    ``path`` is the name given (``run.mcap``); every path this recording wrote is in
+    :attr:`paths`, the current one last. Files that exist already are refused
+    (FileExistsError naming them) before anything is written.
+    """
+
+    path: Path
+    types: MessageTypes
+    compression: str = "zstd"
+    policy: SplitPolicy = field(default_factory=SplitPolicy)
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    paths: list[Path] = field(default_factory=list)
+    _topics: dict[str, _Topic] = field(default_factory=dict)
+    _current: McapFile | None = None
+    _opened: float = 0.0
+
+    def __post_init__(self) -> None:
+        first = split_name(self.path, 0) if self.policy.splits else self.path
+        if first.exists():
+            raise FileExistsError(f"{first} exists already; choose another name or remove it")
+        self._open(first)
+
+    @property
+    def current(self) -> McapFile:
+        """The file being written now."""
+        assert self._current is not None
+        return self._current
+
+    def _open(self, path: Path) -> None:
+        self._current = McapFile(path, self.types, compression=self.compression)
+        self.paths.append(path)
+        self._opened = time.monotonic()
+        for name, values in self.metadata.items():
+            self._current.metadata(name, values)
+        for topic, known in self._topics.items():
+            self._current.channel(topic, known.type_name, known.offered_qos)
+
+    def add_topic(self, topic: str, type_name: str, offered_qos: list[str]) -> None:
+        """Makes ``topic`` a channel of this and every later file."""
+        self._topics[topic] = _Topic(type_name, offered_qos)
+        self.current.channel(topic, type_name, offered_qos)
+
+    def add_metadata(self, name: str, values: dict[str, str]) -> None:
+        """Adds a metadata record to this file and every later one."""
+        self.metadata[name] = values
+        self.current.metadata(name, values)
+
+    def write(self, topic: str, log_time: int, publish_time: int, data: bytes) -> None:
+        """Writes one message of a topic added before, starting a new file first if due."""
+        if self._due(len(data)):
+            self.current.close()
+            self._open(split_name(self.path, len(self.paths)))
+        current = self.current
+        current.write(current.channel_of(topic), log_time, publish_time, data)
+
+    def _due(self, incoming: int) -> bool:
+        policy, current = self.policy, self.current
+        if not current.messages:
+            return False
+        if policy.size is not None and current.size + incoming > policy.size:
+            return True
+        return (policy.duration is not None
+                and time.monotonic() - self._opened >= policy.duration)
+
+    def flush_if_due(self) -> None:
+        """Writes and syncs the open chunk if it is old enough (see :mod:`.mcap_file`)."""
+        self.current.flush_if_due()
+
+    def close(self) -> None:
+        """Finishes the current file."""
+        if self._current is not None:
+            self._current.close()
