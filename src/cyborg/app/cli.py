@@ -17,6 +17,7 @@
     cyborg param list|get|set      parameters of a node
     cyborg sim --map FILE          the simulated robot on an ARNL map, on the bus
     cyborg nav goals|plan FILE     goals of a map; plan a path and print its length
+    cyborg record -o FILE          record the bus into an MCAP file (--recover a cut one)
     cyborg detect SOURCE           objects and their distance in images, videos, bags, topics
     cyborg detect models list|fetch   known detector models
 
@@ -37,6 +38,7 @@ from cyborg.app import (
     detect_commands,
     monitor_commands,
     param_commands,
+    record_commands,
     runner_commands,
     sim_commands,
     up,
@@ -57,6 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     monitor_commands.add_parser(commands)
     runner_commands.add_parsers(bt_commands.add_parser(commands))
     bus_commands.add_parser(commands)
+    record_commands.add_parser(commands)
     param_commands.add_parser(commands)
     sim_commands.add_parser(commands)
     detect_commands.add_parser(commands)

@@ -12,6 +12,7 @@ kind             start function (and its parameters)
 ``monitor``      :func:`cyborg.monitor.component.start`
 ``camera``       :func:`cyborg.vision.component.start_camera`
 ``detector``     :func:`cyborg.vision.component.start_detector`
+``recorder``     :func:`cyborg.record.component.start`
 ===============  ====================================================================
 
 Any other kind is given as ``"package.module:function"``: a start function
@@ -25,6 +26,7 @@ from functools import partial
 
 from cyborg.bus.component import NodeSpec, Starter
 from cyborg.monitor import component as monitor
+from cyborg.record import component as recorder
 from cyborg.robot.settling_robot import SettlingBusRobot
 from cyborg.runner import component as runner
 from cyborg.sim import component as sim
@@ -36,6 +38,7 @@ KINDS: dict[str, Starter] = {
     "monitor": monitor.start,
     "camera": vision.start_camera,
     "detector": vision.start_detector,
+    "recorder": recorder.start,
 }
 """The start function of each kind a launch file may name."""
 

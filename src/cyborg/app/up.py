@@ -33,6 +33,7 @@ from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.errors import CommandError
 from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_robot
 from cyborg.app.system import run_system
+from cyborg.app.up_record import add_record_options, record_nodes
 from cyborg.app.up_vision import add_vision_options, vision_nodes
 from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.monitor import component as monitor
@@ -82,6 +83,7 @@ def add_parser(commands: Any) -> None:
     up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
     add_access_options(up)
     add_vision_options(up)
+    add_record_options(up)
     add_bus_options(up)
     up.set_defaults(handler=up_command)
 
@@ -118,6 +120,7 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
                   "robot_namespace": namespace}, where="tree runner"),
     ]
     nodes += vision_nodes(args, namespace)
+    nodes += record_nodes(args, namespace, map_path, tree_path)
     return LaunchDescription(nodes, list(args.connect), args.listen or DEFAULT_ROUTER)
 
 

@@ -33,7 +33,7 @@ import time
 from dataclasses import dataclass, field
 from importlib.metadata import PackageNotFoundError, version
 
-from cyborg.bus import Context, Durability, Node, Qos
+from cyborg.bus import Durability, Node, Qos
 from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
 from cyborg.bus.raw import RawMessage
 from cyborg.bus.wire import EntityKind
@@ -86,14 +86,15 @@ class RecordingStats:
 class Recorder:
     """Records the bus into ``files``; see the module. Stop it with :meth:`close`.
 
-    ``run`` adds values to the ``cyborg`` metadata record (``map``, ``tree``, ``command``);
-    the version and the start time are always there.
+    ``node`` is the recorder's own node (it destroys it when closed); ``run`` adds values to
+    the ``cyborg`` metadata record (``map``, ``tree``, ``command``); the version and the start
+    time are always there.
     """
 
-    def __init__(self, context: Context, files: RecordingFiles, selection: TopicSelection, *,
-                 name: str = NAME, namespace: str = "/",
+    def __init__(self, node: Node, files: RecordingFiles, selection: TopicSelection, *,
                  run: dict[str, str] | None = None) -> None:
-        self.context, self.files, self.selection = context, files, selection
+        self.node, self.context = node, node.context
+        self.files, self.selection = files, selection
         self.stats = RecordingStats()
         self.failure: str | None = None
         self.paused = False
@@ -104,8 +105,7 @@ class Recorder:
         files.add_metadata(RUN_METADATA, {
             "cyborg_version": cyborg_version(),
             "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(run or {})})
-        self.node = Node(name, namespace, context=context)
-        self.node.create_service(f"{name}/pause", SetBool, self._on_pause)
+        node.create_service(f"{node.name}/pause", SetBool, self._on_pause)
         self.node.create_timer(DISCOVERY_INTERVAL, self.discover)
         self.node.create_timer(FLUSH_CHECK, self._flush_if_due)
         self.discover()
