@@ -96,7 +96,7 @@ def complete(scan: Scan, out: BinaryIO, position: int) -> int:
     crc = zlib.crc32(struct.pack("<BQQQ", Opcode.FOOTER, 20, summary_start, offsets_start), crc)
     Footer(summary_start=summary_start, summary_offset_start=offsets_start,
            summary_crc=crc).write(summary)
-    data = builder.end() + summary.end() + MAGIC
+    data = builder.end() + summary_data + summary.end() + MAGIC
     out.write(data)
     return len(data)
 

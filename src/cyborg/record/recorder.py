@@ -150,6 +150,8 @@ class Recorder:
             self.stats.paused_drops += 1
             return
         sent = raw.info.timestamp_ns if raw.info is not None else raw.received_ns
+        if sent < 0:  # a sender's clock is not checked by the bus; MCAP times are unsigned
+            sent = raw.received_ns
         with self._lock:
             if self.failure is not None or self._closed:
                 return

@@ -122,11 +122,15 @@ def identify(path: Path, start: bytes) -> str:
         return f"{path}: an SQLite database (a rosbag2 .db3 file?), not an MCAP file"
     if len(start) < len(MAGIC) and MAGIC.startswith(start):
         return f"{path}: cut within its first {len(MAGIC)} bytes; nothing to recover"
-    try:
-        start.decode("utf-8")
-        kind = "a text file"
-    except UnicodeDecodeError:
-        kind = "not an MCAP file"
+    text = ""
+    for cut in range(4):  # the sample may end inside a character: judge the whole ones
+        try:
+            text = start[:len(start) - cut].decode("utf-8")
+            break
+        except UnicodeDecodeError:
+            continue
+    printable = all(char.isprintable() or char in "\t\r\n" for char in text)
+    kind = "a text file" if text and printable else "not an MCAP file"
     return f"{path}: {kind} (it does not start with the MCAP magic bytes)"
 
 
