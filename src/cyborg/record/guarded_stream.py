@@ -52,8 +52,9 @@ class GuardedStream:
         except OSError as exc:
             self._cut_back()
             reason = REASONS.get(exc.errno or 0, exc.strerror or str(exc))
-            self.failed = StorageError(exc.errno, f"{self.path}: {reason}; the recording "
-                                                  f"stopped after {self.good} bytes")
+            self.failed = StorageError(f"{self.path}: {reason}; the recording stopped after "
+                                       f"{self.good} bytes")
+            self.failed.errno = exc.errno
             raise self.failed from exc
         self.good += done
         return done

@@ -140,9 +140,9 @@ class Recorder:
                 return
             self.files.add_topic(topic, type_name, offered)
             self._types[topic] = type_name
-            self.stats.topics[topic] = 0
         self.node.create_raw_subscription(
             topic, type_name, lambda raw: self._on_message(topic, raw), qos)
+        self.stats.topics.setdefault(topic, 0)  # listed once messages can arrive
 
     # ------------------------------------------------------------------ messages
     def _on_message(self, topic: str, raw: RawMessage) -> None:
@@ -162,7 +162,7 @@ class Recorder:
                 return
         self.stats.messages += 1
         self.stats.bytes += len(raw.data)
-        self.stats.topics[topic] += 1
+        self.stats.topics[topic] = self.stats.topics.get(topic, 0) + 1
         if self._types[topic] == robot.MAP_GEOMETRY.type_name:
             self._note_map(topic, raw.data)
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from cyborg.bus import MessageTypes
+from cyborg.record.guarded_stream import StorageError
 from cyborg.record.mcap_file import McapFile
 
 _SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]?i?B?)\s*$", re.IGNORECASE)
@@ -109,7 +110,13 @@ class RecordingFiles:
         return self._current
 
     def _open(self, path: Path) -> None:
-        self._current = McapFile(path, self.types, compression=self.compression)
+        try:
+            self._current = McapFile(path, self.types, compression=self.compression)
+        except FileExistsError as exc:
+            if not self.paths:
+                raise
+            raise StorageError(f"{path} exists already; the recording stopped before it "
+                               "rather than overwrite it") from exc
         self.paths.append(path)
         self._opened = time.monotonic()
         for name, values in self.metadata.items():
