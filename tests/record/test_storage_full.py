@@ -16,7 +16,7 @@ from mcap.reader import make_reader
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.wire import EntityKind
-from cyborg.record import mcap_file, split
+from cyborg.record import completion, mcap_file, split
 from cyborg.record.guarded_stream import StorageError
 from cyborg.record.mcap_file import McapFile
 from cyborg.record.recorder import Recorder
@@ -112,7 +112,7 @@ def test_when_even_the_summary_finds_no_room_the_last_chunks_make_room_for_it(
     with pytest.raises(StorageError):
         fill(file, 1000)
     refusals = [2]
-    real_complete = mcap_file.complete
+    real_complete = completion.complete
 
     def no_room_twice(*args: Any) -> int:
         if refusals[0]:
