@@ -106,3 +106,27 @@ def test_after_kill_9_recover_gives_back_all_but_the_last_second(talker: Talker,
     assert numbers == list(range(numbers[0], numbers[0] + len(numbers)))
     assert numbers[-1] + 1 >= published_before, (numbers[-1], published_before)
     assert read_mcap(fixed)["/map"] == [{"data": "campus"}]
+
+
+def test_cyborg_up_record_records_the_run_with_its_map_and_tree(tmp_path: Path) -> None:
+    path = tmp_path / "up.mcap"
+    result = subprocess.run(
+        [sys.executable, "-m", "cyborg", "up", "--no-detector", "--no-monitor", "--record",
+         str(path), "--duration", "6", "--listen", f"tcp/127.0.0.1:{free_port()}"],
+        capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert f"recorder     {path}" in result.stdout
+    with open(path, "rb") as stream:
+        reader = make_reader(stream)
+        summary = reader.get_summary()
+        metadata = {item.name: item.metadata for item in reader.iter_metadata()}
+    assert summary is not None and summary.statistics is not None
+    counts = {summary.channels[channel].topic: count
+              for channel, count in summary.statistics.channel_message_counts.items()}
+    for topic in ("/cyborg/pose", "/cyborg/scan", "/cyborg/battery_status", "/cyborg/path",
+                  "/cyborg/map_geometry", "/cyborg/bt/behavior_tree", "/cyborg/bt/status",
+                  "/clock"):
+        assert counts.get(topic, 0) > 0, topic
+    assert metadata["cyborg"]["map"].endswith("campus.map")
+    assert metadata["cyborg"]["tree"].endswith("campus_patrol.b3.json")
+    assert metadata["cyborg.map"]["source"] == "campus.map"
