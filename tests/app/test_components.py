@@ -37,7 +37,8 @@ COMPONENT_MODULES = {"simulator": "cyborg.sim.component",
                      "tree_runner": "cyborg.runner.component",
                      "monitor": "cyborg.monitor.component",
                      "camera": "cyborg.vision.component",
-                     "detector": "cyborg.vision.component"}
+                     "detector": "cyborg.vision.component",
+                     "recorder": "cyborg.record.component"}
 
 
 def _default(function: Callable[..., Any], name: str) -> Any:

@@ -1,0 +1,51 @@
+"""``cyborg record``'s and the recorder component's bad input: clear errors naming the option."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cyborg.app.cli import main
+from cyborg.app.launchables import starter_for
+from cyborg.bus import BusConfig, Context
+from cyborg.bus.component import LaunchError, NodeSpec
+
+
+@pytest.mark.parametrize(("words", "message"), [
+    (["--split-size", "big"], "--split-size 'big': expected a size such as 500MB or 1GiB"),
+    (["--split-duration", "0"], "--split-duration '0': must be more than 0"),
+    (["--exclude", ""], "--exclude: an empty pattern"),
+    (["--duration", "-1"], "--duration must be more than 0 seconds"),
+])
+def test_bad_options_are_refused_before_joining_the_bus(
+        words: list[str], message: str, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["record", "-o", str(tmp_path / "run.mcap"), *words]) == 1
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "run.mcap").exists()
+
+
+@pytest.mark.parametrize(("parameters", "message"), [
+    ({}, "launch.toml: node 3: output: name the MCAP file to write"),
+    ({"output": "run.mcap", "split_size": "huge"}, "launch.toml: node 3: --split-size 'huge'"),
+    ({"output": "run.mcap", "compression": "rar"}, "compression 'rar': expected one of"),
+])
+def test_the_recorder_component_refuses_a_spec_naming_where_it_was_written(
+        parameters: dict[str, object], message: str, tmp_path: Path) -> None:
+    spec = NodeSpec("recorder", "recorder", "/", dict(parameters), base=tmp_path,
+                    where="launch.toml: node 3")
+    with Context(BusConfig.isolated()) as context, pytest.raises(LaunchError) as refused:
+        starter_for(spec)(context, spec)
+    assert message in str(refused.value)
+
+
+def test_the_recorder_component_records_into_the_launch_files_folder(tmp_path: Path) -> None:
+    spec = NodeSpec("recorder", "recorder", "/cyborg", {"output": "run.mcap", "map": "m.map"},
+                    base=tmp_path, where="launch.toml: node 1")
+    with Context(BusConfig.isolated()) as context:
+        running = starter_for(spec)(context, spec)
+        assert str(tmp_path / "run.mcap") in running.describe()
+        assert "/cyborg/recorder/pause" in running.describe()
+        running.stop()
+    assert (tmp_path / "run.mcap").stat().st_size > 0
