@@ -154,3 +154,19 @@ def test_recover_refuses_a_missing_file_an_existing_target_and_no_target(
     assert "--recover needs --output" in capsys.readouterr().err
     assert main(["record", "--recover", str(whole), "-o", str(tmp_path / "ok.mcap")]) == 0
     assert "recovered from" in capsys.readouterr().out
+
+
+def test_recovering_a_whole_file_rebuilds_the_indexes_and_statistics_the_writer_wrote(
+        tmp_path: Path) -> None:
+    whole, fixed = tmp_path / "whole.mcap", tmp_path / "fixed.mcap"
+    write_recording(whole)
+    recovery = recover(whole, fixed)
+    assert recovery.stopped == ""
+    with open(whole, "rb") as original, open(fixed, "rb") as rebuilt:
+        written, recovered = make_reader(original), make_reader(rebuilt)
+        first, second = written.get_summary(), recovered.get_summary()
+        assert first is not None and second is not None
+        assert second.chunk_indexes == first.chunk_indexes
+        assert second.statistics == first.statistics
+        assert second.channels == first.channels and second.schemas == first.schemas
+        assert list(recovered.iter_metadata()) == list(written.iter_metadata())

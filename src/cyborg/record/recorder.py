@@ -99,6 +99,7 @@ class Recorder:
         self.failure: str | None = None
         self.paused = False
         self._lock = threading.Lock()
+        self._discovering = threading.Lock()
         self._types: dict[str, str] = {}
         self._maps: dict[str, str] = {}
         self._closed = False
@@ -113,6 +114,10 @@ class Recorder:
     # ------------------------------------------------------------------ topics
     def discover(self) -> None:
         """Subscribes to every new topic of the graph that the selection accepts."""
+        with self._discovering:  # the first look (the caller's thread) may meet the timer's
+            self._discover()
+
+    def _discover(self) -> None:
         offered: dict[str, list[tuple[str, str]]] = {}
         for entity in self.context.graph.entities([EntityKind.PUBLISHER]):
             offered.setdefault(entity.topic, []).append((entity.type_name, entity.qos))
@@ -140,8 +145,11 @@ class Recorder:
                 return
             self.files.add_topic(topic, type_name, offered)
             self._types[topic] = type_name
-        self.node.create_raw_subscription(
-            topic, type_name, lambda raw: self._on_message(topic, raw), qos)
+        try:
+            self.node.create_raw_subscription(
+                topic, type_name, lambda raw: self._on_message(topic, raw), qos)
+        except RuntimeError:  # the recorder is being closed
+            return
         self.stats.topics.setdefault(topic, 0)  # listed once messages can arrive
 
     # ------------------------------------------------------------------ messages
