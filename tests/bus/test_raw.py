@@ -1,0 +1,58 @@
+"""Raw subscriptions get each message's CDR as it travelled: in-process, through Zenoh, through
+shared memory, latched; stamped on arrival, with the sender's attachment."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from cyborg.bus import BusConfig, Context, Node, Qos, new_message
+from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.bus.raw import RawMessage
+from tests.bus.bus_peer import linked_contexts, until_subscribed, wait_for
+
+
+def big_image(context: Context) -> object:
+    message = new_message(context.types, "sensor_msgs/msg/Image",
+                          {"height": 300, "width": 400, "encoding": "rgb8", "step": 1200})
+    message.data = np.arange(360_000, dtype=np.uint32).astype(np.uint8)
+    return message
+
+
+def test_in_process_messages_come_as_the_cdr_the_bus_would_send() -> None:
+    with Context(BusConfig.isolated()) as context:
+        talker, recorder = Node("talker", context=context), Node("recorder", context=context)
+        got: list[RawMessage] = []
+        recorder.create_raw_subscription("/chatter", "std_msgs/msg/String", got.append)
+        publisher = talker.create_publisher("/chatter", String)
+        before = time.time_ns()
+        publisher.publish(String(data="hello"))
+        assert wait_for(lambda: got, 10)
+        raw = got[0]
+        assert raw.data == bytes(context.types.serialize(String(data="hello"),
+                                                          "std_msgs/msg/String"))
+        assert raw.info is not None and raw.info.gid == publisher.gid
+        assert before <= raw.info.timestamp_ns <= raw.received_ns <= time.time_ns()
+
+
+def test_remote_messages_come_as_their_payload_small_large_and_latched() -> None:
+    with linked_contexts() as (recording, publishing):
+        talker, recorder = Node("talker", context=publishing), Node("rec", context=recording)
+        latched = talker.create_publisher("/latched", String, Qos.latched())
+        latched.publish(String(data="kept for late subscribers"))
+        got: dict[str, list[RawMessage]] = {"/latched": [], "/image": []}
+        recorder.create_raw_subscription("/latched", "std_msgs/msg/String",
+                                         got["/latched"].append, Qos.latched())
+        recorder.create_raw_subscription("/image", "sensor_msgs/msg/Image", got["/image"].append)
+        camera = talker.create_publisher("/image", "sensor_msgs/msg/Image")
+        until_subscribed(publishing, "/image", 20)
+        assert wait_for(lambda: publishing.shm_readers("/image"), 20)  # the slot path
+        image = big_image(publishing)
+        camera.publish(image)
+        assert wait_for(lambda: got["/latched"] and got["/image"], 20), got
+        types = publishing.types
+        assert got["/latched"][0].data == bytes(types.serialize(
+            String(data="kept for late subscribers"), "std_msgs/msg/String"))
+        assert got["/image"][0].data == bytes(types.serialize(image, "sensor_msgs/msg/Image"))
+        assert len(got["/image"][0].data) > 64 * 1024
