@@ -53,7 +53,8 @@ simulator builds on navigation and the bus; the robot's nodes glue the engine to
 navigation's pose types (not its planner); the monitor watches trees over the bus and borrows
 only the engine's DOT writer, statuses and JSON-text checks; vision publishes and subscribes on
 the bus and knows nothing of trees or navigation; the recorder takes any topic's raw bytes
-from the bus and names the contracts' topics only to describe the run. All but the contracts use the contracts."""
+from the bus and names the contracts' topics only to describe the run. All but the contracts
+use the contracts."""
 
 
 @pytest.mark.parametrize("package", sorted(ALLOWED))
