@@ -92,11 +92,12 @@ def test_after_kill_9_recover_gives_back_all_but_the_last_second(talker: Talker,
                                                                   tmp_path: Path) -> None:
     path, fixed = tmp_path / "run.mcap", tmp_path / "fixed.mcap"
     recording = start_recording(talker, path)
-    time.sleep(4.0)
+    time.sleep(6.0)
     killed_at = time.monotonic()
     recording.kill()
     recording.wait(30)
-    published_before = sum(1 for sent in talker.sent if sent < killed_at - 3.0)
+    # chunks go out at least every second; the rest of the margin is for a loaded machine
+    published_before = sum(1 for sent in talker.sent if sent < killed_at - 4.0)
     assert not scan(path).finished  # cut: no Data End, no summary
     result = subprocess.run([sys.executable, "-m", "cyborg", "record", "--recover", str(path),
                              "-o", str(fixed)], capture_output=True, text=True, timeout=60)
