@@ -49,3 +49,35 @@ def test_the_recorder_component_records_into_the_launch_files_folder(tmp_path: P
         assert "/cyborg/recorder/pause" in running.describe()
         running.stop()
     assert (tmp_path / "run.mcap").stat().st_size > 0
+
+
+def test_the_live_line_shows_messages_megabytes_rate_topics_and_pause(tmp_path: Path) -> None:
+    import io
+
+    from cyborg.app.record_commands import LiveLine
+    from cyborg.bus import Node
+    from cyborg.record.recorder import Recorder
+    from cyborg.record.selection import TopicSelection
+    from cyborg.record.split import RecordingFiles
+
+    with Context(BusConfig.isolated()) as context:
+        recorder = Recorder(Node("recorder", context=context),
+                            RecordingFiles(tmp_path / "run.mcap", context.types),
+                            TopicSelection.of())
+        recorder.stats.messages, recorder.stats.bytes = 12345, 4_100_000
+        recorder.stats.topics.update({"/a": 1, "/b": 2})
+        recorder.stats.skipped["/odd"] = "unknown type their_msgs/msg/Odd"
+        stream = io.StringIO()
+        line = LiveLine(recorder, stream)
+        assert not line.live
+        line.update()
+        recorder.set_paused(True)
+        paused = line.text()
+        recorder.close()
+        line.finish()
+    first = stream.getvalue().splitlines()[0]
+    assert first.startswith("recording  12,345 msgs  4.1 MB  ")
+    assert "/s  2 topics  0:00" in first
+    assert paused.startswith("PAUSED")
+    assert "12,345 messages on 2 topics" in stream.getvalue()
+    assert "not recorded: /odd (unknown type their_msgs/msg/Odd)" in stream.getvalue()
