@@ -91,11 +91,11 @@ class RecordingFiles:
     types: MessageTypes
     compression: str = "zstd"
     policy: SplitPolicy = field(default_factory=SplitPolicy)
-    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
-    paths: list[Path] = field(default_factory=list)
-    _topics: dict[str, _Topic] = field(default_factory=dict)
-    _current: McapFile | None = None
-    _opened: float = 0.0
+    paths: list[Path] = field(init=False, default_factory=list)
+    _topics: dict[str, _Topic] = field(init=False, default_factory=dict)
+    _metadata: dict[tuple[str, str], dict[str, str]] = field(init=False, default_factory=dict)
+    _current: McapFile | None = field(init=False, default=None)
+    _opened: float = field(init=False, default=0.0)
 
     def __post_init__(self) -> None:
         first = split_name(self.path, 0) if self.policy.splits else self.path
@@ -119,7 +119,7 @@ class RecordingFiles:
                                "rather than overwrite it") from exc
         self.paths.append(path)
         self._opened = time.monotonic()
-        for name, values in self.metadata.items():
+        for (name, _topic), values in self._metadata.items():
             self._current.metadata(name, values)
         for topic, known in self._topics.items():
             self._current.channel(topic, known.type_name, known.offered_qos)
@@ -130,8 +130,11 @@ class RecordingFiles:
         self.current.channel(topic, type_name, offered_qos)
 
     def add_metadata(self, name: str, values: dict[str, str]) -> None:
-        """Adds a metadata record to this file and every later one."""
-        self.metadata[name] = values
+        """Adds a metadata record to this file; later files repeat the last of each name.
+
+        Records that name a ``topic`` are told apart by it too: each robot's map is repeated.
+        """
+        self._metadata[(name, values.get("topic", ""))] = values
         self.current.metadata(name, values)
 
     def write(self, topic: str, log_time: int, publish_time: int, data: bytes) -> None:
