@@ -9,9 +9,9 @@
 It joins the bus's router like the other bus commands (``--connect``, ``--wait``) and records
 until Ctrl-C (or ``--duration``), which finishes the file with its summary. A live line on
 stderr shows the messages, megabytes and rate; into a pipe or file a line comes every ten
-seconds. ``kill -USR1`` pauses and resumes it, as does its service ``/recorder/pause``
-(``std_srvs/srv/SetBool``). A full disk stops it with exit code 1 and a readable file.
-docs/recording.md says what a recording holds.
+seconds. The key ``p`` (on a terminal) and ``kill -USR1`` pause and resume it, as does its
+service ``/recorder/pause`` (``std_srvs/srv/SetBool``). A full disk stops it with exit code 1
+and a readable file. docs/recording.md says what a recording holds.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from typing import Any, TextIO
 
 from cyborg.app.bus_options import open_context
 from cyborg.app.errors import CommandError
+from cyborg.app.keypress import Keys
 from cyborg.app.progress import duration, size, terminal_width
 from cyborg.bus import Node
 from cyborg.bus.config import DEFAULT_ROUTER
@@ -108,18 +109,20 @@ def record_command(args: argparse.Namespace) -> int:
 def _follow(recorder: Recorder, limit: float | None, stream: TextIO) -> int:
     """Shows the live line until Ctrl-C, SIGTERM, ``limit`` or a failure; then finishes."""
     line = LiveLine(recorder, stream)
+    key = "p or " if sys.stdin.isatty() else ""
     print(f"cyborg record: writing {recorder.files.paths[0]}; Ctrl-C stops, "
-          f"kill -USR1 {os.getpid()} pauses", file=stream, flush=True)
+          f"{key}kill -USR1 {os.getpid()} pauses and resumes", file=stream, flush=True)
     previous = {signum: signal.getsignal(signum) for signum in (signal.SIGTERM, signal.SIGUSR1)}
     signal.signal(signal.SIGTERM, _interrupt)
     signal.signal(signal.SIGUSR1, lambda _signum, _frame: recorder.toggle_pause())
     started = time.monotonic()
     try:
-        while recorder.failure is None:
-            if limit is not None and time.monotonic() - started >= limit:
-                break
-            line.update()
-            time.sleep(POLL)
+        with Keys(sys.stdin, {"p": recorder.toggle_pause}) as keys:
+            while recorder.failure is None:
+                if limit is not None and time.monotonic() - started >= limit:
+                    break
+                line.update()
+                keys.wait(POLL)
     except KeyboardInterrupt:
         pass
     finally:
