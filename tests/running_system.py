@@ -56,6 +56,7 @@ class System:
         spec = next(spec for spec in self.launch.description.nodes if spec.kind == "simulator")
         new = start_simulator(self.context, replace(spec, parameters={**spec.parameters,
                                                                       **parameters}))
+        assert isinstance(new, RunningSimulator), "one robot, not a fleet"
         self.launch.running.append(new)
         return new
 

@@ -249,7 +249,8 @@ def test_names_resolve_as_the_bus_resolves_them() -> None:
 
 def test_qos_follows_the_contract() -> None:
     assert robot.BATTERY_STATUS.qos == Qos.latched()
-    assert robot.MAP_GEOMETRY.qos == robot.FOOTPRINT.qos == robot.TF_STATIC.qos == Qos.latched()
+    assert robot.MAP_GEOMETRY.qos == robot.FOOTPRINT.qos == Qos.latched()
+    assert robot.TF_STATIC.qos == Qos.latched(100)  # every robot's transforms, at once
     assert robot.POSE.qos == Qos(depth=10)
     assert robot.CMD_VEL.qos == Qos(depth=1)  # only the newest command matters
     assert robot.CURRENT_GOAL.qos == Qos.latched()

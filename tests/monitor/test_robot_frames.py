@@ -92,3 +92,17 @@ def test_any_transforms_never_raise(links: list[tuple[str, str, float, float, fl
     mount = mount_of("laser", found)
     wire_text({"m": mount, "w": warnings})
     assert mount is None or all(math.isfinite(value) for value in mount)
+
+
+def test_robots_frames_named_after_them_give_each_robot_its_own_mount() -> None:
+    """Several robots on one /tf_static (a fleet names its frames robot1/..., as ROS's tf
+    prefix does): each scan's frame resolves to its own robot's mount."""
+    found: dict[str, tuple[str, list[float]]] = {}
+    for index, mount_x in enumerate((0.267, 0.3, 0.1), 1):
+        transforms_found, warnings = transforms_wire(transforms(
+            (f"robot{index}/base_link", f"robot{index}/laser", mount_x, 0.0, 0.0)))
+        assert warnings == []
+        found.update(transforms_found)
+    assert [mount_of(f"robot{index}/laser", found) for index in (1, 2, 3)] == [
+        [0.267, 0.0, 0.0], [0.3, 0.0, 0.0], [0.1, 0.0, 0.0]]
+    assert mount_of("laser", found) is None, "the plain name is another robot's"

@@ -111,8 +111,13 @@ to ``position.theta`` on arrival, ``comment`` the goal's description from the ma
 goal ends (reached, failed, cancelled, preempted) the topic says so with an empty ``name``."""
 MAP_GEOMETRY = Topic("map_geometry", MapGeometry, latched=True)
 FOOTPRINT = Topic("footprint", PolygonStamped, latched=True)
-TF_STATIC = Topic("/tf_static", TFMessage, latched=True)
-"""Fixed transforms between the robot's frames; absolute and latched, as in ROS 2."""
+TF_STATIC = Topic("/tf_static", TFMessage, latched=True, depth=100)
+"""Fixed transforms between the robot's frames; absolute and latched, as in ROS 2.
+
+One topic for the whole bus: with several robots each publishes its own transforms (its frames
+named after it, ``robot1/base_link``), and a subscriber that joins late gets every robot's
+latched message at once; depth 100, as ROS's static transform listener keeps, so that none of
+them pushes another out of its queue."""
 TOPICS: tuple[Topic, ...] = (CLOCK, POSE, ODOM, SCAN, BUMPER_STATE, BATTERY_STATUS, PATH_STATE,
                              PATH, CURRENT_GOAL, MAP_GEOMETRY, FOOTPRINT, TF_STATIC)
 """The topics the robot publishes."""
@@ -173,6 +178,23 @@ NAVIGATION_SERVICES: tuple[Service, ...] = (AVAILABLE_GOALS, DISTANCE_TO_GOAL, C
 """The services of :mod:`cyborg.nav.services`, answered on the map in use."""
 
 MOVE_TO_GOAL = Action("move_to_goal", MoveToGoal)
+
+FLEET_ROBOT = "robot"
+"""What a fleet's robots are called: ``robot1``, ``robot2``, ... (:func:`fleet_namespaces`)."""
+
+
+def fleet_namespaces(base: str, count: int) -> list[str]:
+    """The namespaces of ``count`` robots under ``base``: a robot alone keeps ``base``.
+
+    Several are ``<base>/robot1`` … ``<base>/robotN``: ``/robot1`` … under ``/``, each robot's
+    tree runner then under ``/robot1/bt`` (:func:`cyborg.interfaces.tree_runner.robot_of_runner`
+    pairs them back).
+    """
+    if count == 1:
+        return [base]
+    prefix = "/" + base.strip("/")
+    return [f"{prefix.rstrip('/')}/{FLEET_ROBOT}{index}" for index in range(1, count + 1)]
+
 
 def robot_namespace(topic: str, type_name: str) -> str | None:
     """The namespace of the robot that publishes ``topic`` of ``type_name``, or None.

@@ -13,21 +13,31 @@ parameter      meaning (default)
 ``speed``      simulated seconds per wall-clock second (:data:`SPEED`, 1: real time;
                0: as fast as possible); settable while it runs
 ``battery``    the charge at the start, percent (:data:`BATTERY`, full; read-only)
+``robots``     how many robots (:data:`ROBOTS`, 1; read-only); see below
 =============  ========================================================================
+
+With ``robots`` N > 1 it simulates a fleet on the map (:mod:`cyborg.sim.fleet`): one loop, one
+``/clock``, and a node :data:`NAME` per robot under ``<namespace>/robot1`` …
+``<namespace>/robotN`` (:func:`cyborg.interfaces.robot.fleet_namespaces`), each with these
+parameters (``speed`` set on any of them paces the whole fleet). ``start`` places the first
+robot, the others start near it. Only the first follows the absolute ``/initialpose``; each
+robot's frames carry its name (``robot1/base_link``, ``robot1/laser``), see
+:mod:`cyborg.sim.node`.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from cyborg.bus import Context, Node
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces import robot
 from cyborg.nav.arnl_map import MapError, read_map
 from cyborg.sim.battery import Battery
-from cyborg.sim.loop import REAL_TIME, SimulationLoop
+from cyborg.sim.fleet import MAX_ROBOTS, Fleet, robot_loops
+from cyborg.sim.loop import REAL_TIME, PacedLoop, SimulationLoop
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.simulator import Simulator
 
@@ -39,6 +49,8 @@ SPEED = REAL_TIME
 """Simulated seconds per wall-clock second unless told otherwise."""
 BATTERY = Battery.charge_percent
 """The battery's charge at the start unless told otherwise, percent: full."""
+ROBOTS = 1
+"""How many robots unless told otherwise."""
 
 
 class RunningSimulator:
@@ -60,39 +72,113 @@ class RunningSimulator:
         self.node.destroy()
 
 
-def start(context: Context, spec: NodeSpec) -> RunningSimulator:
-    """Starts the simulator from ``spec``; a map that cannot be read refuses it."""
+def start(context: Context, spec: NodeSpec) -> RunningSimulator | RunningFleet:
+    """Starts the simulator from ``spec``; a map that cannot be read refuses it.
+
+    With a ``robots`` parameter above 1 it is a fleet (see the module doc).
+    """
+    count = spec.parameters.get("robots", ROBOTS)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_ROBOTS:
+        raise spec.error(f"parameter `robots` must be a whole number from 1 to {MAX_ROBOTS}, "
+                         f"not {count!r}")
+    if count > 1:
+        return _start_fleet(context, spec, count)
     node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
     try:
-        params = node.parameters
-        map_value = params.declare("map", "", "ARNL .map file", read_only=True)
-        if not map_value:
-            raise spec.error("the simulator needs a `map` parameter (an ARNL .map file)")
-        start = params.declare("start", "", "goal or dock to start at", read_only=True)
-        speed = params.declare("speed", SPEED, "simulated seconds per second (0: flat out)")
-        charge = params.declare("battery", BATTERY, "battery charge at the start, percent",
-                                read_only=True, limits=(0.0, 100.0))
-        map_path = spec.path(str(map_value))
+        settings = _declare(node, spec)
         try:
-            arnl_map = read_map(map_path)
-            simulator = Simulator(arnl_map, start=start or None,
-                                  battery=Battery(charge_percent=float(charge)))
-            loop = SimulationLoop(simulator, float(speed))
+            arnl_map = read_map(settings.map_path)
+            simulator = Simulator(arnl_map, start=settings.start or None,
+                                  battery=Battery(charge_percent=settings.charge))
+            loop = SimulationLoop(simulator, settings.speed)
         except (MapError, KeyError, ValueError) as exc:
             raise spec.error(str(exc).strip("\"'")) from exc
-
-        def check(changes: dict[str, Any]) -> None:
-            if "speed" in changes and float(changes["speed"]) < 0:
-                raise ValueError("speed must be positive, or 0 for as fast as possible")
-
-        def change(changes: dict[str, Any]) -> None:
-            if "speed" in changes:
-                loop.speed = float(changes["speed"])
-        params.on_set(check)
-        params.on_change(change)
+        _pace(node, loop)
         SimulatorNode(node, loop)
         loop.start()
     except BaseException:
         node.destroy()
         raise
-    return RunningSimulator(node, loop, map_path)
+    return RunningSimulator(node, loop, settings.map_path)
+
+
+class _Settings(NamedTuple):
+    map_path: Path
+    start: str
+    speed: float
+    charge: float
+
+
+def _declare(node: Node, spec: NodeSpec) -> _Settings:
+    """Declares the simulator's parameters on ``node``; refuses a spec without a map."""
+    params = node.parameters
+    map_value = params.declare("map", "", "ARNL .map file", read_only=True)
+    if not map_value:
+        raise spec.error("the simulator needs a `map` parameter (an ARNL .map file)")
+    start = params.declare("start", "", "goal or dock to start at", read_only=True)
+    speed = params.declare("speed", SPEED, "simulated seconds per second (0: flat out)")
+    charge = params.declare("battery", BATTERY, "battery charge at the start, percent",
+                            read_only=True, limits=(0.0, 100.0))
+    if "robots" in spec.parameters:
+        params.declare("robots", ROBOTS, "how many robots", read_only=True)
+    return _Settings(spec.path(str(map_value)), str(start), float(speed), float(charge))
+
+
+def _pace(node: Node, loop: PacedLoop[Any]) -> None:
+    """Lets ``node``'s ``speed`` parameter pace ``loop`` while it runs."""
+    def check(changes: dict[str, Any]) -> None:
+        if "speed" in changes and float(changes["speed"]) < 0:
+            raise ValueError("speed must be positive, or 0 for as fast as possible")
+
+    def change(changes: dict[str, Any]) -> None:
+        if "speed" in changes:
+            loop.speed = float(changes["speed"])
+    node.parameters.on_set(check)
+    node.parameters.on_change(change)
+
+
+class RunningFleet:
+    """A started fleet: its robots' nodes, its loop, the fleet and the map it runs on."""
+
+    def __init__(self, nodes: list[Node], loop: PacedLoop[Fleet], map_path: Path) -> None:
+        self.nodes, self.loop, self.map_path = nodes, loop, map_path
+        self.fleet = loop.simulator
+
+    def describe(self) -> str:
+        """The map, the pace, and where each robot's interface is."""
+        speed = self.loop.speed
+        pace = "as fast as possible" if math.isinf(speed) else f"{speed:g}x real time"
+        names = ", ".join(node.namespace for node in self.nodes)
+        return (f"simulator    {len(self.nodes)} robots on {self.map_path.name} at {pace}: "
+                f"ARNL-like interfaces under {names}; /clock")
+
+    def stop(self) -> None:
+        """Stops the simulation and leaves the bus."""
+        self.loop.stop()
+        for node in self.nodes:
+            node.destroy()
+
+
+def _start_fleet(context: Context, spec: NodeSpec, count: int) -> RunningFleet:
+    nodes: list[Node] = []
+    try:
+        for namespace in robot.fleet_namespaces(spec.namespace, count):
+            nodes.append(Node(spec.name, namespace, context=context,
+                              parameters=spec.parameters))
+        settings = [_declare(node, spec) for node in nodes][-1]  # the same for each
+        try:
+            fleet = Fleet(read_map(settings.map_path), count, settings.start or None,
+                          charges=[settings.charge] * count)
+        except (MapError, KeyError, ValueError) as exc:
+            raise spec.error(str(exc).strip("\"'")) from exc
+        loop = PacedLoop(fleet, settings.speed)
+        for index, (node, share) in enumerate(zip(nodes, robot_loops(loop), strict=True)):
+            _pace(node, loop)
+            SimulatorNode(node, share, initial_pose=index == 0, publishes_clock=index == 0,
+                          frame_prefix=node.namespace.strip("/") + "/")
+        loop.start()
+    except BaseException:
+        for node in nodes:
+            node.destroy()
+        raise
+    return RunningFleet(nodes, loop, settings.map_path)

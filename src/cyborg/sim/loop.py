@@ -6,6 +6,10 @@ passes in 0.3 s; with ``speed`` 0 (or infinity) it runs as fast as the machine a
 touches the simulator from another thread holds ``loop.lock``. After every sensor step the
 ``on_sensor`` callbacks run (on the loop's thread, lock held) — that is where a bus node
 publishes.
+
+A :class:`PacedLoop` steps anything :class:`Stepped`: one simulator, or a fleet of them on one map
+(:class:`cyborg.sim.fleet.Fleet`, whose robots each have a :class:`RobotLoop` of their own).
+:class:`RobotLoop` is what a robot's bus node needs of the loop that steps its simulator.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import math
 import threading
 import time
 from collections.abc import Callable
+from typing import Generic, Protocol, TypeVar
 
 from cyborg.sim.simulator import Simulator
 
@@ -61,19 +66,74 @@ class SimulationLock:
                 time.sleep(0)
 
 
-class SimulationLoop:
-    """Steps ``simulator`` on a thread of its own at ``speed`` (see the module doc).
+class Stepped(Protocol):
+    """What a loop can step: a simulator, or a fleet of them.
 
-    Whoever touches the simulator from another thread holds :attr:`lock`; the ``on_sensor``
-    callbacks run on the loop's thread, lock held, after each sensor step; :attr:`error` holds
-    what stopped the loop if it failed.
+    Simulated ``time`` (s) is advanced one physics step by ``step()``, with a sensor step every
+    ``steps_per_sensor`` physics steps.
     """
 
-    def __init__(self, simulator: Simulator, speed: float = REAL_TIME) -> None:
+    @property
+    def time(self) -> float:
+        """Simulated seconds since the start."""
+
+    @property
+    def steps_per_sensor(self) -> int:
+        """Physics steps per sensor step."""
+
+    def step(self) -> None:
+        """Advance one physics step."""
+
+
+World = TypeVar("World", bound=Stepped)
+
+
+class RobotLoop(Protocol):
+    """What a simulated robot's bus node needs of the loop that steps it.
+
+    Its ``simulator``, the ``lock`` to hold while touching it, the ``on_sensor`` callbacks run
+    after each sensor step (on the loop's thread, lock held), the ``error`` that stopped the
+    loop, whether it is ``running``, and ``stop``. A :class:`SimulationLoop` of one simulator
+    is one; so is each robot's share of a fleet's loop.
+    """
+
+    @property
+    def simulator(self) -> Simulator:
+        """The robot's simulator."""
+
+    @property
+    def lock(self) -> SimulationLock:
+        """Held by whoever touches the simulator from another thread."""
+
+    @property
+    def on_sensor(self) -> list[Callable[[Simulator], None]]:
+        """Run after each sensor step, on the loop's thread, lock held."""
+
+    @property
+    def error(self) -> BaseException | None:
+        """What stopped the loop, if it failed."""
+
+    @property
+    def running(self) -> bool:
+        """Whether the simulation steps."""
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop stepping the robot."""
+
+
+class PacedLoop(Generic[World]):
+    """Steps ``simulator`` (one, or a fleet) on a thread of its own at ``speed``.
+
+    See the module doc. Whoever touches the simulator from another thread holds :attr:`lock`;
+    the ``on_sensor`` callbacks run on the loop's thread, lock held, after each sensor step;
+    :attr:`error` holds what stopped the loop if it failed.
+    """
+
+    def __init__(self, simulator: World, speed: float = REAL_TIME) -> None:
         self.simulator = simulator
         self.speed = speed
         self.lock = SimulationLock()
-        self.on_sensor: list[Callable[[Simulator], None]] = []
+        self.on_sensor: list[Callable[[World], None]] = []
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
@@ -132,3 +192,10 @@ class SimulationLoop:
         except BaseException as exc:  # reported, not swallowed: the owner checks .error
             self.error = exc
             log.exception("the simulation stopped")
+
+
+class SimulationLoop(PacedLoop[Simulator]):
+    """Steps one :class:`~cyborg.sim.simulator.Simulator`.
+
+    It is a :class:`PacedLoop` and a :class:`RobotLoop` at once (see the module doc).
+    """

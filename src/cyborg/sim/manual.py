@@ -3,8 +3,8 @@
 :func:`placement_problem` says whether the robot may be put at a pose (``set_pose``,
 ``/initialpose``): the pose must be finite, on the map (within the extent of its walls, points
 and objects), and the body there must overlap neither a wall or obstacle (the simulated world's
-clearance grid, as the bumpers feel it) nor a forbidden area or line. :func:`limit_command`
-clamps a hand-given speed command (``cmd_vel``) to the teleoperation limits of
+clearance grid, as the bumpers feel it), nor another robot, nor a forbidden area or line.
+:func:`limit_command` clamps a hand-given speed command (``cmd_vel``) to the teleoperation limits of
 :mod:`cyborg.interfaces.robot` and the drive's own.
 """
 
@@ -36,6 +36,8 @@ def placement_problem(pose: Pose2D, bounds: tuple[float, float, float, float],
     if not (min_x <= x <= max_x and min_y <= y <= max_y):
         return (f"{where} is off the map (it spans ({min_x:.2f}, {min_y:.2f}) to "
                 f"({max_x:.2f}, {max_y:.2f}))")
+    if base.robots_gap(pose) < 0.0:
+        return f"the robot at {where} would overlap another robot"
     gap = base.body_clearance(pose)
     if gap < 0.0:
         return f"the robot at {where} would overlap a wall or an obstacle (by {-gap:.2f} m)"

@@ -32,7 +32,7 @@ from cyborg.bus.msgs.geometry_msgs.msg import PoseWithCovarianceStamped, Twist
 from cyborg.interfaces import robot
 from cyborg.interfaces.robot import MAP_FRAME, TELEOP_TIMEOUT
 from cyborg.nav.geometry import Pose, Pose2D
-from cyborg.sim.loop import SimulationLoop
+from cyborg.sim.loop import RobotLoop
 from cyborg.sim.simulator import Simulator
 
 log = logging.getLogger("cyborg.sim")
@@ -52,7 +52,7 @@ class ManualControl:
     one of them should follow it.
     """
 
-    def __init__(self, node: Node, loop: SimulationLoop, preempt: Callable[[str], None],
+    def __init__(self, node: Node, loop: RobotLoop, preempt: Callable[[str], None],
                  callbacks: CallbackThread, *, clock: Callable[[], float] = time.monotonic,
                  initial_pose: bool = True, timeout: float = TELEOP_TIMEOUT) -> None:
         self.node, self.loop, self.sim = node, loop, loop.simulator

@@ -33,6 +33,13 @@ plus the navigation services of :mod:`cyborg.nav.services` (goals, distances, ma
 load_map_file), answered on the simulator's own map. Sensor topics are published at most
 ``max_publish_rate`` times per wall-clock second, so a simulation running hundreds of times
 faster than real time does not flood the bus; ``/clock`` follows every sensor step.
+
+With several robots on one bus (:mod:`cyborg.sim.fleet`) each has a node of its own under its
+namespace; only one of them publishes ``/clock`` (``publishes_clock``) and follows the absolute
+``/initialpose`` (``initial_pose``), and each names its frames with a prefix (``frame_prefix``
+``robot1/``: ``robot1/base_link`` → ``robot1/laser`` on ``/tf_static``, the scans'
+``frame_id`` ``robot1/laser``), as ROS multi-robot setups do, since ``/tf_static`` is one
+topic for the whole bus. A robot alone keeps the plain names.
 ``set_pose``, ``cmd_vel`` and ``/initialpose`` are :class:`~cyborg.sim.manual_node.ManualControl`'s.
 """
 
@@ -87,7 +94,7 @@ from cyborg.nav.geometry import Pose2D
 from cyborg.nav.map_message import MapPublisher
 from cyborg.nav.planner import Planner
 from cyborg.nav.services import NavigationMap, NavigationServices
-from cyborg.sim.loop import SimulationLoop
+from cyborg.sim.loop import RobotLoop
 from cyborg.sim.manual_node import ManualControl
 from cyborg.sim.simulator import Simulator, Target
 
@@ -102,12 +109,17 @@ class SimulatorNode:
     """Publishes a running simulation and serves its actions and services.
 
     ``clock`` gives wall-clock seconds (for the ``cmd_vel`` deadman); ``initial_pose``: whether
-    to follow ``/initialpose`` (see :class:`~cyborg.sim.manual_node.ManualControl`).
+    to follow ``/initialpose`` (see :class:`~cyborg.sim.manual_node.ManualControl`);
+    ``publishes_clock``: whether to publish ``/clock``; ``frame_prefix`` goes before the
+    robot's frame names (``robot1/`` makes ``robot1/base_link``; not before ``map``).
     """
 
-    def __init__(self, node: Node, loop: SimulationLoop, max_publish_rate: float = 30.0, *,
-                 clock: Callable[[], float] = time.monotonic, initial_pose: bool = True) -> None:
+    def __init__(self, node: Node, loop: RobotLoop, max_publish_rate: float = 30.0, *,
+                 clock: Callable[[], float] = time.monotonic, initial_pose: bool = True,
+                 publishes_clock: bool = True, frame_prefix: str = "") -> None:
         self.node, self.loop, self.sim = node, loop, loop.simulator
+        self.base_frame = frame_prefix + BASE_FRAME
+        self.laser_frame = frame_prefix + LASER_FRAME
         self._min_period = 1.0 / max_publish_rate
         self._published_at = 0.0
         self._last_state: tuple[Any, ...] = ()
@@ -120,7 +132,7 @@ class SimulatorNode:
         self._newest_goal = 0
         self._active_goal: ServerGoal[MoveToGoal_Goal, MoveToGoal_Feedback] | None = None
         self._feedback_at = -math.inf
-        self.clock = robot.CLOCK.publisher(node)
+        self.clock = robot.CLOCK.publisher(node) if publishes_clock else None
         self.pose = robot.POSE.publisher(node)
         self.odom = robot.ODOM.publisher(node)
         self.scan = robot.SCAN.publisher(node)
@@ -176,7 +188,8 @@ class SimulatorNode:
         self._feedback(sim)
         with self._stepped:
             self._stepped.notify_all()
-        self.clock.publish(Clock(clock=self._stamp()))
+        if self.clock is not None:
+            self.clock.publish(Clock(clock=self._stamp()))
         if sim.time - self._battery_at >= 1.0:
             self._battery_at = sim.time
             self._publish_battery(sim)
@@ -184,7 +197,7 @@ class SimulatorNode:
         if state != self._last_state:
             self._last_state = state
             self.bumpers.publish(BumperState(
-                header=self._header(BASE_FRAME), front_bumpers=np.array([state[0]]),
+                header=self._header(self.base_frame), front_bumpers=np.array([state[0]]),
                 rear_bumpers=np.array([state[1]])))
             self.path_state.publish(String(data=state[2].value))
         goal = sim.current_goal
@@ -207,7 +220,7 @@ class SimulatorNode:
     def _publish_battery(self, sim: Simulator) -> None:
         battery = sim.battery
         self.battery.publish(BatteryStatus(
-            header=self._header(BASE_FRAME), charging_state=int(battery.state),
+            header=self._header(self.base_frame), charging_state=int(battery.state),
             charge_percent=battery.charge_percent, voltage=battery.voltage,
             charging=battery.charging, dock_state=sim.docking.state.value))
 
@@ -217,13 +230,14 @@ class SimulatorNode:
                                   covariance=np.zeros(36))
         twist = Twist(linear=Vector3(x=float(sim.base.speed), y=0.0, z=0.0),
                       angular=Vector3(x=0.0, y=0.0, z=float(sim.base.turn_rate)))
-        return Odometry(header=self._header(MAP_FRAME), child_frame_id=BASE_FRAME, pose=pose,
+        return Odometry(header=self._header(MAP_FRAME), child_frame_id=self.base_frame,
+                        pose=pose,
                         twist=TwistWithCovariance(twist=twist, covariance=np.zeros(36)))
 
     def _scan(self, sim: Simulator) -> LaserScan:
         spec = sim.laser.spec
         return LaserScan(
-            header=self._header(LASER_FRAME), angle_min=spec.angle_min,
+            header=self._header(self.laser_frame), angle_min=spec.angle_min,
             angle_max=spec.angle_min + spec.angle_increment * (spec.beams - 1),
             angle_increment=spec.angle_increment, time_increment=0.0,
             scan_time=1.0 / sim.settings.sensor_rate, range_min=spec.range_min,
@@ -245,12 +259,13 @@ class SimulatorNode:
         """The body's outline in its own frame (it never changes)."""
         corners = [Point32(x=float(x), y=float(y), z=0.0)
                    for x, y in self.sim.base.footprint.polygon()]
-        return PolygonStamped(header=self._header(BASE_FRAME), polygon=Polygon(points=corners))
+        return PolygonStamped(header=self._header(self.base_frame),
+                              polygon=Polygon(points=corners))
 
     def _transforms(self) -> TFMessage:
         """Where the laser sits on the robot: ``mount_x`` ahead of the axle, facing forward."""
         mount = TransformStamped(
-            header=self._header(BASE_FRAME), child_frame_id=LASER_FRAME,
+            header=self._header(self.base_frame), child_frame_id=self.laser_frame,
             transform=Transform(
                 translation=Vector3(x=float(self.sim.laser.spec.mount_x), y=0.0, z=0.0),
                 rotation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)))

@@ -1,7 +1,7 @@
 """The simulated Pioneer LX base: its differential drive, its body and its bumpers.
 
-The drive has speed and acceleration limits, the body cannot pass through walls, and the
-bumpers report contact.
+The drive has speed and acceleration limits, the body cannot pass through walls nor through
+other robots' bodies (:attr:`RobotBase.others`, set by a fleet), and the bumpers report contact.
 
 Motion is unicycle kinematics (forward speed ``v``, turn rate ``w``) integrated exactly over each
 step. Commands are followed within the acceleration limits. A step that would make the body
@@ -19,6 +19,7 @@ from numba import njit
 
 from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Pose2D, normalize_angle
+from cyborg.sim.bodies import nearest_gap, outline_at
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,8 @@ class RobotBase:
 
     ``clearance`` holds metres to the nearest wall per cell; cell (0, 0) has its lower-left
     corner at ``origin`` (m), and ``resolution`` is metres per cell. ``speed`` (m/s) and
-    ``turn_rate`` (rad/s) are the motion now.
+    ``turn_rate`` (rad/s) are the motion now. ``others`` are other robots' outlines in the map
+    (K x 2 corners each, :mod:`cyborg.sim.bodies`): the body keeps clear of them as of walls.
     """
 
     clearance: np.ndarray  # metres to the nearest wall, per cell of the world grid
@@ -64,6 +66,7 @@ class RobotBase:
     bumpers: Bumpers = field(default_factory=Bumpers)
     odometer: float = 0.0  # metres driven
     bumps: int = 0  # contacts since start
+    others: tuple[np.ndarray, ...] = ()  # other robots' outlines, map coordinates
 
     def command(self, speed: float, turn_rate: float, dt: float) -> None:
         """Move for ``dt`` seconds towards the commanded speed and turn rate."""
@@ -93,10 +96,20 @@ class RobotBase:
 
     # ------------------------------------------------------------------ contact
     def body_clearance(self, pose: Pose2D) -> float:
-        """Smallest gap (metres, negative when overlapping) between the body and a wall."""
+        """Smallest gap (metres, negative when overlapping) to a wall or another robot."""
         offsets, radius = self.footprint.circles()
-        return float(body_gap(pose.x, pose.y, pose.theta, offsets, radius, self.clearance,
-                              self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
+        walls = float(body_gap(pose.x, pose.y, pose.theta, offsets, radius, self.clearance,
+                               self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
+        return min(walls, self.robots_gap(pose)) if self.others else walls
+
+    def robots_gap(self, pose: Pose2D) -> float:
+        """Smallest gap (m, negative when overlapping) to the other robots' outlines.
+
+        The body is at ``pose``; the gap is inf without other robots.
+        """
+        if not self.others:
+            return math.inf
+        return nearest_gap(outline_at(self.footprint.polygon(), pose), self.others)
 
     def collides(self, pose: Pose2D) -> bool:
         """Whether the body at ``pose`` overlaps a wall."""

@@ -15,6 +15,10 @@ By hand, :meth:`Simulator.teleop` drives at a given speed and turn rate (within 
 :mod:`cyborg.sim.manual`, and never into what the robot knows: the command passes the motion
 check of :mod:`cyborg.sim.motion_check`) until :meth:`Simulator.end_teleop`, and
 :meth:`Simulator.set_pose` puts the robot somewhere else at once. Both end any goal.
+
+Other robots on the same map (:mod:`cyborg.sim.fleet`) are given as their outlines
+(:meth:`Simulator.meet`): the laser sees them, the drive cannot pass through them, and the
+navigator and the motion check take them as obstacles, as they take the laser's returns.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from cyborg.nav.geometry import Pose2D, normalize_angle
 from cyborg.nav.grid import MapGrid
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
+from cyborg.sim.bodies import outline_at, outline_points
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
 from cyborg.sim.manual import limit_command, placement_problem
@@ -86,7 +91,8 @@ class Simulator:
     """
 
     def __init__(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
-                 settings: SimSettings | None = None, battery: Battery | None = None) -> None:
+                 settings: SimSettings | None = None, battery: Battery | None = None,
+                 planner: Planner | None = None) -> None:
         self.settings = settings or SimSettings()
         self.battery = battery or Battery()
         self.time = 0.0
@@ -100,8 +106,10 @@ class Simulator:
         self._after_dock: tuple[Pose2D, bool] | None = None
         self._teleop: tuple[float, float] | None = None
         self._target: Target | None = None
+        self.others: tuple[np.ndarray, ...] = ()
+        self._ways: tuple[np.ndarray, ...] = ()
         warm_up()  # the motion check's kernel, before the robot moves
-        self.load_map(arnl_map, start)
+        self.load_map(arnl_map, start, planner)
 
     # ------------------------------------------------------------------ world
     def load_map(self, arnl_map: ArnlMap, start: Pose2D | str | None = None,
@@ -139,6 +147,7 @@ class Simulator:
         self.map, self.world, self.planner = prepared.map, prepared.world, prepared.planner
         self.bounds = prepared.map.bounds()
         self.base, self.laser = prepared.base, prepared.laser
+        self.base.others = self.others
         self.angles = settings.laser.angles()
         self.navigator = Navigator(prepared.planner, settings.navigator)
         self.docking = Docking(settings.dock)
@@ -154,6 +163,22 @@ class Simulator:
     def pose(self) -> Pose2D:
         """The robot's pose now, in the map frame (m, rad)."""
         return self.base.pose
+
+    @property
+    def outline(self) -> np.ndarray:
+        """The robot's outline where it stands: its footprint's corners in the map (K x 2, m)."""
+        return outline_at(self.base.footprint.polygon(), self.base.pose)
+
+    def meet(self, others: tuple[np.ndarray, ...], ways: tuple[np.ndarray, ...] = ()) -> None:
+        """The other robots near this one, as their outlines (K x 2 map coordinates each).
+
+        Until the next call they are obstacles: to the laser, the drive, the navigator and the
+        motion check; ``ways``, the outlines they would cover braking from where they are now
+        (:func:`~cyborg.sim.bodies.braking_outlines`), are obstacles to the last two. Empty
+        tuples leave the robot alone on its map.
+        """
+        self.others = self.base.others = others
+        self._ways = ways
 
     @property
     def current_goal(self) -> Target | None:
@@ -313,7 +338,7 @@ class Simulator:
 
     def _sense(self) -> None:
         pose = self.base.pose
-        self.ranges = self.laser.scan(pose.x, pose.y, pose.theta)
+        self.ranges = self.laser.scan(pose.x, pose.y, pose.theta, self.others)
         self.hits = self.laser.points(pose.x, pose.y, pose.theta, self.ranges)
         self.scans += 1
 
@@ -323,14 +348,21 @@ class Simulator:
         if self._teleop is not None:
             return self._drive_by_hand(self._teleop)
         return self.navigator.update(self.time, self.base.pose, self.ranges, self.angles,
-                                     self.hits, self._motion(), self._period)
+                                     self._obstacles(), self._motion(), self._period)
+
+    def _obstacles(self) -> np.ndarray:
+        """What the robot knows is in its way: the laser's returns and the other robots."""
+        if not self.others:
+            return self.hits
+        bodies = self.others + self._ways
+        return np.concatenate([self.hits, *(outline_points(other) for other in bodies)])
 
     def _drive_by_hand(self, wanted: tuple[float, float]) -> tuple[float, float]:
         """The hand-given command, or a gentler one if it would touch a wall or a return."""
         if wanted == (0.0, 0.0):
             return wanted
         base, pose = self.base, self.base.pose
-        around = Surroundings(base.clearance, base.origin, base.resolution, self.hits)
+        around = Surroundings(base.clearance, base.origin, base.resolution, self._obstacles())
         return safest_command(pose.x, pose.y, pose.theta, self._motion(), wanted, self._period,
                               base.footprint, around)
 
@@ -340,8 +372,8 @@ class Simulator:
         travelled = math.hypot(pose.x - docking.travelled_from[0],
                                pose.y - docking.travelled_from[1])
         if docking.phase is DockPhase.APPROACH:
-            command = self.navigator.update(now, pose, self.ranges, self.angles, self.hits,
-                                            self._motion(), self._period)
+            command = self.navigator.update(now, pose, self.ranges, self.angles,
+                                            self._obstacles(), self._motion(), self._period)
             state = self.navigator.state
             if state is PathState.REACHED_GOAL:
                 docking.enter(DockState.DOCKING, DockPhase.DRIVE_IN, now, (pose.x, pose.y))

@@ -1,0 +1,143 @@
+"""Other robots' bodies as obstacles: outlines in the map, gaps between bodies, laser hits.
+
+When several simulated robots share a map (:mod:`cyborg.sim.fleet`), each robot's outline is
+an obstacle to the others, exactly as drawn: a convex polygon (the footprint of
+:meth:`cyborg.nav.footprint.Footprint.polygon`) placed at the robot's pose by :func:`outline_at`.
+
+* :func:`polygon_gap` is the smallest distance between two such outlines, negative (minus the
+  depth of the overlap) when they overlap; the drive refuses a step that makes it negative.
+* :func:`cast_onto` shortens laser beams that hit an outline before anything else.
+* :func:`outline_points` samples an outline as points, which the motion check and the
+  navigator take like laser returns (so a robot knows of another even behind its back, where
+  the laser is blind); :func:`braking_outlines` adds where a moving robot would come to a
+  stop, so that two robots driving at each other each keep out of the other's way, not only
+  out of where it is now.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numba import njit
+
+from cyborg.nav.geometry import Pose2D
+
+OUTLINE_SPACING = 0.05
+"""Metres between the points :func:`outline_points` puts on an outline."""
+
+
+def outline_at(polygon: np.ndarray, pose: Pose2D) -> np.ndarray:
+    """``polygon`` (K x 2, in the robot's frame) placed at ``pose``: K x 2 map coordinates."""
+    cos, sin = math.cos(pose.theta), math.sin(pose.theta)
+    x, y = polygon[:, 0], polygon[:, 1]
+    return np.column_stack([pose.x + cos * x - sin * y, pose.y + sin * x + cos * y])
+
+
+def nearest_gap(outline: np.ndarray, others: Sequence[np.ndarray]) -> float:
+    """The smallest :func:`polygon_gap` between ``outline`` and any of ``others`` (inf: none)."""
+    lowest = math.inf
+    for other in others:
+        lowest = min(lowest, float(polygon_gap(outline, other)))
+    return lowest
+
+
+@njit(cache=True)
+def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover - jit
+    """The gap (m) between convex polygons ``a`` and ``b`` (K x 2 corners, in order).
+
+    Apart, it is their distance; overlapping, it is minus the smallest shift along an edge's
+    normal that would part them (separating axes). Touching gives 0.
+    """
+    depth = np.inf
+    for polygon in (a, b):
+        count = polygon.shape[0]
+        for i in range(count):
+            j = (i + 1) % count
+            nx = polygon[j, 1] - polygon[i, 1]
+            ny = polygon[i, 0] - polygon[j, 0]
+            norm = math.hypot(nx, ny)
+            if norm == 0.0:
+                continue
+            nx, ny = nx / norm, ny / norm
+            low_a = high_a = a[0, 0] * nx + a[0, 1] * ny
+            for k in range(1, a.shape[0]):
+                value = a[k, 0] * nx + a[k, 1] * ny
+                low_a, high_a = min(low_a, value), max(high_a, value)
+            low_b = high_b = b[0, 0] * nx + b[0, 1] * ny
+            for k in range(1, b.shape[0]):
+                value = b[k, 0] * nx + b[k, 1] * ny
+                low_b, high_b = min(low_b, value), max(high_b, value)
+            overlap = min(high_a, high_b) - max(low_a, low_b)
+            if overlap < 0.0:  # a separating axis: the distance is between corners and edges
+                return min(_corner_distance(a, b), _corner_distance(b, a))
+            depth = min(depth, overlap)
+    return -depth
+
+
+@njit(cache=True)
+def _corner_distance(corners: np.ndarray, polygon: np.ndarray) -> float:  # pragma: no cover
+    best = np.inf
+    count = polygon.shape[0]
+    for k in range(corners.shape[0]):
+        px, py = corners[k, 0], corners[k, 1]
+        for i in range(count):
+            j = (i + 1) % count
+            ax, ay = polygon[i, 0], polygon[i, 1]
+            dx, dy = polygon[j, 0] - ax, polygon[j, 1] - ay
+            length = dx * dx + dy * dy
+            t = 0.0 if length == 0.0 else max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy)
+                                                       / length))
+            best = min(best, math.hypot(px - ax - t * dx, py - ay - t * dy))
+    return best
+
+
+@njit(cache=True)
+def cast_onto(outline: np.ndarray, x: float, y: float, angles: np.ndarray,
+              ranges: np.ndarray) -> None:  # pragma: no cover - jit
+    """Shorten ``ranges`` (m, from ``(x, y)`` along absolute ``angles``) that hit ``outline``."""
+    count = outline.shape[0]
+    for beam in range(angles.shape[0]):
+        dx, dy = math.cos(angles[beam]), math.sin(angles[beam])
+        for i in range(count):
+            j = (i + 1) % count
+            ax, ay = outline[i, 0] - x, outline[i, 1] - y
+            ex, ey = outline[j, 0] - outline[i, 0], outline[j, 1] - outline[i, 1]
+            denominator = dx * ey - dy * ex
+            if denominator == 0.0:
+                continue  # parallel to the edge
+            along = (ax * ey - ay * ex) / denominator  # distance along the beam
+            share = (ax * dy - ay * dx) / denominator  # where on the edge, 0..1
+            if along >= 0.0 and 0.0 <= share <= 1.0 and along < ranges[beam]:
+                ranges[beam] = along
+
+
+def outline_points(outline: np.ndarray, spacing: float = OUTLINE_SPACING) -> np.ndarray:
+    """Points along ``outline``'s edges, at most ``spacing`` apart: (N, 2) map coordinates."""
+    pieces = []
+    for start, end in zip(outline, np.roll(outline, -1, axis=0), strict=True):
+        steps = max(1, math.ceil(float(np.hypot(*(end - start))) / spacing))
+        share = np.arange(steps)[:, None] / steps
+        pieces.append(start + share * (end - start))
+    return np.concatenate(pieces) if pieces else np.zeros((0, 2))
+
+
+BRAKING_STEP = 0.25
+"""Metres between the outlines :func:`braking_outlines` puts along a robot's braking way."""
+
+
+def braking_outlines(polygon: np.ndarray, pose: Pose2D, speed: float,
+                     deceleration: float) -> list[np.ndarray]:
+    """The outlines a robot at ``pose`` covers until it stops, braking from ``speed`` (m/s).
+
+    ``polygon`` is its footprint (its own frame); it brakes straight ahead (backwards for a
+    negative speed) at ``deceleration`` (m/s²). One outline where it stands when it stands
+    still, more (:data:`BRAKING_STEP` apart) along the way when it moves.
+    """
+    way = speed * abs(speed) / (2.0 * deceleration)
+    steps = math.ceil(abs(way) / BRAKING_STEP)
+    cos, sin = math.cos(pose.theta), math.sin(pose.theta)
+    return [outline_at(polygon, Pose2D(pose.x + cos * way * k / steps,
+                                       pose.y + sin * way * k / steps, pose.theta))
+            for k in range(steps + 1)] if steps else [outline_at(polygon, pose)]

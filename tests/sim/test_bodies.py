@@ -1,0 +1,68 @@
+"""Other robots' bodies as obstacles: the gap between two outlines, beams that hit an outline,
+points along it, and the drive that will not push one body into another."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cyborg.nav.footprint import PIONEER_LX
+from cyborg.nav.geometry import Pose2D
+from cyborg.sim.bodies import cast_onto, nearest_gap, outline_at, outline_points, polygon_gap
+from cyborg.sim.robot import RobotBase
+
+SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+
+
+def square(x: float, y: float, theta: float = 0.0) -> np.ndarray:
+    return outline_at(SQUARE, Pose2D(x, y, theta))
+
+
+@pytest.mark.parametrize(("other", "gap"), [
+    (square(2.0, 0.0), 1.0),  # side by side
+    (square(1.0, 0.0), 0.0),  # touching
+    (square(0.8, 0.0), -0.2),  # overlapping by 0.2 m
+    (square(2.0, 2.0), math.sqrt(2.0)),  # corner to corner
+    (square(0.5 + math.sqrt(0.5) + 0.3, 0.0, math.pi / 4), 0.3),  # a corner towards a side
+])
+def test_the_gap_between_two_outlines(other: np.ndarray, gap: float) -> None:
+    assert polygon_gap(square(0.0, 0.0), other) == pytest.approx(gap, abs=1e-9)
+    assert polygon_gap(other, square(0.0, 0.0)) == pytest.approx(gap, abs=1e-9)
+
+
+def test_the_nearest_of_several_outlines_counts() -> None:
+    assert nearest_gap(square(0, 0), [square(5, 0), square(0, 3)]) == pytest.approx(2.0)
+    assert nearest_gap(square(0, 0), []) == math.inf
+
+
+def test_beams_stop_at_the_first_edge_of_an_outline() -> None:
+    ranges = np.array([10.0, 10.0, 10.0, 0.5])
+    angles = np.array([0.0, math.pi / 2, math.pi, 0.0])
+    cast_onto(square(3.0, 0.0), 0.0, 0.0, angles, ranges)
+    # straight at it: its near side, 2.5 m; sideways and backwards: missed; a wall nearer stays
+    assert ranges.tolist() == pytest.approx([2.5, 10.0, 10.0, 0.5])
+
+
+def test_points_along_an_outline_are_close_together_and_on_it() -> None:
+    points = outline_points(square(0, 0), spacing=0.05)
+    assert len(points) == 4 * 20
+    steps = np.hypot(*np.diff(np.vstack([points, points[:1]]), axis=0).T)
+    assert steps.max() <= 0.05 + 1e-9
+    assert np.allclose(np.abs(points).max(axis=1), 0.5)
+
+
+def test_the_drive_stops_short_of_another_robot() -> None:
+    """A robot driving at another stalls with its bumper pressed, never overlapping it."""
+    clearance = np.full((200, 200), 10.0)  # an open field, 10 m x 10 m
+    base = RobotBase(clearance, (0.0, 0.0), 0.05, pose=Pose2D(2.0, 5.0, 0.0))
+    other = outline_at(PIONEER_LX.polygon(), Pose2D(4.0, 5.0, math.pi / 2))
+    base.others = (other,)
+    for _ in range(400):  # 8 s at 1 m/s: far past the other robot if nothing stopped it
+        base.command(1.0, 0.0, 0.02)
+        assert base.robots_gap(base.pose) >= 0.0
+    assert base.bumpers.front and base.speed == 0.0
+    assert base.robots_gap(base.pose) < 0.05, "it stopped against the other robot"
+    base.command(-0.3, 0.0, 0.02)  # backing off is allowed
+    assert base.pose.x < 4.0 and not base.collides(base.pose)
