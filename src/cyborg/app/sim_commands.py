@@ -4,6 +4,7 @@
 
     cyborg sim --map AMROffice.map [--speed 10] [--start Dock] [--namespace /cyborg]
     cyborg sim --map AMROffice.map --speed 0 --duration 3600   # an hour, flat out
+    cyborg sim --map AMROffice.map --robots 3 --namespace /    # /robot1, /robot2, /robot3
     cyborg nav goals AMROffice.map
     cyborg nav plan AMROffice.map Dock room1        # names, or x,y[,heading] in metres/degrees
 
@@ -42,7 +43,10 @@ def add_parser(commands: Any) -> None:
                         help="home, goal or dock to start at (default: the map's home, else "
                              "its dock, else the free point nearest the map's centre)")
     parser.add_argument("--namespace", default=sim.NAMESPACE,
-                        help=f"the robot's namespace (default {sim.NAMESPACE})")
+                        help=f"the robot's namespace (default {sim.NAMESPACE}); with several "
+                             "robots, where their namespaces robot1 ... go (/ for /robot1 ...)")
+    parser.add_argument("--robots", type=int, default=sim.ROBOTS, metavar="N",
+                        help=f"how many robots to simulate on the map (default {sim.ROBOTS})")
     parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                         help="join the router there instead of being one")
     parser.add_argument("--listen", default=DEFAULT_ROUTER, metavar="ENDPOINT",
@@ -127,6 +131,8 @@ def sim_command(args: argparse.Namespace) -> int:
     parameters: dict[str, Any] = {"map": str(args.map), "speed": args.speed}
     if args.start:
         parameters["start"] = args.start
+    if args.robots != sim.ROBOTS:
+        parameters["robots"] = args.robots
     spec = NodeSpec("simulator", sim.NAME, args.namespace, parameters, where="simulator")
     context, where = bus_context(args.connect, args.listen)
     try:

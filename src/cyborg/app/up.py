@@ -7,7 +7,10 @@ patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format
 time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``; this machine only unless
 ``--monitor-host 0.0.0.0``, see docs/security.md), and a camera playing
 sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
-``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. It prints what runs
+``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. ``--robots N`` simulates
+N robots on the map (:mod:`cyborg.sim.fleet`), ``/robot1`` … ``/robotN``, each with its own
+tree runner (``/robot1/bt`` …) on the same tree; one monitor shows them all, and the camera and
+detector serve the first. It prints what runs
 and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
 
 The defaults are chosen to *show* the mission, not to mimic a day of it: the battery drains
@@ -36,9 +39,11 @@ from cyborg.app.system import run_system
 from cyborg.app.up_record import add_record_options, record_nodes
 from cyborg.app.up_vision import add_vision_options, vision_nodes
 from cyborg.bus.component import LaunchError, NodeSpec
+from cyborg.interfaces.robot import fleet_namespaces
 from cyborg.monitor import component as monitor
 from cyborg.runner import component as runner
 from cyborg.sim import component as sim
+from cyborg.sim.fleet import MAX_ROBOTS
 
 DATA = files("cyborg.app").joinpath("data")
 """The bundled data: the campus map and its patrol tree."""
@@ -75,6 +80,10 @@ def add_parser(commands: Any) -> None:
                          f"above the bundled tree's {CAMPUS_THRESHOLD:g} %% recharge threshold)")
     up.add_argument("--namespace", default=sim.NAMESPACE,
                     help=f"the robot's namespace (default {sim.NAMESPACE})")
+    up.add_argument("--robots", type=int, default=sim.ROBOTS, metavar="N",
+                    help=f"how many robots to simulate (default {sim.ROBOTS}; several: "
+                         f"/robot1 ... /robotN, each with its own tree runner; at most "
+                         f"{MAX_ROBOTS})")
     up.add_argument("--monitor-port", type=int, default=monitor.PORT, metavar="PORT",
                     help=f"port of the web monitor (default {monitor.PORT}; 0: any free port)")
     up.add_argument("--monitor-host", default=monitor.HOST, metavar="ADDRESS",
@@ -100,27 +109,36 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     """The system ``cyborg up`` starts, as a launch description."""
     if args.speed < 0:
         raise CommandError("--speed must be positive, or 0 for as fast as possible")
+    if not 1 <= args.robots <= MAX_ROBOTS:
+        raise CommandError(f"--robots must be from 1 to {MAX_ROBOTS}, not {args.robots}")
+    if args.robots > 1 and args.namespace != sim.NAMESPACE:
+        raise CommandError(f"--namespace names one robot; with --robots {args.robots} the "
+                           f"robots are /robot1 ... /robot{args.robots}")
     map_path = args.map or Path(str(DATA.joinpath(CAMPUS_MAP)))
     tree_path = args.tree or Path(str(DATA.joinpath(CAMPUS_TREE)))
-    namespace = under_robot(args.namespace, sim.NAMESPACE)
-    tree_namespace = under_robot(args.namespace, runner.NAMESPACE)
+    fleet = "/" if args.robots > 1 else under_robot(args.namespace, sim.NAMESPACE)
+    namespaces = fleet_namespaces(fleet, args.robots)
+    trees = [under_robot(namespace, runner.NAMESPACE) for namespace in namespaces]
     robot: dict[str, Any] = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
     if args.start:
         robot["start"] = args.start
+    if args.robots > 1:
+        robot["robots"] = args.robots
     nodes = [] if args.no_monitor else [
         # first: a taken port stops the launch before the robot moves
-        NodeSpec("monitor", monitor.NAME, namespace,
-                 {"trees": [tree_namespace], "port": args.monitor_port,
+        NodeSpec("monitor", monitor.NAME, fleet,
+                 {"trees": trees, "port": args.monitor_port,
                   "host": args.monitor_host, **access_parameters(args)},
                  where="monitor (--monitor-port)")]
-    nodes += [
-        NodeSpec("simulator", sim.NAME, namespace, robot, where="simulator"),
-        NodeSpec("tree_runner", runner.NAME, tree_namespace,
-                 {"tree_file": str(tree_path), "use_sim_time": True,
-                  "robot_namespace": namespace}, where="tree runner"),
-    ]
-    nodes += vision_nodes(args, namespace)
-    nodes += record_nodes(args, namespace, map_path, tree_path)
+    nodes.append(NodeSpec("simulator", sim.NAME, fleet, robot,
+                          where="simulator (--robots)" if args.robots > 1 else "simulator"))
+    nodes += [NodeSpec("tree_runner", runner.NAME, tree_namespace,
+                       {"tree_file": str(tree_path), "use_sim_time": True,
+                        "robot_namespace": namespace},
+                       where="tree runner" + (f" of {namespace}" if args.robots > 1 else ""))
+              for namespace, tree_namespace in zip(namespaces, trees, strict=True)]
+    nodes += vision_nodes(args, namespaces[0])
+    nodes += record_nodes(args, fleet, map_path, tree_path)  # one recorder: all topics
     return LaunchDescription(nodes, list(args.connect), args.listen or DEFAULT_ROUTER)
 
 
@@ -132,6 +150,9 @@ def up_notes(args: argparse.Namespace) -> list[str]:
     """
     pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
     lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
+    if args.robots > 1:
+        lines.append(f"robots       {args.robots} (--robots), each with its tree, sharing the "
+                     "map's dock")
     if (args.map, args.tree, args.speed, args.battery) == (None, None, DEFAULT_SPEED,
                                                            DEFAULT_BATTERY):
         lines += [f"             the patrol goes to recharge below {CAMPUS_THRESHOLD:g} % "

@@ -1,0 +1,95 @@
+"""`cyborg up --robots N`: N simulated robots on one map, each in its own namespace with its
+own tree runner, one monitor for all of them; a clear error for a count that cannot be."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from cyborg.app.cli import build_parser
+from cyborg.app.errors import CommandError
+from cyborg.app.launch import Launch
+from cyborg.app.up import up_description
+from cyborg.bus import BusConfig, Context
+from cyborg.bus.wire import EntityKind
+from cyborg.runner.component import RunningTree
+from cyborg.sim.component import RunningFleet
+from tests.running_system import wait_until
+
+ROBOTS = ["/robot1", "/robot2", "/robot3"]
+
+
+def _description(*words: str) -> dict[str, list[tuple[str, str, dict[str, object]]]]:
+    args = build_parser().parse_args(["up", *words])
+    kinds: dict[str, list[tuple[str, str, dict[str, object]]]] = {}
+    for spec in up_description(args).nodes:
+        kinds.setdefault(spec.kind, []).append((spec.name, spec.namespace, spec.parameters))
+    return kinds
+
+
+def test_three_robots_are_one_fleet_three_tree_runners_and_one_monitor() -> None:
+    kinds = _description("--robots", "3", "--no-detector")
+    [(_, fleet_namespace, fleet)] = kinds["simulator"]
+    assert fleet_namespace == "/" and fleet["robots"] == 3, "one simulator, three robots"
+    runners = [(namespace, parameters["robot_namespace"])
+               for _, namespace, parameters in kinds["tree_runner"]]
+    assert runners == [(f"{robot}/bt", robot) for robot in ROBOTS]
+    [(_, _, monitor)] = kinds["monitor"]
+    assert monitor["trees"] == [f"{robot}/bt" for robot in ROBOTS]
+
+
+def test_one_robot_is_as_before() -> None:
+    kinds = _description("--no-detector")
+    [(_, namespace, simulator)] = kinds["simulator"]
+    assert namespace == "/cyborg" and "robots" not in simulator
+    assert [(n, p["robot_namespace"]) for _, n, p in kinds["tree_runner"]] == [
+        ("/cyborg/bt", "/cyborg")]
+
+
+def test_the_detector_serves_the_first_robot() -> None:
+    kinds = _description("--robots", "2")
+    vision = kinds["detector"] + kinds["camera"]
+    assert vision and all(namespace.startswith("/robot1/") for _, namespace, _ in vision)
+
+
+@pytest.mark.parametrize(("words", "said"), [
+    (["--robots", "0"], "--robots must be from 1 to 16, not 0"),
+    (["--robots", "17"], "--robots must be from 1 to 16, not 17"),
+    (["--robots", "2", "--namespace", "/lab"],
+     "--namespace names one robot; with --robots 2 the robots are /robot1 ... /robot2"),
+])
+def test_a_count_that_cannot_be_is_a_clear_error(words: list[str], said: str) -> None:
+    with pytest.raises(CommandError) as raised:
+        up_description(build_parser().parse_args(["up", *words]))
+    assert str(raised.value) == said
+
+
+@pytest.mark.heavy
+def test_cyborg_up_with_three_robots_drives_each_with_its_own_tree() -> None:
+    args = build_parser().parse_args(["up", "--robots", "3", "--no-monitor", "--no-detector",
+                                      "--speed", "10"])
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(up_description(args), context)
+        launch.start()
+        try:
+            [fleet] = [item for item in launch.running if isinstance(item, RunningFleet)]
+            runners = [item for item in launch.running if isinstance(item, RunningTree)]
+            assert [node.namespace for node in fleet.nodes] == ROBOTS
+            assert [item.runner.node.namespace for item in runners] == [
+                f"{robot}/bt" for robot in ROBOTS]
+            graph = context.graph
+            wait_until(lambda: all(graph.count(f"{robot}/pose", EntityKind.PUBLISHER) == 1
+                                   for robot in ROBOTS), 20, "each robot's pose on the bus")
+            assert graph.count("/clock", EntityKind.PUBLISHER) == 1
+            sims = fleet.fleet.simulators
+            with fleet.loop.lock:
+                starts = [sim.pose for sim in sims]
+
+            def all_moved() -> bool:
+                with fleet.loop.lock:
+                    return all(math.hypot(sim.pose.x - start.x, sim.pose.y - start.y) > 0.5
+                               for sim, start in zip(sims, starts, strict=True))
+            wait_until(all_moved, 90, "every robot to drive off on its own patrol")
+        finally:
+            launch.stop()
