@@ -5,7 +5,7 @@
 // latency benchmark (`structures`: structures received; `laidOut`: how many had been received
 // when the tree was last laid out).
 
-import { say, showBanner, showToolbar, showTrees } from "./chrome.js";
+import { say, selectTreeRobot, showBanner, showToolbar, showTrees } from "./chrome.js";
 import { Connection, keepSeatSecret } from "./connection.js";
 import { saveView } from "./export.js";
 import { History } from "./history.js";
@@ -14,6 +14,7 @@ import { LazyMapPanel } from "./map/lazy_panel.js";
 import { TreeModel } from "./model.js";
 import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
+import { learnRobots, onRobotSelected, treeOfRobot } from "./robots.js";
 import { TreeView } from "./tree_view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -79,11 +80,14 @@ function receive(message) {
   switch (message.t) {
     case "watching":
       page.ns = message.ns;
-      mapPanel.setTree(page.ns);
+      treeShown();
       break;
     case "structure":
       stats.structures += 1;
-      if (message.ns !== page.ns) mapPanel.setTree(page.ns = message.ns);
+      if (message.ns !== page.ns) {
+        page.ns = message.ns;
+        treeShown();
+      }
       model.reset(message.v, message.tree ? message.tree.root : null);
       page.title = message.tree ? message.tree.title : "";
       if (page.selected && !model.byId.has(page.selected)) page.selected = null;
@@ -127,6 +131,7 @@ function receive(message) {
       banner();
       break;
     case "robots":
+      learnRobots(message);
       page.robots = message.robots;
       showTrees(page);
       break;
@@ -335,16 +340,27 @@ function applySearch(jump) {
   }
 }
 
-// ------------------------------------------------------------------ wiring
-$("robot").addEventListener("change", (event) => {
-  page.ns = event.target.value;
-  mapPanel.setTree(page.ns);
+// ------------------------------------------------------------------ the selected robot
+// Choosing in the robot selector shows that tree; a robot selected elsewhere (a click on the
+// map) shows the tree that drives it (js/robots.js).
+function showTree(ns) {
+  if (ns === page.ns) return;
+  page.ns = ns;
   page.folded.clear();
   page.opened.clear();
   page.selected = null;
   tickHistory.live();
   connection.post({ t: "watch", ns: page.ns });
-});
+  treeShown();
+}
+
+function treeShown() {
+  selectTreeRobot(page);
+  mapPanel.setTree(page.ns);
+}
+
+onRobotSelected((ns, from) => { if (from !== "tree") showTree(treeOfRobot(ns)); });
+$("robot").addEventListener("change", (event) => showTree(event.target.value));
 $("run").addEventListener("click", () => command({ t: "enable", on: page.enabled === false }));
 $("depth").addEventListener("change", (event) => {
   page.depth = Math.max(-1, parseInt(event.target.value, 10) || 0);

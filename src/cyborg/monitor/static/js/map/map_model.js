@@ -34,8 +34,10 @@
 // A message that fails to decode becomes a warning, never an exception that would stop the
 // page: every message is applied inside try/catch.
 
+import { colourOf } from "../robots.js";
+
 export const CATEGORY = { OTHER: 0, GOAL: 1, GOAL_WITH_HEADING: 2, DOCK: 3, HOME: 4, FORBIDDEN_LINE: 5, FORBIDDEN_AREA: 6, SIM_OBSTACLE: 7 };
-export const PALETTE = ["#1a73e8", "#e8710a", "#188038", "#a142f4", "#d01884", "#12b5cb", "#9e6a03", "#3c4043"];
+export { PALETTE } from "../robots.js";
 // The Pioneer LX's 12-point outline (nav/footprint.py), until the robot tells its own.
 export const DEFAULT_FOOTPRINT = Float32Array.from([
   0.32, 0.18, 0.29, 0.21, 0.26, 0.24, -0.26, 0.24, -0.29, 0.21, -0.32, 0.18,
@@ -216,12 +218,10 @@ export class MapModel {
     if (!robot) {
       robot = {
         ns, seq: null, pose: null, scan: null, scanCount: 0, mount: null, footprint: DEFAULT_FOOTPRINT, alive: this.alive.get(ns) ?? true,
-        node: "", state: "", goal: null, battery: null, pathId: null, path: null, progress: null, colour: PALETTE[0],
+        node: "", state: "", goal: null, battery: null, pathId: null, path: null, progress: null, colour: colourOf(ns),
         seen: null, // {at (ms), items: [{label, score, x, y}]}: the detector's objects
       };
       this.robots.set(ns, robot);
-      const names = [...this.robots.keys()].sort();
-      for (const [name, each] of this.robots) each.colour = PALETTE[names.indexOf(name) % PALETTE.length];
     }
     return robot;
   }

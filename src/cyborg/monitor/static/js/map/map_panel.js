@@ -13,20 +13,22 @@
 // an error for "map"; the panel swallows it and keeps saying "no map yet".
 //
 // `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
-// {points, lines, objects}, moving: {robots, laser, paths, goals, detections}, warnings, toScreen(x, y),
-// toWorld(sx, sy), view(), colourOf(ns), robot(ns), fetches, renders, where, frameMs,
-// messageMs}; robot(ns) is a copy of what the page knows of a robot (pose, mount, footprint,
-// battery, alive, state, path and scan sizes, whether its path is drawn and how far its end
-// is, the running node, the current goal), or null; acting() what acting from the map stands
+// {points, lines, objects}, moving: {robots, laser, paths, goals, detections, names}, warnings,
+// toScreen(x, y), toWorld(sx, sy), view(), colourOf(ns), robot(ns), selected(), fetches,
+// renders, where, frameMs, messageMs}; robot(ns) is a copy of what the page knows of a robot
+// (pose, mount, footprint, battery, alive, state, path and scan sizes, whether its path is
+// drawn and how far its end is, the running node, the current goal), or null; acting() what acting from the map stands
 // at ({robot, canAct, mode, points}); highlight() the goal ringed for the node selected in
 // the tree ({name, x, y, th, category}, or null).
 
+import { colourOf, onRobotSelected, selectRobot, selectedRobot } from "../robots.js";
 import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
 import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
 import { CATEGORY, DETECTIONS_SHOWN_MS, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
+import { pickOnClick, robotAt } from "./robot_pick.js";
 import { StaticLayer } from "./static_layer.js";
 import { MapTools } from "./tools.js";
 import { ViewTransform } from "./view_transform.js";
@@ -80,11 +82,19 @@ export class MapPanel {
       toScreen: (x, y) => this.view.toScreen(x, y),
       toWorld: (sx, sy) => this.view.toWorld(sx, sy),
       view: () => this.view.snapshot(),
-      colourOf: (ns) => this.model.robots.get(ns)?.colour ?? null,
+      colourOf: (ns) => (this.model.robots.has(ns) ? colourOf(ns) : null),
       robot: (ns) => describe(this.model, this.model.robots.get(ns)),
       acting: () => ({ robot: this.actingRobot(), canAct: this.actions.canAct, mode: this.tools.mode, points: this.tools.points.map((p) => [...p]) }),
       highlight: () => this.goalHighlight.target && { ...this.goalHighlight.target },
+      selected: () => this.selected(),
     };
+    // a click on a robot selects it (js/robots.js): its tree is shown, the actions go to it;
+    // not while a tool is chosen or when the click sends the robot to a marker
+    pickOnClick(this.canvas, {
+      robotAt: (sx, sy) => (this.tools.ownsClick(sx, sy) ? null : robotAt(this.model.robots.values(), this.view, sx, sy)),
+      onPick: (ns) => selectRobot(ns, "map"),
+    });
+    onRobotSelected(() => this.schedule());
     this.view.attach(this.canvas, {
       claim: (event) => this.tools.claim(event),
       onChange: () => this.schedule(),
@@ -182,8 +192,12 @@ export class MapPanel {
     this.schedule();
   }
 
+  // The robot the map rings and follows: the page's selected robot (js/robots.js) when the map
+  // has it, else the one the shown tree drives, else the first.
   selected() {
     const robots = this.model.robots;
+    const chosen = selectedRobot();
+    if (chosen && robots.has(chosen)) return chosen;
     const ns = this.treeNs ? this.pairs.get(this.treeNs) ?? this.treeNs.replace(/\/bt$/, "") : null;
     if (ns && robots.has(ns)) return ns;
     return [...robots.keys()].sort()[0] ?? null;

@@ -25,12 +25,12 @@ export function drawBitmap(ctx, view, placement, dpr) {
 
 // The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), robots (the robots
 // to draw, [robot]), layers, selected (ns or null)}. Returns what it drew: {robots, laser,
-// paths, goals, detections}.
+// paths, goals, detections, names}.
 export function drawMoving(ctx, scene) {
   const { view, dpr, layers } = scene;
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, view.width, view.height);
-  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, detections: 0 };
+  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, detections: 0, names: 0 };
   if (layers.paths) {
     for (const robot of scene.robots) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
@@ -55,7 +55,14 @@ export function drawMoving(ctx, scene) {
       ctx.globalAlpha = 1;
       drawn.robots += 1;
     }
-    if (layers.labels) for (const robot of scene.robots) if (robot.pose) drawName(ctx, view, robot);
+    if (layers.labels) {
+      for (const robot of scene.robots) {
+        if (robot.pose) {
+          drawName(ctx, view, robot);
+          drawn.names += 1;
+        }
+      }
+    }
   }
   return drawn;
 }

@@ -105,6 +105,13 @@ export class MapTools {
     if (event.buttons === 0) this.hover(sx, sy);
   }
 
+  // Whether a click at (sx, sy) is the tools' own: a tool is chosen, or the click would send the
+  // robot to a marker. Such a click never selects another robot (the command goes to the one
+  // selected when it was given).
+  ownsClick(sx, sy) {
+    return this.mode !== null || (this.actions.canAct && this.markerAt(sx, sy, HIT_PX) !== null);
+  }
+
   hover(sx, sy) {
     const marker = this.markerAt(sx, sy, HIT_PX);
     const ns = this.actions.robot();
