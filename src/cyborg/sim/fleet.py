@@ -90,8 +90,9 @@ def choose_starts(arnl_map: ArnlMap, planner: Planner, count: int,
                                              "the first robot's start"))
             if len(choices) == count:
                 return choices
-    raise ValueError(f"robots: {arnl_map.source} has room for {len(choices)} robots near the "
-                     f"start ({START_SPACING:g} m apart, off goals and docks), not {count}")
+    raise ValueError(f"robots: {arnl_map.source} has room for {len(choices)} robots "
+                     f"({START_SPACING:g} m apart, off goals and docks, where the first can "
+                     f"drive), not {count}")
 
 
 class Fleet:
