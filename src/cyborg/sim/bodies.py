@@ -9,9 +9,9 @@ an obstacle to the others, exactly as drawn: a convex polygon (the footprint of
 * :func:`cast_onto` shortens laser beams that hit an outline before anything else.
 * :func:`outline_points` samples an outline as points, which the motion check and the
   navigator take like laser returns (so a robot knows of another even behind its back, where
-  the laser is blind); :func:`braking_outlines` adds where a moving robot would come to a
-  stop, so that two robots driving at each other each keep out of the other's way, not only
-  out of where it is now.
+  the laser is blind); placed (:func:`placed`) along a moving robot's braking way too
+  (:func:`braking_poses`), so that two robots driving at each other each keep out of the
+  other's way, not only out of where it is now.
 """
 
 from __future__ import annotations
@@ -30,9 +30,18 @@ OUTLINE_SPACING = 0.05
 
 def outline_at(polygon: np.ndarray, pose: Pose2D) -> np.ndarray:
     """``polygon`` (K x 2, in the robot's frame) placed at ``pose``: K x 2 map coordinates."""
-    cos, sin = math.cos(pose.theta), math.sin(pose.theta)
-    x, y = polygon[:, 0], polygon[:, 1]
-    return np.column_stack([pose.x + cos * x - sin * y, pose.y + sin * x + cos * y])
+    return _placed(np.ascontiguousarray(polygon, dtype=np.float64), pose.x, pose.y, pose.theta)
+
+
+@njit(cache=True)
+def _placed(polygon: np.ndarray, x: float, y: float,
+            theta: float) -> np.ndarray:  # pragma: no cover - jit
+    cos, sin = math.cos(theta), math.sin(theta)
+    out = np.empty_like(polygon)
+    for k in range(polygon.shape[0]):
+        out[k, 0] = x + cos * polygon[k, 0] - sin * polygon[k, 1]
+        out[k, 1] = y + sin * polygon[k, 0] + cos * polygon[k, 1]
+    return out
 
 
 def nearest_gap(outline: np.ndarray, others: Sequence[np.ndarray]) -> float:
@@ -124,20 +133,27 @@ def outline_points(outline: np.ndarray, spacing: float = OUTLINE_SPACING) -> np.
 
 
 BRAKING_STEP = 0.25
-"""Metres between the outlines :func:`braking_outlines` puts along a robot's braking way."""
+"""Metres between the poses :func:`braking_poses` puts along a robot's braking way."""
 
 
-def braking_outlines(polygon: np.ndarray, pose: Pose2D, speed: float,
-                     deceleration: float) -> list[np.ndarray]:
-    """The outlines a robot at ``pose`` covers until it stops, braking from ``speed`` (m/s).
+def braking_poses(pose: Pose2D, speed: float, deceleration: float) -> list[Pose2D]:
+    """Where a robot at ``pose`` will be until it stops, braking from ``speed`` (m/s).
 
-    ``polygon`` is its footprint (its own frame); it brakes straight ahead (backwards for a
-    negative speed) at ``deceleration`` (m/s²). One outline where it stands when it stands
-    still, more (:data:`BRAKING_STEP` apart) along the way when it moves.
+    It brakes straight ahead (backwards for a negative speed) at ``deceleration`` (m/s²): the
+    pose where it stands, and when it moves more along the way, :data:`BRAKING_STEP` apart.
     """
     way = speed * abs(speed) / (2.0 * deceleration)
     steps = math.ceil(abs(way) / BRAKING_STEP)
     cos, sin = math.cos(pose.theta), math.sin(pose.theta)
-    return [outline_at(polygon, Pose2D(pose.x + cos * way * k / steps,
-                                       pose.y + sin * way * k / steps, pose.theta))
-            for k in range(steps + 1)] if steps else [outline_at(polygon, pose)]
+    return [pose] + [Pose2D(pose.x + cos * way * k / steps, pose.y + sin * way * k / steps,
+                            pose.theta) for k in range(1, steps + 1)]
+
+
+def placed(points: np.ndarray, poses: list[Pose2D]) -> np.ndarray:
+    """``points`` (N x 2, in the robot's frame) placed at each of ``poses``: (len(poses) N, 2)."""
+    theta = np.array([pose.theta for pose in poses])[:, None]
+    x = np.array([pose.x for pose in poses])[:, None]
+    y = np.array([pose.y for pose in poses])[:, None]
+    cos, sin = np.cos(theta), np.sin(theta)
+    px, py = points[:, 0][None, :], points[:, 1][None, :]
+    return np.column_stack([(x + cos * px - sin * py).ravel(), (y + sin * px + cos * py).ravel()])

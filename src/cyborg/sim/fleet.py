@@ -36,7 +36,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import braking_outlines
+from cyborg.sim.bodies import braking_poses, outline_points, placed
 from cyborg.sim.loop import PacedLoop, SimulationLock
 from cyborg.sim.simulator import SimSettings, Simulator
 from cyborg.sim.start import START_MARGIN, StartChoice, choose_start
@@ -118,7 +118,8 @@ class Fleet:
                            for choice, charge in zip(starts, charges, strict=True)]
         self.start_choices = starts
         self._steps = 0
-        self._ways: list[tuple[np.ndarray, ...]] = [() for _ in self.simulators]
+        self._samples = [outline_points(sim.base.footprint.polygon())
+                         for sim in self.simulators]  # each body's outline, its own frame
 
     @property
     def map(self) -> ArnlMap:
@@ -138,35 +139,31 @@ class Fleet:
     def step(self) -> None:
         """Advance every robot one physics step, each meeting the others where they are now.
 
-        Each meets them again at every step; at a sensor step it also learns where they would
-        come to a stop (:func:`~cyborg.sim.bodies.braking_outlines`), which it keeps clear of.
+        At each sensor step a robot also learns the points along the others' outlines and
+        their braking ways (:mod:`cyborg.sim.bodies`), which its navigator keeps clear of.
         """
         sensing = self._steps % self.steps_per_sensor == 0  # as each simulator counts
         self._steps += 1
-        outlines = [sim.outline for sim in self.simulators]
+        outlines = [sim.outline for sim in self.simulators]  # set_pose may have moved one
         for index, sim in enumerate(self.simulators):
             near = self._near(index)
+            points = None
             if sensing:
-                self._ways[index] = tuple(way for other in near if other.base.speed
-                                          for way in _braking(other))
-            sim.meet(tuple(outlines[self.simulators.index(other)] for other in near),
-                     self._ways[index])
+                placed_points = [placed(self._samples[other], braking_poses(
+                    self.simulators[other].pose, self.simulators[other].base.speed,
+                    self.simulators[other].base.limits.acceleration)) for other in near]
+                points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
+            sim.meet(tuple(outlines[other] for other in near), points)
             sim.step()
-            outlines[index] = sim.outline
+            outlines[index] = sim.outline  # where the next robot meets it
 
-    def _near(self, index: int) -> list[Simulator]:
-        """The robots on ``index``'s map within its laser's reach."""
+    def _near(self, index: int) -> list[int]:
+        """The indices of the robots on ``index``'s map within its laser's reach."""
         sim = self.simulators[index]
         pose, reach = sim.pose, sim.laser.spec.range_max + 1.0
-        return [other for other in self.simulators
+        return [number for number, other in enumerate(self.simulators)
                 if other is not sim and other.map is sim.map
                 and np.hypot(other.pose.x - pose.x, other.pose.y - pose.y) <= reach]
-
-
-def _braking(sim: Simulator) -> list[np.ndarray]:
-    base = sim.base
-    return braking_outlines(base.footprint.polygon(), base.pose, base.speed,
-                            base.limits.acceleration)
 
 
 class FleetRobotLoop:

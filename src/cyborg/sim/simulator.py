@@ -35,7 +35,7 @@ from cyborg.nav.geometry import Pose2D, normalize_angle
 from cyborg.nav.grid import MapGrid
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import outline_at, outline_points
+from cyborg.sim.bodies import outline_at
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
 from cyborg.sim.manual import limit_command, placement_problem
@@ -107,7 +107,7 @@ class Simulator:
         self._teleop: tuple[float, float] | None = None
         self._target: Target | None = None
         self.others: tuple[np.ndarray, ...] = ()
-        self._ways: tuple[np.ndarray, ...] = ()
+        self._points = np.zeros((0, 2))
         warm_up()  # the motion check's kernel, before the robot moves
         self.load_map(arnl_map, start, planner)
 
@@ -169,16 +169,16 @@ class Simulator:
         """The robot's outline where it stands: its footprint's corners in the map (K x 2, m)."""
         return outline_at(self.base.footprint.polygon(), self.base.pose)
 
-    def meet(self, others: tuple[np.ndarray, ...], ways: tuple[np.ndarray, ...] = ()) -> None:
+    def meet(self, others: tuple[np.ndarray, ...], points: np.ndarray | None = None) -> None:
         """The other robots near this one, as their outlines (K x 2 map coordinates each).
 
-        Until the next call they are obstacles: to the laser, the drive, the navigator and the
-        motion check; ``ways``, the outlines they would cover braking from where they are now
-        (:func:`~cyborg.sim.bodies.braking_outlines`), are obstacles to the last two. Empty
-        tuples leave the robot alone on its map.
+        Until the next call they are obstacles to the laser and the drive, and ``points`` (N x
+        2, m: along their outlines and their braking ways, :mod:`~cyborg.sim.bodies`) are
+        obstacles to the navigator and the motion check. No others: the robot is alone.
         """
         self.others = self.base.others = others
-        self._ways = ways
+        if points is not None:
+            self._points = points
 
     @property
     def current_goal(self) -> Target | None:
@@ -352,10 +352,7 @@ class Simulator:
 
     def _obstacles(self) -> np.ndarray:
         """What the robot knows is in its way: the laser's returns and the other robots."""
-        if not self.others:
-            return self.hits
-        bodies = self.others + self._ways
-        return np.concatenate([self.hits, *(outline_points(other) for other in bodies)])
+        return np.concatenate([self.hits, self._points]) if len(self._points) else self.hits
 
     def _drive_by_hand(self, wanted: tuple[float, float]) -> tuple[float, float]:
         """The hand-given command, or a gentler one if it would touch a wall or a return."""
