@@ -4,6 +4,7 @@ own tree runner, one monitor for all of them; a clear error for a count that can
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -12,6 +13,7 @@ from cyborg.app.errors import CommandError
 from cyborg.app.launch import Launch
 from cyborg.app.up import up_description
 from cyborg.bus import BusConfig, Context
+from cyborg.bus.component import LaunchError
 from cyborg.bus.wire import EntityKind
 from cyborg.runner.component import RunningTree
 from cyborg.sim.component import RunningFleet
@@ -63,6 +65,20 @@ def test_a_count_that_cannot_be_is_a_clear_error(words: list[str], said: str) ->
     with pytest.raises(CommandError) as raised:
         up_description(build_parser().parse_args(["up", *words]))
     assert str(raised.value) == said
+
+
+def test_more_robots_than_the_map_has_room_for_is_a_clear_error(shared: Path) -> None:
+    args = build_parser().parse_args(["up", "--robots", "14", "--map",
+                                      str(shared / "maps" / "AMROffice.map"), "--no-monitor",
+                                      "--no-detector"])
+    with Context(BusConfig.isolated()) as context:
+        launch = Launch(up_description(args), context)
+        with pytest.raises(LaunchError) as raised:
+            launch.start()
+    assert str(raised.value) == (
+        f"simulator (--robots): robots: {shared / 'maps' / 'AMROffice.map'} has room for 12 "
+        "robots (1.5 m apart, off goals and docks, where the first can drive), not 14")
+    assert launch.running == [], "nothing was left running"
 
 
 @pytest.mark.heavy

@@ -10,7 +10,15 @@ import pytest
 
 from cyborg.nav.footprint import PIONEER_LX
 from cyborg.nav.geometry import Pose2D
-from cyborg.sim.bodies import cast_onto, nearest_gap, outline_at, outline_points, polygon_gap
+from cyborg.sim.bodies import (
+    braking_poses,
+    cast_onto,
+    nearest_gap,
+    outline_at,
+    outline_points,
+    placed,
+    polygon_gap,
+)
 from cyborg.sim.robot import RobotBase
 
 SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
@@ -66,3 +74,19 @@ def test_the_drive_stops_short_of_another_robot() -> None:
     assert base.robots_gap(base.pose) < 0.05, "it stopped against the other robot"
     base.command(-0.3, 0.0, 0.02)  # backing off is allowed
     assert base.pose.x < 4.0 and not base.collides(base.pose)
+
+
+def test_a_moving_robot_covers_its_braking_way() -> None:
+    """Standing: where it is; at 1 m/s braking at 0.5 m/s²: the metre ahead, 0.25 m apart."""
+    assert braking_poses(Pose2D(1.0, 2.0, 0.5), 0.0, 0.5) == [Pose2D(1.0, 2.0, 0.5)]
+    ahead = braking_poses(Pose2D(0.0, 0.0, math.pi / 2), 1.0, 0.5)
+    assert [(round(p.x, 9), round(p.y, 9)) for p in ahead] == [
+        (0.0, 0.0), (0.0, 0.25), (0.0, 0.5), (0.0, 0.75), (0.0, 1.0)]
+    backwards = braking_poses(Pose2D(0.0, 0.0, 0.0), -0.5, 0.5)
+    assert backwards[-1].x == pytest.approx(-0.25) and len(backwards) == 2
+
+
+def test_points_placed_at_several_poses() -> None:
+    points = np.array([[1.0, 0.0], [0.0, 1.0]])
+    found = placed(points, [Pose2D(0.0, 0.0, 0.0), Pose2D(5.0, 5.0, math.pi / 2)])
+    assert np.allclose(found, [[1.0, 0.0], [0.0, 1.0], [5.0, 6.0], [4.0, 5.0]])

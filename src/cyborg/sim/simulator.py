@@ -15,10 +15,7 @@ By hand, :meth:`Simulator.teleop` drives at a given speed and turn rate (within 
 :mod:`cyborg.sim.manual`, and never into what the robot knows: the command passes the motion
 check of :mod:`cyborg.sim.motion_check`) until :meth:`Simulator.end_teleop`, and
 :meth:`Simulator.set_pose` puts the robot somewhere else at once. Both end any goal.
-
-Other robots on the same map (:mod:`cyborg.sim.fleet`) are given as their outlines
-(:meth:`Simulator.meet`): the laser sees them, the drive cannot pass through them, and the
-navigator and the motion check take them as obstacles, as they take the laser's returns.
+Other robots on the map (:mod:`cyborg.sim.fleet`) are obstacles to it (:meth:`Simulator.meet`).
 """
 
 from __future__ import annotations
@@ -170,11 +167,11 @@ class Simulator:
         return outline_at(self.base.footprint.polygon(), self.base.pose)
 
     def meet(self, others: tuple[np.ndarray, ...], points: np.ndarray | None = None) -> None:
-        """The other robots near this one, as their outlines (K x 2 map coordinates each).
+        """The other robots near this one: their outlines (K x 2 map coordinates each).
 
-        Until the next call they are obstacles to the laser and the drive, and ``points`` (N x
-        2, m: along their outlines and their braking ways, :mod:`~cyborg.sim.bodies`) are
-        obstacles to the navigator and the motion check. No others: the robot is alone.
+        Until the next call the laser sees them and the drive cannot pass through them; the
+        navigator and the motion check keep clear of ``points`` (N x 2, m: along their outlines
+        and braking ways, :mod:`~cyborg.sim.bodies`; None keeps the last). No others: alone.
         """
         self.others = self.base.others = others
         if points is not None:
