@@ -55,17 +55,17 @@ export function onRobotSelected(listener) {
   return () => listeners.delete(listener);
 }
 
-// Learns the robots and their trees from the monitor's `robots` message; a message without
-// `map_robots` changes nothing.
+// Learns the robots and their trees from the monitor's `robots` message: the robots it lists
+// now (one it no longer follows is forgotten, its colour kept). A message without `map_robots`
+// changes nothing.
 export function learnRobots(message) {
   if (!message || !Array.isArray(message.map_robots)) return;
-  const fresh = [];
+  robots.clear();
   for (const entry of message.map_robots) {
     if (!entry || typeof entry.ns !== "string") continue;
-    if (!robots.has(entry.ns)) fresh.push(entry.ns);
     robots.set(entry.ns, { ns: entry.ns, tree: typeof entry.tree === "string" ? entry.tree : null, alive: entry.alive !== false });
   }
-  for (const ns of fresh.sort()) colourOf(ns);
+  for (const ns of [...robots.keys()].sort()) colourOf(ns);
 }
 
 // The robots the page knows of, sorted by namespace: [{ns, tree, alive}].
