@@ -13,6 +13,7 @@ from cyborg.nav.geometry import Pose2D
 from cyborg.sim.bodies import (
     braking_poses,
     cast_onto,
+    grown,
     nearest_gap,
     outline_at,
     outline_points,
@@ -90,3 +91,14 @@ def test_points_placed_at_several_poses() -> None:
     points = np.array([[1.0, 0.0], [0.0, 1.0]])
     found = placed(points, [Pose2D(0.0, 0.0, 0.0), Pose2D(5.0, 5.0, math.pi / 2)])
     assert np.allclose(found, [[1.0, 0.0], [0.0, 1.0], [5.0, 6.0], [4.0, 5.0]])
+
+
+def test_an_outline_grown_by_a_margin_keeps_its_shape() -> None:
+    assert np.allclose(grown(SQUARE, 0.1), SQUARE * 1.2), "a square 1.2 m wide"
+    body = PIONEER_LX.polygon()
+    around = grown(body, 0.1)
+    assert np.abs(around).max(axis=0) == pytest.approx([0.42, 0.34])
+    # a body 0.1 m ahead of another's front touches the other's grown outline
+    ahead = outline_at(body, Pose2D(5.0 + 0.32 + 0.1 + 0.32, 0.0, 0.0))
+    assert polygon_gap(outline_at(around, Pose2D(5.0, 0.0, 0.0)), ahead) == pytest.approx(
+        0.0, abs=1e-9)

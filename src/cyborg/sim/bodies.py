@@ -122,6 +122,28 @@ def cast_onto(outline: np.ndarray, x: float, y: float, angles: np.ndarray,
                 ranges[beam] = along
 
 
+KEEP_CLEAR = 0.1
+"""Metres a robot's navigator and motion check keep from another robot's outline.
+
+They hold the robot's own body as three circles (:meth:`~cyborg.nav.footprint.Footprint.
+circles`), which leave its cut corners out by up to 6 cm: kept this much further off,
+those corners do not touch the other robot either."""
+
+
+def grown(polygon: np.ndarray, margin: float) -> np.ndarray:
+    """The convex ``polygon`` with every edge moved ``margin`` m outwards.
+
+    ``polygon`` is K x 2 corners, counter-clockwise; the new corners are mitred.
+    """
+    following = np.roll(polygon, -1, axis=0) - polygon
+    normals = np.column_stack([following[:, 1], -following[:, 0]])
+    normals /= np.maximum(np.hypot(normals[:, 0], normals[:, 1]), 1e-12)[:, None]
+    before = np.roll(normals, 1, axis=0)  # the normal of the edge ending at each corner
+    mitre = (normals + before) / (1.0 + np.sum(normals * before, axis=1))[:, None]
+    result: np.ndarray = polygon + margin * mitre
+    return result
+
+
 def outline_points(outline: np.ndarray, spacing: float = OUTLINE_SPACING) -> np.ndarray:
     """Points along ``outline``'s edges, at most ``spacing`` apart: (N, 2) map coordinates."""
     pieces = []

@@ -36,7 +36,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import braking_poses, outline_points, placed
+from cyborg.sim.bodies import KEEP_CLEAR, braking_poses, grown, outline_points, placed
 from cyborg.sim.loop import PacedLoop, SimulationLock
 from cyborg.sim.simulator import SimSettings, Simulator
 from cyborg.sim.start import START_MARGIN, StartChoice, choose_start
@@ -118,8 +118,8 @@ class Fleet:
                            for choice, charge in zip(starts, charges, strict=True)]
         self.start_choices = starts
         self._steps = 0
-        self._samples = [outline_points(sim.base.footprint.polygon())
-                         for sim in self.simulators]  # each body's outline, its own frame
+        self._samples = [outline_points(grown(sim.base.footprint.polygon(), KEEP_CLEAR))
+                         for sim in self.simulators]  # around each body, in its own frame
 
     @property
     def map(self) -> ArnlMap:
