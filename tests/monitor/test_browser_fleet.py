@@ -96,6 +96,21 @@ def _canvas_origin(page: Page) -> tuple[float, float]:
     return box["x"], box["y"]
 
 
+def _zoom_on(page: Page, ns: str) -> tuple[float, float]:
+    """Zooms the map in about the robot ``ns``; where it is on the canvas then."""
+    page.click("#map-fit")
+    at = _robot(page, ns)["pose"]
+    sx, sy = on_map(page, f"m.toScreen({at['x']}, {at['y']})")
+    left, top = _canvas_origin(page)
+    page.mouse.move(left + round(sx), top + round(sy))
+    while on_map(page, "m.view().scale") < 60:
+        page.mouse.wheel(0, -300)
+        page.wait_for_timeout(50)
+    page.wait_for_timeout(200)  # drawn at that scale
+    found: tuple[float, float] = tuple(on_map(page, f"m.toScreen({at['x']}, {at['y']})"))
+    return found
+
+
 def test_three_robots_each_in_its_colour_selected_from_the_list_or_the_map(
         browser: Browser) -> None:
     with fleet_system() as fleet:
@@ -117,14 +132,15 @@ def test_three_robots_each_in_its_colour_selected_from_the_list_or_the_map(
             [f"{ns}/bt", ns, colour] for ns, colour in zip(ROBOTS, colours, strict=True)]
         assert all(option[3].startswith(f"● {ns} — ") for option, ns in zip(options, ROBOTS,
                                                                             strict=True))
-        # still, each robot is drawn in its colour where the page has it
+        # still, each robot is drawn in its colour where the page has it (zoomed in on it, so
+        # that a neighbour queueing close by, or its name, does not cover it)
         with fleet.simulator.loop.lock:
             page.wait_for_timeout(400)  # the last poses are on screen
-            for ns, colour in zip(ROBOTS, colours, strict=True):
-                at = _robot(page, ns)["pose"]
-                sx, sy = on_map(page, f"m.toScreen({at['x']}, {at['y']})")
-                assert pixel(page, sx, sy) == [*rgb(colour), 255], ns
             screenshot(page, "fleet_map")
+            for ns, colour in zip(ROBOTS, colours, strict=True):
+                sx, sy = _zoom_on(page, ns)
+                assert pixel(page, sx, sy) == [*rgb(colour), 255], ns
+            page.click("#map-fit")
         # choosing robot2 in the list: its tree is shown (Pause reaches its runner), the map
         # follows it, the swatch takes its colour
         page.check("#map-follow")
