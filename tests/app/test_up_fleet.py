@@ -11,7 +11,7 @@ import pytest
 from cyborg.app.cli import build_parser
 from cyborg.app.errors import CommandError
 from cyborg.app.launch import Launch
-from cyborg.app.up import up_description
+from cyborg.app.up import FLEET_BATTERY_STEP, up_description, up_notes
 from cyborg.bus import BusConfig, Context
 from cyborg.bus.component import LaunchError
 from cyborg.bus.wire import EntityKind
@@ -34,11 +34,18 @@ def test_three_robots_are_one_fleet_three_tree_runners_and_one_monitor() -> None
     kinds = _description("--robots", "3", "--no-detector")
     [(_, fleet_namespace, fleet)] = kinds["simulator"]
     assert fleet_namespace == "/" and fleet["robots"] == 3, "one simulator, three robots"
+    assert fleet["battery_step"] == FLEET_BATTERY_STEP, "they take turns at the charger"
     runners = [(namespace, parameters["robot_namespace"])
                for _, namespace, parameters in kinds["tree_runner"]]
     assert runners == [(f"{robot}/bt", robot) for robot in ROBOTS]
     [(_, _, monitor)] = kinds["monitor"]
     assert monitor["trees"] == [f"{robot}/bt" for robot in ROBOTS]
+
+
+def test_the_first_lines_say_how_full_each_robot_starts() -> None:
+    notes = up_notes(build_parser().parse_args(["up", "--robots", "4", "--battery", "60"]))
+    assert notes[1] == ("robots       4 (--robots), each with its tree; batteries at 60, 78, "
+                        "96, 100 %, so they take turns at the charger")
 
 
 def test_one_robot_is_as_before() -> None:
@@ -101,6 +108,8 @@ def test_cyborg_up_with_three_robots_drives_each_with_its_own_tree() -> None:
             sims = fleet.fleet.simulators
             with fleet.loop.lock:
                 starts = [sim.pose for sim in sims]
+                charges = [sim.battery.charge_percent for sim in sims]
+            assert charges == pytest.approx([33.0, 51.0, 69.0], abs=0.5), "each next one fuller"
 
             def all_moved() -> bool:
                 with fleet.loop.lock:

@@ -10,8 +10,9 @@ sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``-
 ``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. ``--robots N`` simulates
 N robots on the map (:mod:`cyborg.sim.fleet`), ``/robot1`` … ``/robotN``, each with its own
 tree runner (``/robot1/bt`` …) on the same tree; one monitor shows them all, and the camera and
-detector serve the first. It prints what runs
-and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
+detector serve the first. Each next robot's battery starts :data:`FLEET_BATTERY_STEP` % fuller
+(``--battery`` is the first's), so that they take turns at the map's one charger. It prints
+what runs and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
 
 The defaults are chosen to *show* the mission, not to mimic a day of it: the battery drains
 about 9 % an hour and charging to 90 % takes two hours, so at real time from a full battery the
@@ -57,6 +58,9 @@ DEFAULT_SPEED = 30.0
 """Simulated seconds per wall-clock second: a patrol round in ~6 s, a full charge in ~4 min."""
 DEFAULT_BATTERY = 33.0
 """Start charge, percent: about 20 simulated minutes of patrol above the threshold."""
+FLEET_BATTERY_STEP = 18.0
+"""Percent each next robot of several starts fuller: two hours of patrol (9 % an hour), as long
+as a recharge takes, so the robots take turns at the map's charger instead of queueing."""
 
 
 def add_parser(commands: Any) -> None:
@@ -124,6 +128,7 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
         robot["start"] = args.start
     if args.robots > 1:
         robot["robots"] = args.robots
+        robot["battery_step"] = FLEET_BATTERY_STEP
     nodes = [] if args.no_monitor else [
         # first: a taken port stops the launch before the robot moves
         NodeSpec("monitor", monitor.NAME, fleet,
@@ -151,8 +156,10 @@ def up_notes(args: argparse.Namespace) -> list[str]:
     pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
     lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
     if args.robots > 1:
-        lines.append(f"robots       {args.robots} (--robots), each with its tree, sharing the "
-                     "map's dock")
+        charges = ", ".join(f"{min(args.battery + k * FLEET_BATTERY_STEP, 100.0):g}"
+                            for k in range(args.robots))
+        lines.append(f"robots       {args.robots} (--robots), each with its tree; batteries at "
+                     f"{charges} %, so they take turns at the charger")
     if (args.map, args.tree, args.speed, args.battery) == (None, None, DEFAULT_SPEED,
                                                            DEFAULT_BATTERY):
         lines += [f"             the patrol goes to recharge below {CAMPUS_THRESHOLD:g} % "

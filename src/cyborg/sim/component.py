@@ -14,6 +14,8 @@ parameter      meaning (default)
                0: as fast as possible); settable while it runs
 ``battery``    the charge at the start, percent (:data:`BATTERY`, full; read-only)
 ``robots``     how many robots (:data:`ROBOTS`, 1; read-only); see below
+``battery_``   with several robots: percent each next robot's battery starts fuller than
+``step``       the one before (up to full; 0: all alike; read-only)
 =============  ========================================================================
 
 With ``robots`` N > 1 it simulates a fleet on the map (:mod:`cyborg.sim.fleet`): one loop, one
@@ -107,6 +109,7 @@ class _Settings(NamedTuple):
     start: str
     speed: float
     charge: float
+    step: float
 
 
 def _declare(node: Node, spec: NodeSpec) -> _Settings:
@@ -119,9 +122,12 @@ def _declare(node: Node, spec: NodeSpec) -> _Settings:
     speed = params.declare("speed", SPEED, "simulated seconds per second (0: flat out)")
     charge = params.declare("battery", BATTERY, "battery charge at the start, percent",
                             read_only=True, limits=(0.0, 100.0))
+    step = 0.0
     if "robots" in spec.parameters:
         params.declare("robots", ROBOTS, "how many robots", read_only=True)
-    return _Settings(spec.path(str(map_value)), str(start), float(speed), float(charge))
+        step = float(params.declare("battery_step", 0.0, "percent each next robot's battery "
+                                    "starts fuller", read_only=True, limits=(0.0, 100.0)))
+    return _Settings(spec.path(str(map_value)), str(start), float(speed), float(charge), step)
 
 
 def _pace(node: Node, loop: PacedLoop[Any]) -> None:
@@ -168,7 +174,8 @@ def _start_fleet(context: Context, spec: NodeSpec, count: int) -> RunningFleet:
         settings = [_declare(node, spec) for node in nodes][-1]  # the same for each
         try:
             fleet = Fleet(read_map(settings.map_path), count, settings.start or None,
-                          charges=[settings.charge] * count)
+                          charges=[min(settings.charge + index * settings.step, 100.0)
+                                   for index in range(count)])
         except (MapError, KeyError, ValueError) as exc:
             raise spec.error(str(exc).strip("\"'")) from exc
         loop = PacedLoop(fleet, settings.speed)
