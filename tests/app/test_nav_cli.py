@@ -51,3 +51,25 @@ def test_cyborg_sim_runs_for_a_simulated_duration(shared: Path, tmp_path: Path) 
         capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "AMROffice.map at full speed, namespace /cyborg, router at" in done.stdout
+
+
+@pytest.mark.heavy
+def test_cyborg_sim_runs_several_robots(shared: Path) -> None:
+    import socket
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    done = subprocess.run(
+        [sys.executable, "-m", "cyborg", "sim", "--map", str(shared / "maps" / "AMROffice.map"),
+         "--speed", "0", "--duration", "10", "--robots", "3", "--namespace", "/",
+         "--listen", f"tcp/127.0.0.1:{port}"],
+        capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert ("AMROffice.map at full speed, 3 robots under /robot1, /robot2, /robot3, router at"
+            in done.stdout)
+    refused = subprocess.run(
+        [sys.executable, "-m", "cyborg", "sim", "--map", str(shared / "maps" / "AMROffice.map"),
+         "--robots", "17", "--listen", f"tcp/127.0.0.1:{port}"],
+        capture_output=True, text=True, timeout=120)
+    assert refused.returncode != 0
+    assert "parameter `robots` must be a whole number from 1 to 16, not 17" in refused.stderr

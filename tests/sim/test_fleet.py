@@ -21,8 +21,10 @@ from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim import component
 from cyborg.sim.bodies import polygon_gap
-from cyborg.sim.fleet import START_SPACING, Fleet, choose_starts
+from cyborg.sim.fleet import START_SPACING, Fleet, choose_starts, robot_loops
+from cyborg.sim.loop import PacedLoop
 from cyborg.sim.manual import placement_problem
+from cyborg.sim.simulator import Simulator
 from tests.running_system import wait_until
 from tests.small_maps import room_map
 
@@ -66,6 +68,30 @@ def test_a_robot_sees_another_on_its_laser() -> None:
     assert looking.ranges[ahead] == pytest.approx(3.5 - 0.24 - 1.0 - mount, abs=0.03)
     # alone, the beam leaves through the door at (5, 3) and ends on the far wall at x = 10
     assert alone[ahead] == pytest.approx(10.0 - 1.0 - mount, abs=0.03)
+
+
+def test_each_robot_hears_its_own_sensor_steps_and_one_that_stops_leaves_the_others_be() -> None:
+    fleet = Fleet(parse_map(room_map([])), 2, start=Pose2D(1.0, 3.0, 0.0))
+    loop = PacedLoop(fleet, speed=0)
+    shares = robot_loops(loop)
+    heard: list[list[Simulator]] = [[], []]
+    for share, seen in zip(shares, heard, strict=True):
+        share.on_sensor.append(seen.append)
+    loop.start()
+    try:
+        wait_until(lambda: len(heard[0]) > 3 and len(heard[1]) > 3, 30, "sensor steps")
+        assert {id(sim) for sim in heard[0]} == {id(fleet.simulators[0])}
+        assert {id(sim) for sim in heard[1]} == {id(fleet.simulators[1])}
+        assert shares[0].lock is shares[1].lock is loop.lock, "one lock for the fleet"
+        shares[0].stop()  # its node went
+        with loop.lock:
+            stopped_at = len(heard[0])
+            going_on = len(heard[1])
+        wait_until(lambda: len(heard[1]) > going_on + 3, 30, "the other robot's steps")
+        assert len(heard[0]) == stopped_at and not shares[0].running and shares[1].running
+    finally:
+        loop.stop()
+    assert not shares[1].running and shares[1].error is None
 
 
 @pytest.mark.heavy

@@ -23,6 +23,7 @@ from typing import Any
 from cyborg.app.bus_options import DEFAULT_ROUTER, bus_context
 from cyborg.app.errors import CommandError
 from cyborg.bus.component import LaunchError, NodeSpec
+from cyborg.interfaces.robot import fleet_namespaces
 from cyborg.nav.arnl_map import ArnlMap, MapError, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
@@ -143,8 +144,11 @@ def sim_command(args: argparse.Namespace) -> int:
         try:
             loop = running.loop
             pace = "full speed" if args.speed == 0 else f"{args.speed:g}x real time"
-            print(f"cyborg sim: {loop.simulator.map.source} at {pace}, namespace "
-                  f"{args.namespace}, {where}; Ctrl-C stops", flush=True)
+            robots = (f"namespace {args.namespace}" if args.robots == 1 else
+                      f"{args.robots} robots under "
+                      f"{', '.join(fleet_namespaces(args.namespace, args.robots))}")
+            print(f"cyborg sim: {loop.simulator.map.source} at {pace}, {robots}, {where}; "
+                  "Ctrl-C stops", flush=True)
             while loop.running:
                 if args.duration is not None and loop.simulator.time >= args.duration:
                     break
