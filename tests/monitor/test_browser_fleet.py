@@ -4,7 +4,8 @@ runner per robot and the monitor. All three are on the map, each in its own colo
 name and its laser mounted through its own frames; the robot selector shows each robot's
 swatch in the map's colour, switches the tree shown (the page's Pause reaches that robot's
 runner) and the robot the map follows; a click on a robot on the map selects it; and the page
-goes on across a restart of the fleet. Screenshots: fleet_map.png, fleet_restarted.png."""
+goes on across a restart of the fleet. Screenshots: fleet_map.png, fleet_robot2_followed.png,
+fleet_restarted.png."""
 
 from __future__ import annotations
 
@@ -156,6 +157,7 @@ def test_three_robots_each_in_its_colour_selected_from_the_list_or_the_map(
         page.wait_for_function(
             "(() => { const v = window.__map.view(), p = window.__map.robot('/robot2').pose; "
             "return Math.hypot(v.cx - p.x, v.cy - p.y) < 0.05; })()", timeout=10000)
+        screenshot(page, "fleet_robot2_followed")
         # a click on robot3 on the map selects it, and shows its tree
         left, top = _canvas_origin(page)
         page.uncheck("#map-follow")
