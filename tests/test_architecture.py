@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 SOURCE = Path(__file__).resolve().parents[1] / "src" / "cyborg"
-INDEPENDENT = ("bt", "bus")
+INDEPENDENT = ("access", "bt", "bus")
 """Packages that import nothing of cyborg but themselves."""
 
 
@@ -44,17 +44,22 @@ ALLOWED = {"interfaces": ("cyborg.interfaces", "cyborg.bus"),
            "runner": ("cyborg.runner", "cyborg.robot.interface", "cyborg.bt", "cyborg.bus",
                       "cyborg.interfaces"),
            "monitor": ("cyborg.monitor", "cyborg.bus", "cyborg.bt.dot", "cyborg.bt.status",
-                       "cyborg.bt.json_text", "cyborg.interfaces"),
+                       "cyborg.bt.json_text", "cyborg.interfaces", "cyborg.access"),
            "vision": ("cyborg.vision", "cyborg.bus", "cyborg.interfaces"),
-           "record": ("cyborg.record", "cyborg.bus", "cyborg.interfaces")}
+           "record": ("cyborg.record", "cyborg.bus", "cyborg.interfaces"),
+           "foxglove": ("cyborg.foxglove", "cyborg.bus", "cyborg.interfaces", "cyborg.nav",
+                        "cyborg.bt.status", "cyborg.access")}
 """The contracts (topic, service and action names, types, constants) build only on the bus, so
 that both sides of each can import them; navigation may use the bus (its services); the
 simulator builds on navigation and the bus; the robot's nodes glue the engine to the bus, with
 navigation's pose types (not its planner); the monitor watches trees over the bus and borrows
 only the engine's DOT writer, statuses and JSON-text checks; vision publishes and subscribes on
 the bus and knows nothing of trees or navigation; the recorder takes any topic's raw bytes
-from the bus and names the contracts' topics only to describe the run. All but the contracts
-use the contracts."""
+from the bus and names the contracts' topics only to describe the run; the Foxglove server
+relays the bus, drawing robots' maps with navigation's grid and naming tick statuses as the
+engine does. The monitor and the Foxglove server share the access rules of
+``cyborg.access``, which imports nothing else of cyborg. All but the contracts use the
+contracts."""
 
 
 @pytest.mark.parametrize("package", sorted(ALLOWED))
