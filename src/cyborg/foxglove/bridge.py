@@ -47,6 +47,7 @@ class Bridge:
         self._thread = threading.Thread(target=self._follow, daemon=True,
                                         name="cyborg-foxglove-bridge")
         self._warned: set[str] = set()
+        self._offered: dict[str, tuple[object, ...]] = {}  # topic -> what its relay came from
         self._version = -1
 
     def start(self) -> None:
@@ -60,6 +61,7 @@ class Bridge:
         if self._thread.is_alive():
             self._thread.join(5)
         self.relays.remove_all()
+        self._offered.clear()
 
     def update(self) -> None:
         """Advertise, withdraw and replace channels so they match the bus now."""
@@ -67,15 +69,14 @@ class Bridge:
         self._version = graph.version
         wanted = wanted_channels(graph.entities([EntityKind.PUBLISHER]), self.node.types,
                                  self._warned)
-        current = self.relays.topics()
-        for topic, relay in current.items():
+        for topic, key in list(self._offered.items()):
             offer = wanted.get(topic)
-            if offer is None or offer.key != relay.key:
+            if offer is None or offer.key != key:
                 log.info("%s: withdrawn from Foxglove", topic)
                 self.relays.remove(topic)
-        current = self.relays.topics()
+                del self._offered[topic]
         for topic, offer in wanted.items():
-            if topic in current:
+            if topic in self._offered:
                 continue
             try:
                 relay = self._make(topic, offer)
@@ -83,6 +84,7 @@ class Bridge:
                 log.exception("%s: cannot offer it to Foxglove", topic)
                 continue
             self.relays.add(relay)
+            self._offered[topic] = offer.key
             log.info("%s: offered to Foxglove", topic)
 
     def _make(self, topic: str, offer: Offer) -> Relay:

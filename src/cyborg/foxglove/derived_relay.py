@@ -35,7 +35,7 @@ class DerivedRelay(Relay):
 
     def __init__(self, topic: str, node: Node, namespace: str, sources: tuple[Topic[Any], ...],
                  thread: CallbackThread) -> None:
-        super().__init__(topic, (type(self).__name__, namespace))
+        super().__init__(topic)
         self.node, self.namespace, self.sources, self.thread = node, namespace, sources, thread
         self.written = 0
         """Messages written to the channel so far."""

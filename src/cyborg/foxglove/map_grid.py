@@ -49,7 +49,7 @@ def grid_resolution(map_resolution: float, width: float, height: float) -> float
         if math.isfinite(map_resolution) else COARSEST
     while (width / resolution + 2) * (height / resolution + 2) > MAX_CELLS:
         resolution *= 2
-    return resolution
+    return float(np.float32(resolution))  # as the message carries it, so readers' cells agree
 
 
 def occupancy_grid(message: MapGeometry) -> OccupancyGrid:

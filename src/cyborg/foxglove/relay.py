@@ -38,17 +38,14 @@ class Channel(Protocol):
 class Relay(ABC):
     """One Foxglove channel, fed from the bus while at least one client watches it.
 
-    Subclasses make :attr:`channel` and implement :meth:`open` and :meth:`close`; ``key`` says
-    what the relay was made from, so that a relay whose source changed (a topic's type) is
-    replaced rather than kept.
+    Subclasses make :attr:`channel` and implement :meth:`open` and :meth:`close`.
     """
 
     channel: Channel
 
-    def __init__(self, topic: str, key: tuple[Any, ...]) -> None:
+    def __init__(self, topic: str) -> None:
         self.topic = topic
         """The channel's topic, as Foxglove shows it."""
-        self.key = key
 
     @property
     def channel_id(self) -> int:
@@ -85,6 +82,7 @@ class Relays(ServerListener):
         self._by_topic: dict[str, Relay] = {}
         self._by_channel: dict[int, Relay] = {}
         self._watchers: dict[int, set[int]] = {}
+        self._early: dict[int, set[int]] = {}  # subscriptions to channels not added yet
 
     def topics(self) -> dict[str, Relay]:
         """The relays now, by topic."""
@@ -92,12 +90,19 @@ class Relays(ServerListener):
             return dict(self._by_topic)
 
     def add(self, relay: Relay) -> None:
-        """Offer ``relay``'s channel; one already offered on the topic is removed first."""
+        """Offer ``relay``'s channel; one already offered on the topic is removed first.
+
+        A client may subscribe as soon as the channel exists, before it is added here: such
+        subscriptions were kept aside and open the relay now.
+        """
         self.remove(relay.topic)
         with self._lock:
             self._by_topic[relay.topic] = relay
             self._by_channel[relay.channel_id] = relay
-            self._watchers[relay.channel_id] = set()
+            watchers = self._early.pop(relay.channel_id, set())
+            self._watchers[relay.channel_id] = watchers
+            if watchers:
+                _guarded(relay.open, relay.topic, "subscribe")
 
     def remove(self, topic: str) -> None:
         """Withdraw the relay on ``topic``, if any: unsubscribe on the bus, unadvertise."""
@@ -126,6 +131,7 @@ class Relays(ServerListener):
         with self._lock:
             relay = self._by_channel.get(channel.id)
             if relay is None:
+                self._early.setdefault(channel.id, set()).add(client.id)
                 return
             watchers = self._watchers[channel.id]
             first = not watchers
@@ -135,6 +141,7 @@ class Relays(ServerListener):
     def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
         """A client unsubscribed (or left): the last one closes the relay."""
         with self._lock:
+            self._early.get(channel.id, set()).discard(client.id)
             relay = self._by_channel.get(channel.id)
             watchers = self._watchers.get(channel.id)
             if relay is None or watchers is None or client.id not in watchers:

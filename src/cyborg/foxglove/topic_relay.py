@@ -34,7 +34,7 @@ class TopicRelay(Relay):
 
     def __init__(self, node: Node, topic: str, type_name: str, *, latched: bool,
                  context: foxglove.Context) -> None:
-        super().__init__(topic, ("topic", type_name, latched))
+        super().__init__(topic)
         self.node, self.type_name, self.latched = node, type_name, latched
         self.channel: foxglove.Channel = foxglove.Channel(
             topic, schema=ros2msg_schema(node.types, type_name), message_encoding=CDR,

@@ -13,7 +13,8 @@ For each tree runner on the bus (found by its structure topic,
 ``nodes`` lists every node of the structure in pre-order, with the status it returned in this
 tick (``ticked``) or, if it did not run, the one it returned last (``idle``: never yet);
 ``title`` is the title as the editor shows it (placeholders filled in). ``time`` is the tick's
-clock time in seconds (simulated time under ``use_sim_time``). It decodes the runner's
+clock time in seconds (simulated time under ``use_sim_time``); ``duration_ms`` the tick's wall
+time, null when the runner did not time it. It decodes the runner's
 ``behavior_tree`` structure and ``status`` messages as the contracts give them
 (:mod:`cyborg.interfaces.tree_runner`); ticks of a structure it does not know yet are skipped.
 """
@@ -21,6 +22,7 @@ clock time in seconds (simulated time under ``use_sim_time``). It decodes the ru
 from __future__ import annotations
 
 import json
+import math
 from typing import Any
 
 import foxglove
@@ -49,7 +51,7 @@ TICK_SCHEMA: dict[str, Any] = {
         "tree_id": {"type": "string"}, "title": {"type": "string"},
         "source": {"type": "string"}, "runner": {"type": "string"},
         "tick": {"type": "integer"}, "time": {"type": "number"},
-        "duration_ms": {"type": "number"}, "status": _NODE["properties"]["status"],
+        "duration_ms": {"type": ["number", "null"]}, "status": _NODE["properties"]["status"],
         "nodes": {"type": "array", "items": _NODE},
         "active": {"type": "array", "items": {"type": "string"}}},
     "required": ["tree_id", "title", "tick", "time", "status", "nodes"]}
@@ -126,10 +128,10 @@ class TreeTickRelay(DerivedRelay):
             if index is not None:
                 self._last[index] = status_label(int(code))
                 ticked[index] = True
-        stamp = message.stamp
+        stamp, duration = message.stamp, float(message.duration)
         return {**(self._header or {}), "runner": self.namespace, "tick": int(message.tick),
                 "time": stamp.sec + stamp.nanosec * 1e-9,
-                "duration_ms": float(message.duration) * 1000.0,
+                "duration_ms": duration * 1000.0 if math.isfinite(duration) else None,
                 "status": status_label(int(message.status)),
                 "nodes": [{**node, "status": status, "ticked": fresh} for node, status, fresh
                           in zip(self._nodes, self._last, ticked, strict=True)],
