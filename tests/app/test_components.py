@@ -36,6 +36,7 @@ from tests.builders import N, project_json, tree_json
 COMPONENT_MODULES = {"simulator": "cyborg.sim.component",
                      "tree_runner": "cyborg.runner.component",
                      "monitor": "cyborg.monitor.component",
+                     "foxglove": "cyborg.foxglove.component",
                      "camera": "cyborg.vision.component",
                      "detector": "cyborg.vision.component",
                      "recorder": "cyborg.record.component"}

@@ -3,6 +3,7 @@
     cyborg up                      the simulated robot, navigation, the patrol tree, the monitor
     cyborg launch FILE             start the nodes a TOML/YAML launch file lists
     cyborg monitor                 the web monitor of running trees (http://127.0.0.1:8080/)
+    cyborg foxglove                the bus served to the Foxglove app (ws://127.0.0.1:8765)
     cyborg bt validate FILE        report every problem in a behavior3editor export
     cyborg bt run FILE             tick a tree with a live status line
     cyborg bt dot FILE             the tree as a Graphviz DOT graph
@@ -36,6 +37,7 @@ from cyborg.app import (
     bt_commands,
     bus_commands,
     detect_commands,
+    foxglove_commands,
     monitor_commands,
     param_commands,
     record_commands,
@@ -57,6 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     up.add_parser(commands)
     monitor_commands.add_parser(commands)
+    foxglove_commands.add_parser(commands)
     runner_commands.add_parsers(bt_commands.add_parser(commands))
     bus_commands.add_parser(commands)
     record_commands.add_parser(commands)

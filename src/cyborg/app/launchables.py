@@ -10,6 +10,7 @@ kind             start function (and its parameters)
 ``tree_runner``  :func:`cyborg.runner.component.start`, with the robot on the bus
                  (:class:`~cyborg.robot.settling_robot.SettlingBusRobot`)
 ``monitor``      :func:`cyborg.monitor.component.start`
+``foxglove``     :func:`cyborg.foxglove.component.start`
 ``camera``       :func:`cyborg.vision.component.start_camera`
 ``detector``     :func:`cyborg.vision.component.start_detector`
 ``recorder``     :func:`cyborg.record.component.start`
@@ -25,6 +26,7 @@ import importlib
 from functools import partial
 
 from cyborg.bus.component import NodeSpec, Starter
+from cyborg.foxglove import component as foxglove
 from cyborg.monitor import component as monitor
 from cyborg.record import component as recorder
 from cyborg.robot.settling_robot import SettlingBusRobot
@@ -36,6 +38,7 @@ KINDS: dict[str, Starter] = {
     "simulator": sim.start,
     "tree_runner": partial(runner.start, robot=SettlingBusRobot),  # app wires the robot in
     "monitor": monitor.start,
+    "foxglove": foxglove.start,
     "camera": vision.start_camera,
     "detector": vision.start_detector,
     "recorder": recorder.start,

@@ -5,7 +5,8 @@ the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn b
 ARNL format) with its navigation services, the tree runner with the bundled
 patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
 time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``; this machine only unless
-``--monitor-host 0.0.0.0``, see docs/security.md), and a camera playing
+``--monitor-host 0.0.0.0``, see docs/security.md), with ``--foxglove`` a Foxglove server
+(ws://127.0.0.1:8765, :mod:`cyborg.app.foxglove_commands`), and a camera playing
 sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
 ``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. ``--robots N`` simulates
 N robots on the map (:mod:`cyborg.sim.fleet`), ``/robot1`` … ``/robotN``, each with its own
@@ -35,11 +36,13 @@ from typing import Any
 from cyborg.app.access_options import access_parameters, add_access_options
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.errors import CommandError
+from cyborg.app.foxglove_commands import foxglove_parameters
 from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_robot
 from cyborg.app.system import run_system
 from cyborg.app.up_record import add_record_options, record_nodes
 from cyborg.app.up_vision import add_vision_options, vision_nodes
 from cyborg.bus.component import LaunchError, NodeSpec
+from cyborg.foxglove import component as foxglove
 from cyborg.interfaces.robot import fleet_namespaces
 from cyborg.monitor import component as monitor
 from cyborg.runner import component as runner
@@ -94,6 +97,10 @@ def add_parser(commands: Any) -> None:
                     help=f"address the web monitor listens on (default {monitor.HOST}: this "
                          "machine only; 0.0.0.0: every interface)")
     up.add_argument("--no-monitor", action="store_true", help="do not start the web monitor")
+    up.add_argument("--foxglove", type=int, nargs="?", const=foxglove.PORT, default=None,
+                    metavar="PORT", help="also serve the bus to the Foxglove app on this "
+                    f"machine (ws://127.0.0.1:PORT, default {foxglove.PORT}; see `cyborg "
+                    "foxglove`)")
     add_access_options(up)
     add_vision_options(up)
     add_record_options(up)
@@ -135,6 +142,10 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
                  {"trees": trees, "port": args.monitor_port,
                   "host": args.monitor_host, **access_parameters(args)},
                  where="monitor (--monitor-port)")]
+    if args.foxglove is not None:  # early too: a taken port stops the launch
+        nodes.append(NodeSpec("foxglove", foxglove.NAME, fleet,
+                              foxglove_parameters(args, args.foxglove, foxglove.HOST),
+                              where="foxglove (--foxglove)"))
     nodes.append(NodeSpec("simulator", sim.NAME, fleet, robot,
                           where="simulator (--robots)" if args.robots > 1 else "simulator"))
     nodes += [NodeSpec("tree_runner", runner.NAME, tree_namespace,
