@@ -107,3 +107,10 @@ def test_cyborg_up_with_foxglove_serves_the_robot_map_and_tree() -> None:
         _out, err = process.communicate(timeout=60)
     assert process.returncode == 130, err
     assert "Traceback" not in err
+
+
+def test_a_port_that_is_not_one_is_refused_naming_it() -> None:
+    with Context(BusConfig.isolated()) as context, pytest.raises(
+            LaunchError, match=re.escape("here: port 70000: expected 0 (any free port) to 65535")):
+        foxglove.start(context, NodeSpec("foxglove", "fox", "/", {"port": 70000},
+                                         where="here"))

@@ -87,9 +87,12 @@ def start(context: Context, spec: NodeSpec) -> RunningFoxglove:
                                spec.path(str(token_file)) if token_file else None)
         except TokenError as exc:
             raise spec.error(str(exc)) from None
-        server = FoxgloveServer(node, host=str(host), port=int(port), token=token,
-                                allow_hosts=[str(name) for name in allow_hosts if name],
-                                allow_origins=[str(name) for name in allow_origins if name])
+        try:
+            server = FoxgloveServer(node, host=str(host), port=int(port), token=token,
+                                    allow_hosts=[str(name) for name in allow_hosts if name],
+                                    allow_origins=[str(name) for name in allow_origins if name])
+        except ValueError as exc:
+            raise spec.error(str(exc)) from None
         try:
             server.start()
         except FoxgloveError as exc:

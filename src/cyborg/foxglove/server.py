@@ -35,6 +35,8 @@ DEFAULT_PORT = 8765
 """The Foxglove WebSocket protocol's usual port (foxglove_bridge's too)."""
 DEFAULT_HOST = "127.0.0.1"
 """This machine only, unless told otherwise."""
+MAX_PORT = 65535
+"""The highest TCP port."""
 
 
 class FoxgloveError(RuntimeError):
@@ -47,12 +49,14 @@ class FoxgloveServer:
     ``token`` (default: ``$CYBORG_MONITOR_TOKEN``) lets other machines in, and is required to
     listen beyond loopback; ``allow_hosts`` adds names the server answers to and
     ``allow_origins`` web pages that may connect from this machine without the token (see
-    :mod:`cyborg.foxglove.admission`).
+    :mod:`cyborg.foxglove.admission`). ValueError for a port that is not one.
     """
 
     def __init__(self, node: Node, *, host: str = DEFAULT_HOST, port: int = DEFAULT_PORT,
                  token: str | None = None, allow_hosts: list[str] | tuple[str, ...] = (),
                  allow_origins: list[str] | tuple[str, ...] = (), poll: float = POLL) -> None:
+        if not 0 <= port <= MAX_PORT:
+            raise ValueError(f"port {port}: expected 0 (any free port) to {MAX_PORT}")
         self.node, self.host, self.requested_port = node, host, port
         self.token = read_token(token)
         self.admission = Admission(HostPolicy(allow_hosts, server="Foxglove server"),
