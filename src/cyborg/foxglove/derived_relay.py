@@ -25,6 +25,9 @@ from cyborg.interfaces.contract import Topic
 
 log = logging.getLogger("cyborg.foxglove")
 
+SAID_REASONS = 100
+"""Distinct reasons for skipping a message that a relay logs; later ones are skipped quietly."""
+
 
 class DerivedRelay(Relay):
     """A relay fed by ``sources`` (contract topics under ``namespace``) through ``node``.
@@ -74,7 +77,7 @@ class DerivedRelay(Relay):
         try:
             result = self.convert(source, message)
         except ValueError as exc:
-            if str(exc) not in self._refused:
+            if str(exc) not in self._refused and len(self._refused) < SAID_REASONS:
                 self._refused.add(str(exc))
                 log.warning("%s: %s skipped: %s", self.topic, source.full_name(self.namespace),
                             exc)
