@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
 
 import foxglove
 
-from cyborg.bus import Node, Qos, Subscription
-from cyborg.bus.wire import Attachment
+from cyborg.bus import Node, Qos
+from cyborg.bus.raw import RawMessage, RawSubscription
 from cyborg.foxglove.relay import Relay
 from cyborg.foxglove.schemas import CDR, ros2msg_schema
 
@@ -42,7 +41,7 @@ class TopicRelay(Relay):
         self.forwarded = 0
         """Messages passed to Foxglove so far."""
         self._lock = threading.Lock()
-        self._subscription: Subscription[Any] | None = None
+        self._subscription: RawSubscription | None = None
         self._kept: dict[bytes, bytes] = {}  # publisher GID -> its last latched message
 
     def open(self) -> None:
@@ -51,8 +50,8 @@ class TopicRelay(Relay):
             if self._subscription is not None:
                 return
             qos = Qos.latched(LATCHED_DEPTH) if self.latched else Qos(depth=DEPTH)
-            self._subscription = self.node.create_subscription(
-                self.topic, self.type_name, self._on_message, qos, with_info=True, raw=True)
+            self._subscription = self.node.create_raw_subscription(
+                self.topic, self.type_name, self._on_message, qos)
 
     def close(self) -> None:
         """Leave the bus and forget the kept messages."""
@@ -69,7 +68,8 @@ class TopicRelay(Relay):
         for data in kept:
             self.channel.log(data, log_time=time.time_ns())
 
-    def _on_message(self, data: bytes, info: Attachment | None) -> None:
+    def _on_message(self, message: RawMessage) -> None:
+        data, info = message.data, message.info
         if self.latched:
             with self._lock:
                 if self._subscription is None:
