@@ -15,6 +15,7 @@ import pytest
 
 from cyborg.bt import load_tree
 from cyborg.bt.clock import ManualClock
+from cyborg.bt.outline import StructureError
 from cyborg.bus import Node
 from cyborg.monitor.client import QUEUE_LIMIT
 from cyborg.monitor.export import (
@@ -24,7 +25,7 @@ from cyborg.monitor.export import (
     render,
     view_dot,
 )
-from cyborg.monitor.tree_state import FRESH, StructureError, TreeState
+from cyborg.monitor.tree_state import FRESH, TreeState
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.builders import N, tree_from
 from tests.monitor.monitor_protocol import (

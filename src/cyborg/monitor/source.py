@@ -21,13 +21,14 @@ import logging
 from collections.abc import Callable
 from typing import Any
 
+from cyborg.bt.outline import StructureError
 from cyborg.bt.status import Status
 from cyborg.bus import Node, Qos, Subscription, new_message
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import tree_runner
 from cyborg.interfaces.contract import Service
 from cyborg.interfaces.tree_runner import HookAction, HookStatus
-from cyborg.monitor.tree_state import StructureError, TreeState, status_name
+from cyborg.monitor.tree_state import TreeState, status_name
 
 log = logging.getLogger("cyborg.monitor")
 

@@ -21,7 +21,6 @@ server reads it).
 
 from __future__ import annotations
 
-import json
 import threading
 from collections import deque
 from dataclasses import dataclass
@@ -30,6 +29,7 @@ from typing import Any
 import numpy as np
 import xxhash
 
+from cyborg.bt.outline import StructureOutline
 from cyborg.bt.status import Status
 
 FRESH = 8
@@ -45,10 +45,6 @@ def status_name(code: int) -> str:
         return Status(code).label
     except ValueError:
         return "?"
-
-
-class StructureError(ValueError):
-    """A ``behavior_tree`` message that is not a tree structure; the message says why."""
 
 
 @dataclass(frozen=True)
@@ -74,21 +70,16 @@ class TreeState:
     """One version of a running tree's structure plus everything seen since it arrived."""
 
     def __init__(self, text: str, *, history: int = HISTORY_TICKS) -> None:
-        try:
-            structure = json.loads(text)
-            root = structure["root"]
-        except (ValueError, TypeError, KeyError) as exc:
-            raise StructureError(f"not a tree structure: {exc}") from None
+        outline = StructureOutline.parse(text)
         self.text = text
-        self.structure: dict[str, Any] = structure
+        self.structure: dict[str, Any] = outline.structure
         self.version = xxhash.xxh64_hexdigest(text.encode())
         """Identifies the structure: same text, same version."""
-        self.ids: list[str] = []
-        self.parents: list[int] = []
-        self.labels: list[str] = []
+        self.ids = outline.ids
+        self.parents = outline.parents
+        self.labels = outline.labels
         """Each node's label (its title with the properties filled in), else its name."""
-        self._index_nodes(root, -1)
-        self.index_of = {uid: index for index, uid in enumerate(self.ids)}
+        self.index_of = outline.index_of
         count = len(self.ids)
         self._lock = threading.Lock()
         self.status = np.zeros(count, np.uint8)
@@ -113,21 +104,6 @@ class TreeState:
         self._header_seen = -1  # the tick the last frame reported
         self.ticks_seen = 0
         self.history: deque[TickEntry] = deque(maxlen=history)
-
-    def _index_nodes(self, node: dict[str, Any], parent: int) -> None:
-        stack = [(node, parent)]
-        while stack:
-            current, parent_index = stack.pop()
-            try:
-                uid = str(current["id"])
-                children = current.get("children", [])
-            except (TypeError, KeyError) as exc:
-                raise StructureError(f"node {len(self.ids)} has no {exc}") from None
-            self.ids.append(uid)
-            self.parents.append(parent_index)
-            self.labels.append(str(current.get("label") or current.get("name") or uid))
-            index = len(self.ids) - 1
-            stack.extend((child, index) for child in reversed(children))
 
     def __len__(self) -> int:
         return len(self.ids)
