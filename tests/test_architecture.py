@@ -49,16 +49,20 @@ ALLOWED = {"interfaces": ("cyborg.interfaces", "cyborg.bus"),
            "vision": ("cyborg.vision", "cyborg.bus", "cyborg.interfaces"),
            "record": ("cyborg.record", "cyborg.bus", "cyborg.interfaces"),
            "foxglove": ("cyborg.foxglove", "cyborg.bus", "cyborg.interfaces", "cyborg.nav",
-                        "cyborg.bt.status", "cyborg.access")}
+                        "cyborg.bt.status", "cyborg.access"),
+           "report": ("cyborg.report", "cyborg.record", "cyborg.bus", "cyborg.interfaces",
+                      "cyborg.bt.status", "cyborg.bt.outline")}
 """The contracts (topic, service and action names, types, constants) build only on the bus, so
 that both sides of each can import them; navigation may use the bus (its services); the
 simulator builds on navigation and the bus; the robot's nodes glue the engine to the bus, with
 navigation's pose types (not its planner); the monitor watches trees over the bus and borrows
 only the engine's DOT writer, statuses and JSON-text checks; vision publishes and subscribes on
 the bus and knows nothing of trees or navigation; the recorder takes any topic's raw bytes
-from the bus and names the contracts' topics only to describe the run; the Foxglove server
-relays the bus, drawing robots' maps with navigation's grid and naming tick statuses as the
-engine does. The monitor and the Foxglove server share the access rules of
+from the bus and names the contracts' topics only to describe the run; the run report reads
+recordings (the recorder's scan and metadata names), decodes them with the bus's types, finds
+the robots by the contracts and borrows only the engine's statuses and structure outline; the
+Foxglove server relays the bus, drawing robots' maps with navigation's grid and naming tick
+statuses as the engine does. The monitor and the Foxglove server share the access rules of
 ``cyborg.access``, which imports nothing else of cyborg. All but the contracts use the
 contracts."""
 
