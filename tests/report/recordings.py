@@ -224,10 +224,10 @@ def mission(path: Path, namespace: str = "/cyborg", *, writer: RecordingWriter |
         out.add(f"{ns}/current_goal", goal(""), began + 20.001)
         done.reached += outcome == "REACHED_GOAL"
         done.failed += outcome != "REACHED_GOAL"
-    for second, labels in ((10.0, ("person", "person")), (30.0, ("chair",)),
-                           (70.0, ("person",)), (130.0, ("chair", "chair", "person"))):
-        out.add(f"{ns}/detector/detections", detections(*labels), second)
-        out.add(f"{ns}/detector/predictions", predictions(*labels), second)
+    for seen_at, labels in ((10.0, ("person", "person")), (30.0, ("chair",)),
+                            (70.0, ("person",)), (130.0, ("chair", "chair", "person"))):
+        out.add(f"{ns}/detector/detections", detections(*labels), seen_at)
+        out.add(f"{ns}/detector/predictions", predictions(*labels), seen_at)
     out.add(f"{ns}/bumper_state", BumperState(header=header(), front_bumpers=np.array([True]),
                                               rear_bumpers=np.array([False])), 50.0)
     if rosout:
