@@ -1,13 +1,18 @@
-"""Who may open and control the web monitor, from the command line.
+"""Who may open and control cyborg's servers, from the command line.
 
-For ``cyborg monitor`` and ``cyborg up``: the names the page answers to and the token that lets
-other machines control. See docs/security.md.
+For ``cyborg monitor``, ``cyborg foxglove`` and ``cyborg up``: the names the server answers to
+and the token that lets other machines in. See docs/security.md.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
+
+TOKEN_IN_PS = ("cyborg: warning: --token shows in `ps` to every user of this machine; prefer "
+               "--token-file PATH or CYBORG_MONITOR_TOKEN")
+"""The warning ``--token`` gets."""
 
 
 def add_access_options(parser: argparse.ArgumentParser) -> None:
@@ -29,3 +34,20 @@ def access_parameters(args: argparse.Namespace) -> dict[str, Any]:
     if args.token_file:
         parameters["token_file"] = str(args.token_file)
     return parameters
+
+
+def add_token_option(parser: argparse.ArgumentParser) -> None:
+    """``--token``, for the commands that start one server (not ``cyborg up``)."""
+    parser.add_argument("--token", default=None,
+                        help="the token itself (shows in `ps`: prefer --token-file or "
+                             "$CYBORG_MONITOR_TOKEN)")
+
+
+def add_token(args: argparse.Namespace, parameters: dict[str, Any]) -> None:
+    """Puts ``--token`` into ``parameters``, warning that it shows in ``ps``.
+
+    It is passed on in memory only: the servers never make it a bus parameter.
+    """
+    if args.token:
+        print(TOKEN_IN_PS, file=sys.stderr)
+        parameters["token"] = args.token

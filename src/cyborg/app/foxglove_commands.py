@@ -18,13 +18,16 @@ PATH`` or ``CYBORG_MONITOR_TOKEN``): clients on other machines connect as
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
-from cyborg.app.access_options import access_parameters, add_access_options
+from cyborg.app.access_options import (
+    access_parameters,
+    add_access_options,
+    add_token,
+    add_token_option,
+)
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.launch import LaunchDescription
-from cyborg.app.monitor_commands import TOKEN_IN_PS
 from cyborg.app.system import run_system
 from cyborg.bus.component import NodeSpec
 from cyborg.foxglove import component as foxglove
@@ -45,9 +48,7 @@ def add_parser(commands: Any) -> None:
                         help="a web page that may connect from this machine without the token, "
                              "beside the Foxglove app (repeatable; *: any)")
     add_access_options(parser)
-    parser.add_argument("--token", default=None,
-                        help="the token itself (shows in `ps`: prefer --token-file or "
-                             "$CYBORG_MONITOR_TOKEN)")
+    add_token_option(parser)
     add_bus_options(parser)
     parser.set_defaults(handler=foxglove_command)
 
@@ -67,9 +68,7 @@ def foxglove_description(args: argparse.Namespace) -> LaunchDescription:
     that it shows in ``ps``.
     """
     parameters = foxglove_parameters(args, args.port, args.host)
-    if args.token:
-        print(TOKEN_IN_PS, file=sys.stderr)
-        parameters["token"] = args.token
+    add_token(args, parameters)
     return LaunchDescription(
         [NodeSpec("foxglove", foxglove.NAME, foxglove.NAMESPACE, parameters,
                   where="cyborg foxglove")],

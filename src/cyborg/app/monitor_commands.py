@@ -19,19 +19,19 @@ DNS rebinding). Tree runners that start later are found on the bus. See docs/sec
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
-from cyborg.app.access_options import access_parameters, add_access_options
+from cyborg.app.access_options import (
+    access_parameters,
+    add_access_options,
+    add_token,
+    add_token_option,
+)
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.launch import LaunchDescription
 from cyborg.app.system import run_system
 from cyborg.bus.component import NodeSpec
 from cyborg.monitor import component as monitor
-
-TOKEN_IN_PS = ("cyborg: warning: --token shows in `ps` to every user of this machine; prefer "
-               "--token-file PATH or CYBORG_MONITOR_TOKEN")
-"""The warning ``--token`` gets."""
 
 
 def add_parser(commands: Any) -> None:
@@ -49,9 +49,7 @@ def add_parser(commands: Any) -> None:
                         help="tree runner namespace to follow (repeatable; default "
                              f"{', '.join(monitor.TREES)}); others on the bus are offered too")
     add_access_options(parser)
-    parser.add_argument("--token", default=None,
-                        help="the token itself (shows in `ps`: prefer --token-file or "
-                             "$CYBORG_MONITOR_TOKEN)")
+    add_token_option(parser)
     add_bus_options(parser)
     parser.set_defaults(handler=monitor_command)
 
@@ -66,9 +64,7 @@ def monitor_description(args: argparse.Namespace) -> LaunchDescription:
         or list(monitor.TREES)
     parameters: dict[str, Any] = {"trees": namespaces, "port": args.port, "host": args.host,
                                   **access_parameters(args)}
-    if args.token:
-        print(TOKEN_IN_PS, file=sys.stderr)
-        parameters["token"] = args.token
+    add_token(args, parameters)
     return LaunchDescription(
         [NodeSpec("monitor", monitor.NAME, monitor.NAMESPACE, parameters,
                   where="cyborg monitor")],
