@@ -69,7 +69,7 @@ export class MapPanel {
     });
     // acting on the robot: always the robot of the shown tree (selected())
     this.actions = new MapActions(root, { send, robot: () => this.actingRobot(), onChange: () => this.schedule() });
-    this.tools = new MapTools(this.canvas, { view: this.view, actions: this.actions, markerAt: (sx, sy, px) => this.markerAt(sx, sy, px), schedule: () => this.schedule() });
+    this.tools = new MapTools(this.canvas, { view: this.view, actions: this.actions, markerAt: (sx, sy, px) => this.markerAt(sx, sy, px), robotAt: (sx, sy) => robotAt(this.model.robots.values(), this.view, sx, sy), schedule: () => this.schedule() });
     this.driver = new Driver(root, { actions: this.actions, post });
     const panel = this; // for the getters below
     this.stats = window.__map = {
@@ -89,9 +89,9 @@ export class MapPanel {
       selected: () => this.selected(),
     };
     // a click on a robot selects it (js/robots.js): its tree is shown, the actions go to it;
-    // not while a tool is chosen or when the click sends the robot to a marker
+    // not while a tool is chosen
     pickOnClick(this.canvas, {
-      robotAt: (sx, sy) => (this.tools.ownsClick(sx, sy) ? null : robotAt(this.model.robots.values(), this.view, sx, sy)),
+      robotAt: (sx, sy) => (this.tools.ownsClick() ? null : robotAt(this.model.robots.values(), this.view, sx, sy)),
       onPick: (ns) => selectRobot(ns, "map"),
     });
     onRobotSelected(() => this.schedule());

@@ -22,12 +22,14 @@ const ONE_SHOT = new Set(["pose", "set"]);
 export class MapTools {
   // `canvas`: the map's upper canvas; `view`: its ViewTransform; `actions`: MapActions;
   // `markerAt(sx, sy)`: the named goal, dock or home under a screen point, or null;
-  // `schedule()`: draw a frame.
-  constructor(canvas, { view, actions, markerAt, schedule }) {
+  // `robotAt(sx, sy)`: the robot under it, or null (a click on a robot selects it, even on a
+  // marker: it never sends one); `schedule()`: draw a frame.
+  constructor(canvas, { view, actions, markerAt, robotAt, schedule }) {
     this.canvas = canvas;
     this.view = view;
     this.actions = actions;
     this.markerAt = markerAt;
+    this.robotAt = robotAt;
     this.schedule = schedule;
     this.mode = null; // "pose", "set", "tour" or null (pan)
     this.drag = null; // {id, start: [x, y] m, end: [x, y] m, sx, sy}
@@ -105,15 +107,21 @@ export class MapTools {
     if (event.buttons === 0) this.hover(sx, sy);
   }
 
-  // Whether a click at (sx, sy) is the tools' own: a tool is chosen, or the click would send the
-  // robot to a marker. Such a click never selects another robot (the command goes to the one
-  // selected when it was given).
-  ownsClick(sx, sy) {
-    return this.mode !== null || (this.actions.canAct && this.markerAt(sx, sy, HIT_PX) !== null);
+  // Whether a click is the tools' own: a tool is chosen. Such a click never selects another
+  // robot (the pose goes to the robot selected when it was given).
+  ownsClick() {
+    return this.mode !== null;
+  }
+
+  // The marker a click at (sx, sy) would send the robot to, or null: none under it, or a robot
+  // stands there (the click selects that robot instead).
+  clickedMarker(sx, sy) {
+    const marker = this.markerAt(sx, sy, HIT_PX);
+    return marker && this.robotAt(sx, sy) === null ? marker : null;
   }
 
   hover(sx, sy) {
-    const marker = this.markerAt(sx, sy, HIT_PX);
+    const marker = this.clickedMarker(sx, sy);
     const ns = this.actions.robot();
     let title = "";
     if (marker) {
@@ -142,7 +150,7 @@ export class MapTools {
     const press = this.press;
     this.press = null;
     if (!press || press.id !== event.pointerId || performance.now() - press.at > CLICK_MS) return;
-    const marker = this.markerAt(sx, sy, HIT_PX);
+    const marker = this.clickedMarker(sx, sy);
     if (!marker || !this.actions.canAct) return;
     if (marker.home) this.actions.act({ t: "home" }, "home");
     else this.actions.go(marker.name);
