@@ -140,6 +140,26 @@ class MessageTypes:
         for name in definitions:
             self._use_static_class(name)
 
+    def add_definition(self, type_name: str, text: str) -> list[str]:
+        """Register a message type from its ``ros2msg`` text; the names it added.
+
+        ``text`` is what a recording's schema holds: the type's ``.msg`` text, then each type
+        it uses after a line of ``=`` and ``MSG: pkg/Type``. Types the bus already knows keep
+        their own definitions (a recording's copy of ``std_msgs/Header`` changes nothing).
+        Raises ValueError saying what cannot be read.
+        """
+        try:
+            definitions = get_types_from_msg(text, type_name)
+        except Exception as exc:  # rosbags raises its own parse errors
+            raise ValueError(f"{type_name}: its definition cannot be read ({exc})") from None
+        new = {name: value for name, value in definitions.items() if name not in self}
+        try:
+            self.store.register(new)
+        except Exception as exc:
+            raise ValueError(f"{type_name}: its definition cannot be registered ({exc})"
+                             ) from None
+        return sorted(new)
+
     def _use_static_class(self, type_name: str) -> None:
         """Put the class generated for ``type_name`` in place of the one rosbags just made.
 

@@ -33,7 +33,7 @@ from cyborg.bus.context import Context
 from cyborg.bus.executor import CallbackThread
 from cyborg.bus.message_types import MessageTypes
 from cyborg.bus.parameters import Parameters
-from cyborg.bus.raw import RawMessage, RawSubscription
+from cyborg.bus.raw import RawMessage, RawPublisher, RawSubscription
 from cyborg.bus.services import Responder, ServiceClient, ServiceServer
 from cyborg.bus.topics import Publisher, Subscription
 from cyborg.bus.typed import ActionType, ServiceType
@@ -175,6 +175,15 @@ class Node:
         ``type_name`` (a known type) makes the key, ``qos`` as for :meth:`create_subscription`.
         """
         return self._keep(RawSubscription, topic, type_name, callback, qos or Qos(depth=10))
+
+    def create_raw_publisher(self, topic: str, type_name: str,
+                             qos: Qos | None = None) -> RawPublisher:
+        """A publisher of CDR bytes as they are (``publish_raw``), for players.
+
+        See :mod:`cyborg.bus.raw`; ``type_name`` (a known type) makes the key, ``qos`` as for
+        :meth:`create_publisher`.
+        """
+        return self._keep(RawPublisher, topic, type_name, qos or Qos(depth=10))
 
     # ------------------------------------------------------------------ services
     @overload

@@ -1,4 +1,4 @@
-"""Raw subscriptions: a topic's messages as the CDR bytes they travel in, never decoded.
+"""Raw endpoints: a topic's messages as the CDR bytes they travel in, never decoded again.
 
 A recorder wants what went over the wire, not Python objects: ``ros2 bag`` stores the
 serialized message as it arrived, and so does ``cyborg record``. A :class:`RawSubscription`
@@ -16,6 +16,14 @@ callback a :class:`RawMessage`:
 message, before it waited in the queue; ``info`` is the sample's attachment (publisher GID,
 sequence number and the publisher's own timestamp), or None for a sample sent without one.
 Create one with :meth:`cyborg.bus.node.Node.create_raw_subscription`.
+
+A player wants the reverse: to send what a recording holds as it was recorded. A
+:class:`RawPublisher` is a :class:`~cyborg.bus.topics.Publisher` (same keys, token, QoS,
+latching, shared memory) whose :meth:`RawPublisher.publish_raw` takes CDR bytes (with their
+encapsulation header) and sends them to other processes as they are. Subscriptions of this
+process, which take messages, get the bytes decoded once (so does a latched publisher's
+history, which later subscriptions of this process are handed). Create one with
+:meth:`cyborg.bus.node.Node.create_raw_publisher`.
 """
 
 from __future__ import annotations
@@ -23,7 +31,7 @@ from __future__ import annotations
 import time
 from typing import Any, NamedTuple
 
-from cyborg.bus.topics import Subscription
+from cyborg.bus.topics import Publisher, Subscription
 from cyborg.bus.wire import Attachment
 
 
@@ -75,3 +83,32 @@ class RawSubscription(Subscription[RawMessage]):
             raw = RawMessage(message[0], message[1], info)
         self.received += 1
         self.callback(raw)
+
+
+class RawPublisher(Publisher[Any]):
+    """Publishes CDR bytes on a topic as they are; see the module.
+
+    Made by :meth:`~cyborg.bus.node.Node.create_raw_publisher`. The type name must be known to
+    the bus (it makes the key and the token, and decodes for subscriptions of this process).
+    """
+
+    def publish_raw(self, data: bytes) -> None:
+        """Sends ``data`` (CDR with its encapsulation header) to every subscriber.
+
+        Raises RuntimeError once the publisher was destroyed; for a latched publisher or one
+        with subscriptions in this process, whatever decoding ``data`` raises (bytes that are
+        not a message of the type).
+        """
+        local = self.context.local_subscriptions(self.topic)
+        message = (self.context.types.deserialize(data, self.type_name)
+                   if local or self.latched else None)
+        with self._lock:
+            if self._closed:
+                raise RuntimeError(f"publish on {self.topic}: the publisher was destroyed")
+            self._sequence += 1
+            attachment = Attachment(self._sequence, time.time_ns(), self.gid)
+            if self.latched:
+                self.context.latch(self.topic, self, (message, attachment))
+            self._publish_remote(message, data, attachment.encode())
+        for subscription in local:
+            subscription.deliver_local(message, self.type_name, attachment)

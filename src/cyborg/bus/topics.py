@@ -153,20 +153,21 @@ class Publisher(_Endpoint, Generic[MessageT]):
             attachment = Attachment(self._sequence, time.time_ns(), self.gid)
             if self.latched:
                 self.context.latch(self.topic, self, (message, attachment))
-            self._publish_remote(message, attachment.encode())
+            self._publish_remote(message, None, attachment.encode())
         for subscription in self.context.local_subscriptions(self.topic):
             subscription.deliver_local(message, self.type_name, attachment)
 
-    def _publish_remote(self, message: Any, attachment: bytes) -> None:
-        context = self.context
+    def _publish_remote(self, message: Any, data: bytes | None, attachment: bytes) -> None:
+        """Sends to other processes: ``message``, or its CDR ``data`` when already serialised."""
+        context, types = self.context, self.context.types
         readers = () if self.latched else context.shm_readers(self.topic)
         if readers:
-            size = context.types.cdr_size(message, self.type_name)
+            size = types.cdr_size(message, self.type_name) if data is None else len(data)
             if size >= SHM_THRESHOLD:
                 if self._slots is None:
                     self._slots = SlotWriter()
-                ref = self._slots.write(size, lambda view: context.types.serialize_into(
-                    message, self.type_name, view))
+                ref = self._slots.write(size, lambda view: types.serialize_into(
+                    message, self.type_name, view) if data is None else _fill(view, data))
                 if ref is not None:
                     reference, doorbell = ref.encode(), context.doorbell
                     if doorbell is None or not doorbell.ring(readers, attachment, reference):
@@ -174,8 +175,8 @@ class Publisher(_Endpoint, Generic[MessageT]):
                     if self._remote_subscriptions() <= len(readers):
                         return
         if self.latched or self._matching():
-            data = context.types.serialize(message, self.type_name)
-            self._zenoh.put(data.obj, attachment=attachment)
+            payload = types.serialize(message, self.type_name).obj if data is None else data
+            self._zenoh.put(payload, attachment=attachment)
 
     def _remote_subscriptions(self) -> int:
         """Subscriptions of other sessions, counted again only when the graph has changed."""
@@ -416,3 +417,9 @@ class Subscription(_Endpoint, Generic[MessageT]):
 
 
 _UNDECODABLE = object()
+
+
+def _fill(view: memoryview, data: bytes) -> int:
+    """Copies serialised ``data`` into a shared-memory slot; the bytes written."""
+    view[:len(data)] = data
+    return len(data)

@@ -15,6 +15,8 @@ that every client endpoint finds its server.
 * :mod:`~cyborg.interfaces.tree_runner` — the tree runner's topics and services (runner ↔
   monitor, command line);
 * :mod:`~cyborg.interfaces.detector` — the camera's and the detector's topics.
+* :mod:`~cyborg.interfaces.player` — the player's state and its pause, seek and step services
+  (`cyborg play` ↔ a timeline).
 
 **Adding to a contract.** Declare the endpoint in the module of the program that serves it,
 e.g. ``BUMPERS = Topic("bumper_state", BumperState, latched=True)`` with ``BumperState``

@@ -213,7 +213,8 @@ def _keep(result: Scan, opcode: int, content: bytes, offset: int, length: int) -
     return True
 
 
-def _chunk(result: Scan, chunk: Chunk, offset: int, length: int) -> ScannedChunk:
+def decompress(chunk: Chunk) -> bytes:
+    """A chunk's records, decompressed and checked; ValueError for a damaged chunk."""
     if chunk.compression == "zstd":
         data = zstandard.ZstdDecompressor().decompress(
             chunk.data, max_output_size=chunk.uncompressed_size)
@@ -227,6 +228,11 @@ def _chunk(result: Scan, chunk: Chunk, offset: int, length: int) -> ScannedChunk
         raise ValueError(f"{len(data)} bytes uncompressed, {chunk.uncompressed_size} expected")
     if chunk.uncompressed_crc and zlib.crc32(data) != chunk.uncompressed_crc:
         raise ValueError("the CRC of its content does not match")
+    return bytes(data)
+
+
+def _chunk(result: Scan, chunk: Chunk, offset: int, length: int) -> ScannedChunk:
+    data = decompress(chunk)
     index: dict[int, list[tuple[int, int]]] = {}
     position = 0
     staged = Scan(result.path, result.size, channels=dict(result.channels))  # kept once whole

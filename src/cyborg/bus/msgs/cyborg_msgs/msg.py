@@ -151,6 +151,20 @@ class cyborg_msgs__msg__MapObject:
 
 
 @dataclass
+class cyborg_msgs__msg__PlayerState:
+    """Class for cyborg_msgs/msg/PlayerState."""
+
+    position: float
+    duration: float
+    rate: float
+    paused: bool
+    finished: bool
+    recording_time: builtin_interfaces__msg__Time
+    source: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/PlayerState'
+
+
+@dataclass
 class cyborg_msgs__msg__Prediction:
     """Class for cyborg_msgs/msg/Prediction."""
 
@@ -180,5 +194,6 @@ BumperState = cyborg_msgs__msg__BumperState
 GoalWithHeading = cyborg_msgs__msg__GoalWithHeading
 MapGeometry = cyborg_msgs__msg__MapGeometry
 MapObject = cyborg_msgs__msg__MapObject
+PlayerState = cyborg_msgs__msg__PlayerState
 Prediction = cyborg_msgs__msg__Prediction
 Predictions = cyborg_msgs__msg__Predictions

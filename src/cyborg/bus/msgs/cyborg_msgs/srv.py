@@ -252,6 +252,33 @@ class cyborg_msgs__srv__ReloadTree_Response:
 
 
 @dataclass
+class cyborg_msgs__srv__Seek_Event:
+    """Class for cyborg_msgs/srv/Seek_Event."""
+
+    info: service_msgs__msg__ServiceEventInfo
+    request: list[cyborg_msgs__srv__Seek_Request]
+    response: list[cyborg_msgs__srv__Seek_Response]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/Seek_Event'
+
+
+@dataclass
+class cyborg_msgs__srv__Seek_Request:
+    """Class for cyborg_msgs/srv/Seek_Request."""
+
+    position: float
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/Seek_Request'
+
+
+@dataclass
+class cyborg_msgs__srv__Seek_Response:
+    """Class for cyborg_msgs/srv/Seek_Response."""
+
+    success: bool
+    message: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/Seek_Response'
+
+
+@dataclass
 class cyborg_msgs__srv__SetPose_Event:
     """Class for cyborg_msgs/srv/SetPose_Event."""
 
@@ -302,6 +329,9 @@ MakePlan_Response = cyborg_msgs__srv__MakePlan_Response
 ReloadTree_Event = cyborg_msgs__srv__ReloadTree_Event
 ReloadTree_Request = cyborg_msgs__srv__ReloadTree_Request
 ReloadTree_Response = cyborg_msgs__srv__ReloadTree_Response
+Seek_Event = cyborg_msgs__srv__Seek_Event
+Seek_Request = cyborg_msgs__srv__Seek_Request
+Seek_Response = cyborg_msgs__srv__Seek_Response
 SetPose_Event = cyborg_msgs__srv__SetPose_Event
 SetPose_Request = cyborg_msgs__srv__SetPose_Request
 SetPose_Response = cyborg_msgs__srv__SetPose_Response
@@ -352,6 +382,12 @@ ReloadTree = ServiceType(
     "cyborg_msgs/srv/ReloadTree",
     ReloadTree_Request,
     ReloadTree_Response,
+)
+
+Seek = ServiceType(
+    "cyborg_msgs/srv/Seek",
+    Seek_Request,
+    Seek_Response,
 )
 
 SetPose = ServiceType(
