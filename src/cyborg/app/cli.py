@@ -19,6 +19,7 @@
     cyborg sim --map FILE          the simulated robot on an ARNL map, on the bus
     cyborg nav goals|plan FILE     goals of a map; plan a path and print its length
     cyborg record -o FILE          record the bus into an MCAP file (--recover a cut one)
+    cyborg play FILE               play a recording (MCAP, ROS 1 or 2 bag) on the bus again
     cyborg report FILE             an HTML report of a recorded run (tree, path, battery, goals)
     cyborg detect SOURCE           objects and their distance in images, videos, bags, topics
     cyborg detect models list|fetch   known detector models
@@ -41,6 +42,7 @@ from cyborg.app import (
     foxglove_commands,
     monitor_commands,
     param_commands,
+    play_commands,
     record_commands,
     report_commands,
     runner_commands,
@@ -65,6 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
     runner_commands.add_parsers(bt_commands.add_parser(commands))
     bus_commands.add_parser(commands)
     record_commands.add_parser(commands)
+    play_commands.add_parser(commands)
     report_commands.add_parser(commands)
     param_commands.add_parser(commands)
     sim_commands.add_parser(commands)

@@ -153,6 +153,14 @@ class MessageTypes:
         except Exception as exc:  # rosbags raises its own parse errors
             raise ValueError(f"{type_name}: its definition cannot be read ({exc})") from None
         new = {name: value for name, value in definitions.items() if name not in self}
+        for name, (_consts, fields) in new.items():
+            for field_name, (kind, spec) in fields:
+                used = spec if kind == Nodetype.NAME else (
+                    spec[0][1] if kind in (Nodetype.ARRAY, Nodetype.SEQUENCE)
+                    and spec[0][0] == Nodetype.NAME else None)
+                if used is not None and used not in new and used not in self:
+                    raise ValueError(f"{type_name}: field {field_name} of {name} is of type "
+                                     f"{used}, defined nowhere")
         try:
             self.store.register(new)
         except Exception as exc:

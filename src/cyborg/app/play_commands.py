@@ -1,0 +1,165 @@
+"""``cyborg play``: a recording published on the bus again, with its timing and ``/clock``.
+
+    cyborg play run.mcap                          at the recorded pace, then stop
+    cyborg play run.mcap --rate 2 --start 120     twice as fast, from two minutes in
+    cyborg play run.mcap --loop --topics /cyborg/pose /cyborg/map_geometry
+    cyborg play run.mcap --exclude '/cyborg/camera/*'
+    cyborg play robot.bag                         a ROS 1 bag; a ROS 2 bag folder plays too
+
+It joins the bus's router like the other bus commands (``--connect``, ``--wait``). On a
+terminal the space key pauses and resumes and ``s`` plays one message (pausing first); the
+player's services do the same from anywhere (``/player/pause``, ``/player/step``,
+``/player/seek``: :mod:`cyborg.interfaces.player`). A live line on stderr shows the position,
+the length, the rate and whether it is paused. docs/recording.md ("Replay") says what is played
+and how.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Any, TextIO
+
+from cyborg.app.bus_options import open_context
+from cyborg.app.errors import CommandError
+from cyborg.app.keypress import Keys
+from cyborg.app.progress import duration, terminal_width
+from cyborg.bus import Node
+from cyborg.bus.config import DEFAULT_ROUTER
+from cyborg.interfaces import player as contract
+from cyborg.record.playback_source import RecordingError, open_recording
+from cyborg.record.player import Player, topic_filter
+
+POLL = 0.1
+"""Seconds between two looks at the player: the live line's redraw, the end."""
+
+
+def add_parser(commands: Any) -> None:
+    """Adds ``cyborg play`` to the commands."""
+    play = commands.add_parser(
+        "play", help="play a recording (MCAP, ROS 1 or ROS 2 bag) on the bus",
+        description="Publish a recording on the bus with its original timing, its messages' "
+                    "bytes as recorded, /clock from its time and its latched topics latched.")
+    play.add_argument("recording", type=Path, metavar="FILE",
+                      help="an MCAP file (cyborg record's or ros2 bag's), a ROS 1 .bag, or a "
+                           "ROS 2 bag folder")
+    play.add_argument("--rate", type=float, default=1.0,
+                      help="speed: 2 plays twice as fast (default 1)")
+    play.add_argument("--start", type=float, default=0.0, metavar="SECONDS",
+                      help="start this many seconds into the recording (default 0)")
+    play.add_argument("--loop", action="store_true", help="play again from the start, forever")
+    play.add_argument("--topics", nargs="+", default=[], metavar="TOPIC",
+                      help="play only these topics (default: all)")
+    play.add_argument("--exclude", action="append", default=[], metavar="PATTERN",
+                      help="leave out topics matching this glob, e.g. '/cyborg/camera/*' "
+                           "(repeatable)")
+    play.add_argument("--paused", action="store_true",
+                      help="start paused (space or the pause service starts it)")
+    play.add_argument("--namespace", default="/", metavar="NS",
+                      help="namespace of the player's node and services (default /)")
+    play.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                      help=f"router to join (default $CYBORG_CONNECT or {DEFAULT_ROUTER})")
+    play.add_argument("--wait", type=float, default=0.5, metavar="S",
+                      help="seconds to let subscribers find the player's topics before the "
+                           "first message (default 0.5)")
+    play.set_defaults(handler=play_command)
+
+
+def play_command(args: argparse.Namespace) -> int:
+    """``cyborg play``: plays until the end (or Ctrl-C; never ends with ``--loop``)."""
+    if not args.rate > 0:
+        raise CommandError(f"--rate {args.rate}: give a speed above 0")
+    if args.wait < 0:
+        raise CommandError(f"--wait {args.wait}: give 0 seconds or more")
+    context = open_context(args)
+    try:
+        try:
+            recording = open_recording(args.recording, context.types)
+        except RecordingError as exc:
+            raise CommandError(str(exc)) from None
+        try:
+            return _play(args, context, recording, sys.stderr)
+        finally:
+            recording.close()
+    finally:
+        context.close()
+
+
+def _play(args: argparse.Namespace, context: Any, recording: Any, stream: TextIO) -> int:
+    if not 0 <= args.start <= recording.duration:
+        raise CommandError(f"--start {args.start}: the recording is "
+                           f"{recording.duration:.1f} s long")
+    accept = topic_filter(args.topics, args.exclude)
+    unknown = sorted(set(args.topics) - set(recording.topics) - set(recording.skipped))
+    if unknown:
+        raise CommandError(f"--topics: {', '.join(unknown)} not in {args.recording}; it has "
+                           f"{', '.join(sorted(recording.topics)) or 'no playable topics'}")
+    if recording.cut is not None:
+        print(f"cyborg play: {args.recording} was cut ({recording.cut}); playing the "
+              f"{duration(recording.duration)} before it", file=stream)
+    for topic, why in sorted(recording.skipped.items()):
+        print(f"  not played: {topic} ({why})", file=stream)
+    player = Player(Node(contract.NAME, args.namespace, context=context), recording,
+                    rate=args.rate, start=args.start, loop=args.loop, paused=True,
+                    accept=accept)
+    keys = "space pauses, s steps, " if sys.stdin.isatty() else ""
+    print(f"cyborg play: {args.recording}, {duration(recording.duration)}, "
+          f"{len(player.topics)} topics; {keys}Ctrl-C stops", file=stream, flush=True)
+    line = PlayLine(player, stream)
+    try:
+        time.sleep(args.wait)
+        player.set_paused(args.paused)
+        with Keys(sys.stdin, {" ": player.toggle_pause, "s": player.step}) as keys_read:
+            while not player.finished:
+                line.update()
+                keys_read.wait(POLL)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        player.close()
+        line.finish()
+    for topic, why in sorted(player.stats.failed.items()):
+        print(f"  not published: {topic} ({why})", file=stream)
+    return 0
+
+
+class PlayLine:
+    """``playing  0:42 / 3:10  x2.0  1,234 msgs`` (or ``PAUSED``) on ``stream``.
+
+    Redrawn in place ten times a second on a terminal; into a pipe or file, one line every ten
+    seconds.
+    """
+
+    def __init__(self, player: Player, stream: TextIO) -> None:
+        self.player, self.stream = player, stream
+        self.live = stream.isatty()
+        self._drawn = 0.0
+
+    def text(self) -> str:
+        """The line as it is now."""
+        player = self.player
+        state = "PAUSED " if player.paused else "playing"
+        loops = f"  loop {player.stats.loops + 1}" if player.loop else ""
+        line = (f"{state}  {duration(player.position)} / {duration(player.recording.duration)}"
+                f"  x{player.rate:g}  {player.stats.messages:,} msgs{loops}")
+        return line[:terminal_width()] if self.live else line
+
+    def update(self) -> None:
+        """Redraws the line when due."""
+        now = time.monotonic()
+        if now - self._drawn < (0.1 if self.live else 10.0):
+            return
+        self._drawn = now
+        self.stream.write("\r\x1b[K" + self.text() if self.live else self.text() + "\n")
+        self.stream.flush()
+
+    def finish(self) -> None:
+        """Ends the line and says what was played."""
+        if self.live:
+            self.stream.write("\r\x1b[K")
+        stats = self.player.stats
+        print(f"played {stats.messages:,} messages on {len(stats.topics)} topics, up to "
+              f"{duration(self.player.position)} of {duration(self.player.recording.duration)}",
+              file=self.stream, flush=True)
