@@ -6,6 +6,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import pytest
 
 from cyborg.bus import BusConfig, Context, Node, Qos, new_message
 from cyborg.bus.msgs.std_msgs.msg import String
@@ -56,3 +57,36 @@ def test_remote_messages_come_as_their_payload_small_large_and_latched() -> None
             String(data="kept for late subscribers"), "std_msgs/msg/String"))
         assert got["/image"][0].data == bytes(types.serialize(image, "sensor_msgs/msg/Image"))
         assert len(got["/image"][0].data) > 64 * 1024
+
+
+def test_a_raw_publisher_sends_the_bytes_as_they_are_remote_local_large_and_latched() -> None:
+    with linked_contexts() as (listening, playing):
+        player, listener = Node("player", context=playing), Node("listener", context=listening)
+        types = playing.types
+        text = bytes(types.serialize(String(data="as recorded"), "std_msgs/msg/String"))
+        latched = player.create_raw_publisher("/map", "std_msgs/msg/String", Qos.latched())
+        latched.publish_raw(text)
+        camera = player.create_raw_publisher("/image", "sensor_msgs/msg/Image")
+        chatter = player.create_raw_publisher("/chatter", "std_msgs/msg/String")
+        got: dict[str, list[RawMessage]] = {"/map": [], "/image": [], "/chatter": []}
+        local: list[String] = []
+        Node("local", context=playing).create_subscription("/chatter", String, local.append)
+        for topic, type_name in (("/image", "sensor_msgs/msg/Image"),
+                                 ("/chatter", "std_msgs/msg/String")):
+            listener.create_raw_subscription(topic, type_name, got[topic].append)
+        until_subscribed(playing, "/image", 20)
+        until_subscribed(playing, "/chatter", 20)
+        assert wait_for(lambda: playing.shm_readers("/image"), 20)  # the slot path
+        image = bytes(types.serialize(big_image(playing), "sensor_msgs/msg/Image"))
+        camera.publish_raw(image)
+        chatter.publish_raw(text)
+        listener.create_raw_subscription("/map", "std_msgs/msg/String", got["/map"].append,
+                                         Qos.latched())  # late: gets the latched bytes
+        assert wait_for(lambda: all(got.values()) and local, 20), got
+        assert [got[t][0].data for t in ("/map", "/image", "/chatter")] == [text, image, text]
+        assert got["/chatter"][0].info is not None
+        assert got["/chatter"][0].info.gid == chatter.gid
+        assert local == [String(data="as recorded")]  # this process's subscribers: decoded
+        chatter.destroy()
+        with pytest.raises(RuntimeError, match="destroyed"):
+            chatter.publish_raw(text)
