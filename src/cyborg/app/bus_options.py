@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from cyborg.app.errors import CommandError
-from cyborg.bus import BusConfig, BusConfigError, Context
+from cyborg.bus import BusConfig, BusConfigError, Context, MessageTypes
 from cyborg.bus.config import DEFAULT_ROUTER
 
 __all__ = ["DEFAULT_ROUTER", "add_bus_options", "add_join_command", "bus_context",
@@ -64,10 +64,14 @@ def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
         raise CommandError(str(exc)) from exc
 
 
-def open_context(args: argparse.Namespace) -> Context:
-    """A context for a command; waits until the router is reached and the graph settles."""
+def open_context(args: argparse.Namespace, types: MessageTypes | None = None) -> Context:
+    """A context for a command; waits until the router is reached and the graph settles.
+
+    ``types``: the message types it uses, when the command has made some known already (a
+    player, from its recording); the bus's own by default.
+    """
     try:
-        context = Context(BusConfig.from_environment(args.connect))
+        context = Context(BusConfig.from_environment(args.connect), types=types)
     except BusConfigError as exc:
         raise CommandError(str(exc)) from exc
     deadline = time.monotonic() + max(args.wait, 0.1) + 1.0

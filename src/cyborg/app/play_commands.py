@@ -26,10 +26,10 @@ from cyborg.app.bus_options import open_context
 from cyborg.app.errors import CommandError
 from cyborg.app.keypress import Keys
 from cyborg.app.progress import duration, terminal_width
-from cyborg.bus import Node
+from cyborg.bus import Context, MessageTypes, Node
 from cyborg.bus.config import DEFAULT_ROUTER
 from cyborg.interfaces import player as contract
-from cyborg.record.playback_source import RecordingError, open_recording
+from cyborg.record.playback_source import Recording, RecordingError, open_recording
 from cyborg.record.player import Player, topic_filter
 
 POLL = 0.1
@@ -73,21 +73,23 @@ def play_command(args: argparse.Namespace) -> int:
         raise CommandError(f"--rate {args.rate}: give a speed above 0")
     if args.wait < 0:
         raise CommandError(f"--wait {args.wait}: give 0 seconds or more")
-    context = open_context(args)
+    types = MessageTypes()
     try:
-        try:
-            recording = open_recording(args.recording, context.types)
-        except RecordingError as exc:
-            raise CommandError(str(exc)) from None
+        recording = open_recording(args.recording, types)  # bad input is said before joining
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    try:
+        context = open_context(args, types)
         try:
             return _play(args, context, recording, sys.stderr)
         finally:
-            recording.close()
+            context.close()
     finally:
-        context.close()
+        recording.close()
 
 
-def _play(args: argparse.Namespace, context: Any, recording: Any, stream: TextIO) -> int:
+def _play(args: argparse.Namespace, context: Context, recording: Recording,
+          stream: TextIO) -> int:
     if not 0 <= args.start <= recording.duration:
         raise CommandError(f"--start {args.start}: the recording is "
                            f"{recording.duration:.1f} s long")

@@ -1,0 +1,53 @@
+"""``cyborg play`` as a user runs it: a recording published into another process's subscribers,
+with its live line and closing summary; bad files refused before joining the bus."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cyborg.bus import BusConfig, Context, MessageTypes, Node
+from cyborg.record.playback_source import open_recording
+from tests.bus.bus_peer import wait_for
+from tests.bus.test_multiprocess import free_port
+from tests.record.playing import CHATTER, Listener, record_run
+
+STRING = "std_msgs/msg/String"
+
+
+@pytest.mark.heavy
+def test_cyborg_play_publishes_the_recording_to_another_process(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    record_run(path)
+    recording = open_recording(path, MessageTypes())
+    expected = [p.data for p in recording.messages() if p.topic == "/chatter"]
+    recording.close()
+    address = f"tcp/127.0.0.1:{free_port()}"
+    with Context(BusConfig.router([address])) as bus:
+        listener = Listener(Node("listener", context=bus))
+        listener.listen("/chatter", STRING)
+        listener.listen("/map", STRING, latched=True)
+        result = subprocess.run(
+            [sys.executable, "-m", "cyborg", "play", str(path), "--rate", "2", "--connect",
+             address, "--wait", "1"], capture_output=True, text=True, timeout=120, check=False)
+        assert result.returncode == 0, result.stderr
+        assert wait_for(lambda: listener.data("/chatter") == expected, 20), result.stderr
+        assert len(listener.data("/map")) == 1
+    assert f"cyborg play: {path}" in result.stderr
+    assert f"played {CHATTER + 1} messages on 2 topics" in result.stderr
+
+
+@pytest.mark.parametrize(("content", "said"), [(b"", "the file is empty"),
+                                               (b"#ROSBAG V2.0\n", "a ROS 1 bag")])
+def test_a_bad_file_is_refused_naming_it_before_joining_the_bus(
+        tmp_path: Path, content: bytes, said: str) -> None:
+    path = tmp_path / "run.mcap"
+    path.write_bytes(content)
+    result = subprocess.run(
+        [sys.executable, "-m", "cyborg", "play", str(path), "--connect", "tcp/127.0.0.1:9"],
+        capture_output=True, text=True, timeout=120, check=False)
+    assert result.returncode == 1
+    assert f"cyborg: error: {path}: {said}" in result.stderr
