@@ -164,10 +164,10 @@ class Publisher(_Endpoint, Generic[MessageT]):
         if readers:
             size = types.cdr_size(message, self.type_name) if data is None else len(data)
             if size >= SHM_THRESHOLD:
-                if self._slots is None:
-                    self._slots = SlotWriter()
+                self._slots = self._slots or SlotWriter()
                 ref = self._slots.write(size, lambda view: types.serialize_into(
-                    message, self.type_name, view) if data is None else _fill(view, data))
+                    message, self.type_name, view) if data is None else view.__setitem__(
+                    slice(None), data))  # the slot's view is len(data) bytes
                 if ref is not None:
                     reference, doorbell = ref.encode(), context.doorbell
                     if doorbell is None or not doorbell.ring(readers, attachment, reference):
@@ -418,8 +418,3 @@ class Subscription(_Endpoint, Generic[MessageT]):
 
 _UNDECODABLE = object()
 
-
-def _fill(view: memoryview, data: bytes) -> int:
-    """Copies serialised ``data`` into a shared-memory slot; the bytes written."""
-    view[:len(data)] = data
-    return len(data)

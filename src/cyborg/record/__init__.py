@@ -13,7 +13,12 @@
   cut file;
 * :mod:`cyborg.record.recorder` — the recorder on the bus: finds topics in the graph,
   subscribes to their raw CDR, writes, pauses and resumes;
-* :mod:`cyborg.record.component` — the recorder as a component (``cyborg up --record``).
+* :mod:`cyborg.record.component` — the recorder as a component (``cyborg up --record``);
+* :mod:`cyborg.record.playback_source` and :mod:`cyborg.record.bag_recording` — recordings to
+  play: MCAP files (whole or cut), ROS 1 and ROS 2 bags, their topics and their messages in
+  time order as CDR;
+* :mod:`cyborg.record.player` — the player on the bus (``cyborg play``): timing, ``/clock``,
+  latches, pause, step, seek and its state.
 
 This package builds on :mod:`cyborg.bus` and :mod:`cyborg.interfaces` only; the command line
 (:mod:`cyborg.app`) wires it. docs/recording.md says what a recording holds.

@@ -24,7 +24,7 @@ from rosbags.interfaces import Connection, Nodetype, QosDurability
 from rosbags.typesys import Stores, get_typestore
 
 from cyborg.bus import MessageTypes
-from cyborg.record.playback_source import (
+from cyborg.record.recorded import (
     Played,
     PlayedTopic,
     Recording,

@@ -51,7 +51,7 @@ from cyborg.bus.msgs.std_srvs.srv import (
 from cyborg.bus.raw import RawPublisher
 from cyborg.interfaces import player as contract
 from cyborg.interfaces import robot
-from cyborg.record.playback_source import Played, Recording
+from cyborg.record.recorded import Played, Recording
 
 log = logging.getLogger(__name__)
 

@@ -1,0 +1,150 @@
+"""MCAP files to play, whole or cut, read through the scan of ``cyborg record --recover``.
+
+:class:`McapRecording` reads an MCAP file in the rosbag2 layout (cyborg's, ``ros2 bag``'s,
+anyone's with ``cdr`` messages) with :func:`cyborg.record.scan.scan`: every whole chunk is
+found and indexed, so a file cut by ``kill -9`` or a power loss plays up to its last whole
+chunk (:attr:`~cyborg.record.recorded.Recording.cut` says where it was cut). Messages are read
+chunk by chunk and merged across chunks in log-time order; the latched topics' last messages
+before a time are found through the chunks' message indexes. A channel whose encoding is not
+``cdr``, or whose type cannot be made known from a ``ros2msg`` schema, is skipped and named.
+"""
+
+from __future__ import annotations
+
+import heapq
+import io
+import struct
+from collections.abc import Iterator
+from pathlib import Path
+from typing import BinaryIO
+
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.records import Channel, Chunk, Message, Schema
+
+from cyborg.bus import MessageTypes
+from cyborg.record import layout
+from cyborg.record.recorded import (
+    Played,
+    PlayedTopic,
+    Recording,
+    RecordingError,
+    is_latched,
+    learn_type,
+)
+from cyborg.record.scan import NotRecoverableError, ScannedChunk, decompress, scan
+
+_RECORD = struct.Struct("<BQ")
+
+
+class McapRecording(Recording):
+    """An MCAP file in the rosbag2 layout, whole or cut; see the module."""
+
+    _stream: BinaryIO
+    _chunks: list[ScannedChunk]
+    _channels: dict[int, str]
+    """The topic of each played channel, by channel id."""
+
+    @classmethod
+    def open(cls, path: Path, types: MessageTypes) -> McapRecording:
+        """Scans ``path`` and learns its types; RecordingError if it is no MCAP recording."""
+        try:
+            found = scan(path)
+        except NotRecoverableError as exc:
+            raise RecordingError(str(exc).replace("; nothing to recover", "")) from None
+        except OSError as exc:
+            raise RecordingError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+        recording = cls(path, start_ns=found.start_time, end_ns=found.end_time)
+        if not found.finished:
+            recording.cut = found.stopped
+        if found.message_count == 0:
+            raise RecordingError(f"{path}: holds no messages"
+                                 + (f" (cut: {found.stopped})" if not found.finished else ""))
+        recording._chunks = sorted(found.chunks, key=lambda c: c.record.message_start_time)
+        recording._channels = {}
+        for channel_id, channel in sorted(found.channels.items()):
+            why = recording._why_not(types, channel, found.schemas)
+            count = found.message_counts.get(channel_id, 0)
+            if why is not None:
+                recording.skipped[channel.topic] = why
+                continue
+            schema = found.schemas[channel.schema_id]
+            recording._channels[channel_id] = channel.topic
+            recording.topics[channel.topic] = PlayedTopic(
+                channel.topic, schema.name, is_latched(channel.metadata.get(layout.QOS_KEY, "")),
+                count)
+        recording._stream = open(path, "rb")  # noqa: SIM115 (closed by close())
+        return recording
+
+    @staticmethod
+    def _why_not(types: MessageTypes, channel: Channel, schemas: dict[int, Schema]
+                 ) -> str | None:
+        if channel.message_encoding != layout.MESSAGE_ENCODING:
+            return f"message encoding {channel.message_encoding!r}, not cdr"
+        schema = schemas.get(channel.schema_id)
+        if schema is None:
+            return "no schema"
+        if schema.encoding != layout.SCHEMA_ENCODING and schema.name not in types:
+            return (f"unknown type {schema.name} with a {schema.encoding or 'missing'} schema, "
+                    "not ros2msg")
+        return learn_type(types, schema.name, schema.data.decode("utf-8", errors="replace"))
+
+    def _records(self, chunk: ScannedChunk) -> bytes:
+        """The decompressed content of a chunk (its messages' records)."""
+        self._stream.seek(chunk.offset + _RECORD.size)
+        content = self._stream.read(chunk.length - _RECORD.size)
+        return decompress(Chunk.read(ReadDataStream(io.BytesIO(content))))
+
+    def _messages_of(self, chunk: ScannedChunk, start_ns: int) -> Iterator[Played]:
+        data = self._records(chunk)
+        position = 0
+        while position < len(data):
+            opcode, length = _RECORD.unpack_from(data, position)
+            body = position + _RECORD.size
+            if opcode == Opcode.MESSAGE:
+                message = Message.read(ReadDataStream(io.BytesIO(data[body:body + length])),
+                                       length)
+                topic = self._channels.get(message.channel_id)
+                if topic is not None and message.log_time >= start_ns:
+                    yield Played(topic, message.log_time, bytes(message.data))
+            position = body + length
+
+    def messages(self, start_ns: int = 0) -> Iterator[Played]:
+        """The played topics' messages from ``start_ns`` on, merged across chunks in time."""
+        pending: list[tuple[int, int, Played]] = []
+        order = 0
+        chunks = [c for c in self._chunks if c.record.message_end_time >= start_ns]
+        for number, chunk in enumerate(chunks):
+            for played in self._messages_of(chunk, start_ns):
+                heapq.heappush(pending, (played.log_time, order, played))
+                order += 1
+            following = (chunks[number + 1].record.message_start_time
+                         if number + 1 < len(chunks) else None)
+            while pending and (following is None or pending[0][0] < following):
+                yield heapq.heappop(pending)[2]
+
+    def latched_before(self, start_ns: int) -> list[Played]:
+        """The last message before ``start_ns`` of each latched topic (found by the index)."""
+        found: list[Played] = []
+        for channel_id, topic in self._channels.items():
+            if not self.topics[topic].latched:
+                continue
+            last: tuple[int, ScannedChunk, int] | None = None
+            for chunk in self._chunks:
+                for log_time, offset in chunk.message_index.get(channel_id, []):
+                    if log_time < start_ns and (last is None or log_time >= last[0]):
+                        last = (log_time, chunk, offset)
+            if last is not None:
+                found.append(self._message_at(topic, last[1], last[2]))
+        return sorted(found, key=lambda played: played.log_time)
+
+    def _message_at(self, topic: str, chunk: ScannedChunk, offset: int) -> Played:
+        data = self._records(chunk)
+        _opcode, length = _RECORD.unpack_from(data, offset)
+        body = offset + _RECORD.size
+        message = Message.read(ReadDataStream(io.BytesIO(data[body:body + length])), length)
+        return Played(topic, message.log_time, bytes(message.data))
+
+    def close(self) -> None:
+        """Closes the file."""
+        self._stream.close()

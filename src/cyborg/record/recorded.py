@@ -1,0 +1,102 @@
+"""What every recording to play tells, whatever its format: topics, time span, messages.
+
+:class:`Recording` is the base of the readers (:mod:`cyborg.record.mcap_recording`,
+:mod:`cyborg.record.bag_recording`; :func:`cyborg.record.playback_source.open_recording`
+chooses one): the topics it can play (:class:`PlayedTopic`), those it cannot with the reason,
+its first and last log times, whether it was cut, and its messages as :class:`Played` (topic,
+log time, CDR bytes) in log-time order. :func:`learn_type` makes a recorded type known to the
+bus from the recording's own definition.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NamedTuple
+
+from cyborg.bus import MessageTypes
+
+
+class RecordingError(ValueError):
+    """A file that cannot be played; the message names the file and what is wrong."""
+
+
+class Played(NamedTuple):
+    """One recorded message: its topic, its log time and its CDR bytes."""
+
+    topic: str
+    log_time: int
+    """When it was recorded, ns (since the epoch for cyborg's recordings)."""
+    data: bytes
+    """CDR with its encapsulation header, as on the wire."""
+
+
+@dataclass(frozen=True)
+class PlayedTopic:
+    """A topic of a recording that can be played."""
+
+    name: str
+    type_name: str
+    latched: bool
+    """Recorded from a transient-local publisher: played latched again."""
+    count: int
+    """Messages of it in the recording (what could be read of a cut file)."""
+
+
+@dataclass
+class Recording:
+    """A recording opened for play; read its messages with :meth:`messages`.
+
+    The base class holds what every kind of recording tells;
+    :class:`~cyborg.record.mcap_recording.McapRecording` and
+    :class:`~cyborg.record.bag_recording.BagRecording` read them.
+    """
+
+    path: Path
+    topics: dict[str, PlayedTopic] = field(default_factory=dict)
+    skipped: dict[str, str] = field(default_factory=dict)
+    """Topics that are not played, with the reason."""
+    start_ns: int = 0
+    """Log time of the first message."""
+    end_ns: int = 0
+    """Log time of the last message."""
+    cut: str | None = None
+    """Where and how the file was cut (only its whole part plays); None for a whole file."""
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first message to the last."""
+        return max(self.end_ns - self.start_ns, 0) / 1e9
+
+    def messages(self, start_ns: int = 0) -> Iterator[Played]:
+        """The messages of the played topics from ``start_ns`` on, in log-time order."""
+        raise NotImplementedError
+
+    def latched_before(self, start_ns: int) -> list[Played]:
+        """The last message before ``start_ns`` of each latched topic, in log-time order."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Releases the file."""
+
+
+def learn_type(types: MessageTypes, type_name: str, definition: str) -> str | None:
+    """Makes ``type_name`` known to the bus from a recording's definition text, if needed.
+
+    Returns None when the bus knows it (now), else why it cannot be played.
+    """
+    if type_name in types:
+        return None
+    if not definition.strip():
+        return f"unknown type {type_name}, and the recording holds no definition of it"
+    try:
+        types.add_definition(type_name, definition)
+    except ValueError as exc:
+        return str(exc)
+    return None if type_name in types else f"unknown type {type_name}"
+
+
+def is_latched(qos_yaml: str) -> bool:
+    """Whether the ``offered_qos_profiles`` of a rosbag2 channel name a transient-local one."""
+    return "transient_local" in qos_yaml
