@@ -15,12 +15,15 @@ from cyborg.bt import HookMode, Status
 from cyborg.bus import BusConfig, Context, MessageTypes, Node, Qos
 from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.wire import Durability, EntityKind
-from cyborg.interfaces import detector, robot, tree_runner
+from cyborg.interfaces import detector, player, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
 from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.source import TreeSource
 from cyborg.nav.arnl_map import read_map
+from cyborg.record.mcap_file import McapFile
+from cyborg.record.playback_source import open_recording
+from cyborg.record.player import Player
 from cyborg.robot.bus_robot import BusRobot
 from cyborg.runner.tree_runner import TreeRunnerNode
 from cyborg.sim.loop import SimulationLoop
@@ -233,6 +236,28 @@ def test_the_camera_serves_everything_the_detector_uses(bus: Context) -> None:
 
 
 # ---------------------------------------------------------------------- the descriptors
+def test_the_player_serves_its_state_and_services_under_its_namespace(
+        bus: Context, tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    recording_file = McapFile(path, bus.types)
+    channel = recording_file.channel("/chatter", "std_msgs/msg/String", [])
+    recording_file.write(channel, 1_000, 1_000, bytes(bus.types.serialize(
+        bus.types.message_class("std_msgs/msg/String")(data="x"), "std_msgs/msg/String")))
+    recording_file.close()
+    recording = open_recording(path, bus.types)
+    playing = Player(Node(player.NAME, "/replay", context=bus), recording, paused=True)
+    try:
+        names = contract_names("/replay", player.TOPICS, player.SERVICES)
+        node = f"/replay/{player.NAME}"
+        settle(bus.graph, lambda: names <= {e.topic for e in endpoints(bus.graph, node, SERVING)})
+        assert_serves(bus.graph, node, "/replay", player.TOPICS, player.SERVICES)
+        assert names == {"/replay/player/state", "/replay/player/pause", "/replay/player/seek",
+                         "/replay/player/step"}
+    finally:
+        playing.close()
+        recording.close()
+
+
 def test_names_resolve_as_the_bus_resolves_them() -> None:
     pose = robot.POSE
     assert pose.full_name("/cyborg") == pose.full_name("cyborg/") == "/cyborg/pose"
@@ -268,9 +293,9 @@ def test_every_type_in_the_contracts_is_known() -> None:
     """The classes the descriptors carry are the bus's own, under the names the graph shows."""
     types = MessageTypes()
     for topic in (*robot.TOPICS, *robot.COMMANDS, *tree_runner.TOPICS,
-                  *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS):
+                  *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS, *player.TOPICS):
         assert types.message_class(topic.type_name) is topic.message_type, topic
-    for service in (*robot.SERVICES, *tree_runner.SERVICES):
+    for service in (*robot.SERVICES, *tree_runner.SERVICES, *player.SERVICES):
         assert service.type_name in types.services, service
         assert types.message_class(service.request_type) is service.service_type.Request
         assert types.message_class(service.response_type) is service.service_type.Response
