@@ -6,9 +6,9 @@
     cyborg play run.mcap --exclude '/cyborg/camera/*'
     cyborg play robot.bag                         a ROS 1 bag; a ROS 2 bag folder plays too
 
-It joins the bus's router like the other bus commands (``--connect``, ``--wait``). On a
-terminal the space key pauses and resumes and ``s`` plays one message (pausing first); the
-player's services do the same from anywhere (``/player/pause``, ``/player/step``,
+It joins the bus's router like the other bus commands (``--connect``, ``--wait``); Ctrl-C and
+SIGTERM stop it, saying how far it played. On a terminal the space key pauses and resumes and
+``s`` plays one message (pausing first); the player's services do the same from anywhere (``/player/pause``, ``/player/step``,
 ``/player/seek``: :mod:`cyborg.interfaces.player`). A live line on stderr shows the position,
 the length, the rate and whether it is paused. docs/recording.md ("Replay") says what is played
 and how.
@@ -17,9 +17,11 @@ and how.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 from pathlib import Path
+from types import FrameType
 from typing import Any, TextIO
 
 from cyborg.app.bus_options import open_context
@@ -110,6 +112,7 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
     print(f"cyborg play: {args.recording}, {duration(recording.duration)}, "
           f"{len(player.topics)} topics; {keys}Ctrl-C stops", file=stream, flush=True)
     line = PlayLine(player, stream)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
         time.sleep(args.wait)
         player.set_paused(args.paused)
@@ -120,11 +123,16 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
     except KeyboardInterrupt:
         pass
     finally:
+        signal.signal(signal.SIGTERM, previous)
         player.close()
         line.finish()
     for topic, why in sorted(player.stats.failed.items()):
         print(f"  not published: {topic} ({why})", file=stream)
     return 0
+
+
+def _interrupt(_signum: int, _frame: FrameType | None) -> None:
+    raise KeyboardInterrupt
 
 
 class PlayLine:
