@@ -3,12 +3,14 @@ with its live line and closing summary; bad files refused before joining the bus
 
 from __future__ import annotations
 
+import io
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from cyborg.app.play_commands import PlayLine
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
 from cyborg.record.playback_source import open_recording
 from tests.bus.bus_peer import wait_for
@@ -51,3 +53,31 @@ def test_a_bad_file_is_refused_naming_it_before_joining_the_bus(
         capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 1
     assert f"cyborg: error: {path}: {said}" in result.stderr
+
+
+def test_a_start_outside_the_recording_and_unknown_topics_are_refused_naming_them(
+        tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    record_run(path)
+    for options, said in ((["--start", "500"], "--start 500.0: "),
+                          (["--topics", "/chatter", "/nothing"], "--topics: /nothing not in")):
+        result = subprocess.run(
+            [sys.executable, "-m", "cyborg", "play", str(path), *options, "--connect",
+             "tcp/127.0.0.1:9"], capture_output=True, text=True, timeout=120, check=False)
+        assert result.returncode == 1
+        assert f"cyborg: error: {said}" in result.stderr
+        assert str(path) in result.stderr
+
+
+def test_the_live_line_shows_position_length_rate_and_pause() -> None:
+    class Stats:
+        messages, loops = 1234, 1
+
+    class Shown:
+        paused, position, rate, loop, stats = False, 42.4, 2.0, True, Stats()
+        recording = type("R", (), {"duration": 190.0})()
+
+    line = PlayLine(Shown(), io.StringIO())  # type: ignore[arg-type]
+    assert line.text() == "playing  0:42 / 3:10  x2  1,234 msgs  loop 2"
+    Shown.paused = True
+    assert line.text().startswith("PAUSED   0:42 / 3:10")

@@ -11,12 +11,14 @@ from pathlib import Path
 import pytest
 
 from cyborg.bus import Context, Node
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.cyborg_msgs.msg import PlayerState
 from cyborg.bus.msgs.cyborg_msgs.srv import Seek_Request
 from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
 from cyborg.bus.msgs.std_srvs.srv import SetBool_Request, Trigger_Request
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import player as contract
+from cyborg.record.mcap_file import McapFile
 from cyborg.record.playback_source import Recording, open_recording
 from cyborg.record.player import Player, topic_filter
 from tests.bus.bus_peer import linked_contexts, until_served, until_subscribed, wait_for
@@ -200,4 +202,30 @@ def test_out_of_range_arguments_are_refused_naming_them(run_file: Path,
         with pytest.raises(ValueError, match="start"):
             Player(Node("p2", context=playing), recording, start=recording.duration + 1)
     finally:
+        recording.close()
+
+
+def test_a_recording_with_its_own_clock_plays_that_one_and_makes_none(
+        buses: tuple[Context, Context], tmp_path: Path) -> None:
+    playing, listening = buses
+    path = tmp_path / "clocked.mcap"
+    file = McapFile(path, playing.types)
+    channel = file.channel("/clock", "rosgraph_msgs/msg/Clock", [])
+    recorded_clock = [bytes(playing.types.serialize(Clock(clock=Time(sec=s, nanosec=0)),
+                                                   "rosgraph_msgs/msg/Clock")) for s in (7, 8)]
+    for number, data in enumerate(recorded_clock):
+        file.write(channel, 1_000 + number * 10_000_000, 0, data)
+    file.close()
+    listener = Listener(Node("listener", context=listening))
+    listener.listen("/clock", "rosgraph_msgs/msg/Clock")
+    player, recording = start_player(playing, path, paused=True)
+    try:
+        assert not player.own_clock
+        until_subscribed(playing, "/clock", 20)
+        player.set_paused(False)
+        assert player.wait_finished(30)
+        assert wait_for(lambda: listener.data("/clock") == recorded_clock, 20)
+        assert playing.graph.count("/clock", EntityKind.PUBLISHER) == 1
+    finally:
+        player.close()
         recording.close()

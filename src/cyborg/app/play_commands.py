@@ -8,10 +8,10 @@
 
 It joins the bus's router like the other bus commands (``--connect``, ``--wait``); Ctrl-C and
 SIGTERM stop it, saying how far it played. On a terminal the space key pauses and resumes and
-``s`` plays one message (pausing first); the player's services do the same from anywhere (``/player/pause``, ``/player/step``,
-``/player/seek``: :mod:`cyborg.interfaces.player`). A live line on stderr shows the position,
-the length, the rate and whether it is paused. docs/recording.md ("Replay") says what is played
-and how.
+``s`` plays one message (pausing first); the player's services do the same from anywhere
+(``/player/pause``, ``/player/step``, ``/player/seek``: :mod:`cyborg.interfaces.player`). A
+live line on stderr shows the position, the length, the rate and whether it is paused.
+docs/recording.md ("Replay") says what is played and how.
 """
 
 from __future__ import annotations
@@ -81,6 +81,7 @@ def play_command(args: argparse.Namespace) -> int:
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
     try:
+        _check(args, recording)
         context = open_context(args, types)
         try:
             return _play(args, context, recording, sys.stderr)
@@ -90,16 +91,20 @@ def play_command(args: argparse.Namespace) -> int:
         recording.close()
 
 
-def _play(args: argparse.Namespace, context: Context, recording: Recording,
-          stream: TextIO) -> int:
+def _check(args: argparse.Namespace, recording: Recording) -> None:
+    """Refuses a start outside the recording and topics it does not have, naming them."""
     if not 0 <= args.start <= recording.duration:
-        raise CommandError(f"--start {args.start}: the recording is "
+        raise CommandError(f"--start {args.start}: {args.recording} is "
                            f"{recording.duration:.1f} s long")
-    accept = topic_filter(args.topics, args.exclude)
     unknown = sorted(set(args.topics) - set(recording.topics) - set(recording.skipped))
     if unknown:
         raise CommandError(f"--topics: {', '.join(unknown)} not in {args.recording}; it has "
                            f"{', '.join(sorted(recording.topics)) or 'no playable topics'}")
+
+
+def _play(args: argparse.Namespace, context: Context, recording: Recording,
+          stream: TextIO) -> int:
+    accept = topic_filter(args.topics, args.exclude)
     if recording.cut is not None:
         print(f"cyborg play: {args.recording} was cut ({recording.cut}); playing the "
               f"{duration(recording.duration)} before it", file=stream)
