@@ -4,14 +4,19 @@ with its live line and closing summary; bad files refused before joining the bus
 from __future__ import annotations
 
 import io
+import os
+import pty
 import subprocess
 import sys
+import termios
+import time
 from pathlib import Path
 
 import pytest
 
 from cyborg.app.play_commands import PlayLine
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
+from cyborg.bus.wire import EntityKind
 from cyborg.record.playback_source import open_recording
 from tests.bus.bus_peer import wait_for
 from tests.bus.test_multiprocess import free_port
@@ -81,3 +86,39 @@ def test_the_live_line_shows_position_length_rate_and_pause() -> None:
     assert line.text() == "playing  0:42 / 3:10  x2  1,234 msgs  loop 2"
     Shown.paused = True
     assert line.text().startswith("PAUSED   0:42 / 3:10")
+
+
+@pytest.mark.heavy
+def test_on_a_terminal_s_steps_and_space_resumes_a_paused_player(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    record_run(path)
+    address = f"tcp/127.0.0.1:{free_port()}"
+    controller, terminal = pty.openpty()
+    with Context(BusConfig.router([address])) as bus:
+        listener = Listener(Node("listener", context=bus))
+        listener.listen("/chatter", STRING)
+        player = subprocess.Popen(
+            [sys.executable, "-m", "cyborg", "play", str(path), "--paused", "--connect",
+             address], stdin=terminal, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            text=True)
+        os.close(terminal)
+        try:
+            assert wait_for(lambda: bus.graph.count("/player/step", EntityKind.SERVICE_SERVER),
+                            60)
+            # keys typed before the player reads them are flushed: wait for its cbreak mode
+            assert wait_for(lambda: not termios.tcgetattr(controller)[3] & termios.ICANON, 60)
+            os.write(controller, b"s")  # the map, recorded first
+            os.write(controller, b"s")  # the first message of /chatter
+            assert wait_for(lambda: len(listener.data("/chatter")) == 1, 30)
+            time.sleep(0.5)
+            assert len(listener.data("/chatter")) == 1  # stepped, then paused
+            os.write(controller, b" ")
+            _out, err = player.communicate(timeout=60)
+        finally:
+            if player.poll() is None:
+                player.kill()
+            os.close(controller)
+        assert player.returncode == 0, err
+        assert wait_for(lambda: len(listener.data("/chatter")) == CHATTER, 20)
+    assert "space pauses, s steps" in err
+    assert f"played {CHATTER + 1} messages" in err
