@@ -14,9 +14,11 @@
 * :mod:`cyborg.record.recorder` — the recorder on the bus: finds topics in the graph,
   subscribes to their raw CDR, writes, pauses and resumes;
 * :mod:`cyborg.record.component` — the recorder as a component (``cyborg up --record``);
-* :mod:`cyborg.record.playback_source` and :mod:`cyborg.record.bag_recording` — recordings to
-  play: MCAP files (whole or cut), ROS 1 and ROS 2 bags, their topics and their messages in
-  time order as CDR;
+* :mod:`cyborg.record.recorded` — what every recording to play tells: its topics, time span,
+  whether it was cut, and its messages in time order as CDR;
+* :mod:`cyborg.record.mcap_recording` and :mod:`cyborg.record.bag_recording` — reading MCAP
+  files (whole or cut) and ROS 1 and ROS 2 bags; :mod:`cyborg.record.playback_source` opens
+  the right one (``open_recording``);
 * :mod:`cyborg.record.player` — the player on the bus (``cyborg play``): timing, ``/clock``,
   latches, pause, step, seek and its state.
 
