@@ -170,3 +170,24 @@ def test_bad_interface_files_name_the_file(tmp_path: Path) -> None:
 def test_unknown_type(types: MessageTypes) -> None:
     with pytest.raises(KeyError, match="unknown type 'nope/msg/Nope'"):
         types.hash("nope/msg/Nope")
+
+
+def test_a_definition_from_a_recording_adds_its_types_and_keeps_the_bus_own() -> None:
+    types = MessageTypes()
+    header = types.store.types["std_msgs/msg/Header"]
+    text = ("std_msgs/Header header\nfloat64[] speeds\n" + "=" * 80
+            + "\nMSG: std_msgs/Header\nuint32 seq\nbuiltin_interfaces/Time stamp\n")
+    assert types.add_definition("their_msgs/msg/Run", text) == ["their_msgs/msg/Run"]
+    assert types.store.types["std_msgs/msg/Header"] is header  # not the recording's, with seq
+    run = types.message_class("their_msgs/msg/Run")
+    assert types.hash("their_msgs/msg/Run").startswith("RIHS01_")
+    message = types.deserialize(types.serialize(run(header=header(
+        stamp=types.message_class("builtin_interfaces/msg/Time")(sec=1, nanosec=2),
+        frame_id="map"), speeds=np.array([0.5])), "their_msgs/msg/Run"), "their_msgs/msg/Run")
+    assert message.header.frame_id == "map" and message.speeds.tolist() == [0.5]
+    with pytest.raises(ValueError, match="field pose of their_msgs/msg/Bad is of type "
+                                         "their_msgs/msg/Missing, defined nowhere"):
+        types.add_definition("their_msgs/msg/Bad", "their_msgs/Missing pose\n")
+    assert "their_msgs/msg/Bad" not in types
+    with pytest.raises(ValueError, match="their_msgs/msg/Worse: its definition cannot be read"):
+        types.add_definition("their_msgs/msg/Worse", "float64 = = =\n")

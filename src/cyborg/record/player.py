@@ -152,6 +152,7 @@ class Player:
             if paused != self.paused:
                 self.paused = paused
                 self._anchor = (time.monotonic(), self._position)
+                self._said_state = 0.0  # said at once
                 self._changed.notify_all()
 
     def toggle_pause(self) -> None:
@@ -163,6 +164,7 @@ class Player:
         with self._changed:
             self.paused = True
             self._steps += 1
+            self._said_state = 0.0
             self._changed.notify_all()
 
     def seek(self, seconds: float) -> None:
