@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import heapq
 import io
+import os
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -91,8 +92,9 @@ class McapRecording(Recording):
 
     def _records(self, chunk: ScannedChunk) -> bytes:
         """The decompressed content of a chunk (its messages' records)."""
-        self._stream.seek(chunk.offset + _RECORD.size)
-        content = self._stream.read(chunk.length - _RECORD.size)
+        # pread: no shared file position, so two readers (a seek, a test) never mix
+        content = os.pread(self._stream.fileno(), chunk.length - _RECORD.size,
+                           chunk.offset + _RECORD.size)
         return decompress(Chunk.read(ReadDataStream(io.BytesIO(content))))
 
     def _messages_of(self, chunk: ScannedChunk, start_ns: int) -> Iterator[Played]:
