@@ -5,6 +5,9 @@ folder, and the Host check in front of it all."""
 
 from __future__ import annotations
 
+import posixpath
+import re
+
 import pytest
 from starlette.types import ASGIApp
 
@@ -98,3 +101,27 @@ def test_the_host_check_guards_the_files_too(way: str) -> None:
     with local_client(app, base_url="http://rebind.attacker.example:8080") as client:
         assert client.get("/static/js/app.js").status_code == 403
         assert client.get("/").status_code == 403
+
+
+def _static_imports(module: str) -> set[str]:
+    """Every module ``module`` (a path under the static folder) loads by static imports."""
+    found: set[str] = set()
+    waiting = [module]
+    while waiting:
+        name = waiting.pop()
+        if name in found:
+            continue
+        found.add(name)
+        text = (STATIC / name).read_text(encoding="utf-8")
+        for target in re.findall(r'^import[^;]*?from\s+"([^"]+)"', text, re.M):
+            waiting.append(posixpath.normpath(posixpath.join(posixpath.dirname(name), target)))
+    return found
+
+
+def test_every_module_the_tree_needs_is_preloaded_so_no_import_waits_on_another() -> None:
+    html = (STATIC / "index.html").read_text(encoding="utf-8")
+    preloaded = set(re.findall(r'<link rel="modulepreload" href="/static/([^"]+)">', html))
+    needed = _static_imports("js/app.js")
+    assert "js/tree_view.js" in needed and "vendor/d3-hierarchy.min.mjs" in needed
+    assert needed - preloaded == set(), "imported by the page's start but not preloaded"
+    assert preloaded - needed == set(), "preloaded but not needed for the first paint"
