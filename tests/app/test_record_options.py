@@ -54,7 +54,7 @@ def test_the_recorder_component_records_into_the_launch_files_folder(tmp_path: P
 def test_the_live_line_shows_messages_megabytes_rate_topics_and_pause(tmp_path: Path) -> None:
     import io
 
-    from cyborg.app.record_commands import LiveLine
+    from cyborg.app.record_commands import RecordLine
     from cyborg.bus import Node
     from cyborg.record.recorder import Recorder
     from cyborg.record.selection import TopicSelection
@@ -68,7 +68,7 @@ def test_the_live_line_shows_messages_megabytes_rate_topics_and_pause(tmp_path: 
         recorder.stats.topics.update({"/a": 1, "/b": 2})
         recorder.stats.skipped["/odd"] = "unknown type their_msgs/msg/Odd"
         stream = io.StringIO()
-        line = LiveLine(recorder, stream)
+        line = RecordLine(recorder, stream)
         assert not line.live
         line.update()
         recorder.set_paused(True)

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
-from cyborg.app.errors import CommandError
+from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.status_line import StatusLine
 from cyborg.bt import (
     Clock,
@@ -206,7 +206,7 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
     runner.add_listener(line.update)
     print(f"running {tree.title!r} from {tree.source} ({len(tree)} nodes) at {rate_hz:g} Hz; "
           "Ctrl-C stops", file=stream)
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    previous = signal.signal(signal.SIGTERM, interrupt)
     interrupted = False
     try:
         runner.run(max_ticks=max_ticks, until_done=until_done)
@@ -220,9 +220,6 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
         return 130
     return 1 if tree.last is not None and tree.last.status is Status.ERROR else 0
 
-
-def _raise_interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
 
 
 def _write(text: str, output: Path | None) -> None:

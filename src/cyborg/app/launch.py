@@ -51,6 +51,7 @@ from typing import Any
 
 import yaml
 
+from cyborg.app.errors import interrupt
 from cyborg.app.launchables import starter_for
 from cyborg.bus import Context
 from cyborg.bus.component import LaunchError, NodeSpec, Running
@@ -209,7 +210,7 @@ class Launch:
         It ends too when a child dies, or, in a child, when its ``parent`` process has ended:
         a launch killed outright leaves no orphans.
         """
-        previous = signal.signal(signal.SIGTERM, _interrupt)
+        previous = signal.signal(signal.SIGTERM, interrupt)
         started = time.monotonic()
         try:
             while duration is None or time.monotonic() - started < duration:
@@ -286,9 +287,6 @@ def end_if_stuck(launch: Launch, deadline: float = STOP_DEADLINE) -> None:
     threading.Thread(target=overdue, name="stop-deadline", daemon=True).start()
 
 
-def _interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
-
 
 def as_child() -> None:
     """Sets the signals of a launch's child process.
@@ -298,7 +296,7 @@ def as_child() -> None:
     have halted.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
 
 
 def _verbosity() -> list[str]:

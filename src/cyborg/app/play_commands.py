@@ -21,13 +21,12 @@ import signal
 import sys
 import time
 from pathlib import Path
-from types import FrameType
 from typing import Any, TextIO
 
 from cyborg.app.bus_options import open_context
-from cyborg.app.errors import CommandError
+from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
-from cyborg.app.progress import duration, terminal_width
+from cyborg.app.progress import LiveLine, duration
 from cyborg.bus import Context, MessageTypes, Node
 from cyborg.bus.config import DEFAULT_ROUTER
 from cyborg.interfaces import player as contract
@@ -117,7 +116,7 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
     print(f"cyborg play: {args.recording}, {duration(recording.duration)}, "
           f"{len(player.topics)} topics; {keys}Ctrl-C stops", file=stream, flush=True)
     line = PlayLine(player, stream)
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    previous = signal.signal(signal.SIGTERM, interrupt)
     try:
         time.sleep(args.wait)
         player.set_paused(args.paused)
@@ -136,44 +135,26 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
     return 0
 
 
-def _interrupt(_signum: int, _frame: FrameType | None) -> None:
-    raise KeyboardInterrupt
 
-
-class PlayLine:
-    """``playing  0:42 / 3:10  x2.0  1,234 msgs`` (or ``PAUSED``) on ``stream``.
-
-    Redrawn in place ten times a second on a terminal; into a pipe or file, one line every ten
-    seconds.
-    """
+class PlayLine(LiveLine):
+    """``playing  0:42 / 3:10  x2.0  1,234 msgs`` (or ``PAUSED``) on ``stream``."""
 
     def __init__(self, player: Player, stream: TextIO) -> None:
-        self.player, self.stream = player, stream
-        self.live = stream.isatty()
-        self._drawn = 0.0
+        super().__init__(stream)
+        self.player = player
 
     def text(self) -> str:
         """The line as it is now."""
         player = self.player
         state = "PAUSED " if player.paused else "playing"
         loops = f"  loop {player.stats.loops + 1}" if player.loop else ""
-        line = (f"{state}  {duration(player.position)} / {duration(player.recording.duration)}"
-                f"  x{player.rate:g}  {player.stats.messages:,} msgs{loops}")
-        return line[:terminal_width()] if self.live else line
-
-    def update(self) -> None:
-        """Redraws the line when due."""
-        now = time.monotonic()
-        if now - self._drawn < (0.1 if self.live else 10.0):
-            return
-        self._drawn = now
-        self.stream.write("\r\x1b[K" + self.text() if self.live else self.text() + "\n")
-        self.stream.flush()
+        return self.fitted(
+            f"{state}  {duration(player.position)} / {duration(player.recording.duration)}"
+            f"  x{player.rate:g}  {player.stats.messages:,} msgs{loops}")
 
     def finish(self) -> None:
         """Ends the line and says what was played."""
-        if self.live:
-            self.stream.write("\r\x1b[K")
+        self.clear()
         stats = self.player.stats
         print(f"played {stats.messages:,} messages on {len(stats.topics)} topics, up to "
               f"{duration(self.player.position)} of {duration(self.player.recording.duration)}",

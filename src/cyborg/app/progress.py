@@ -113,3 +113,38 @@ class ProgressBar:
         if self.live:
             self.stream.write("\n")
         self.stream.flush()
+
+
+class LiveLine:
+    """A line of what a long-running command does now, on ``stream``; :meth:`text` says what.
+
+    Redrawn in place ten times a second on a terminal, cut to its width; into a pipe or file,
+    one line every ten seconds. ``cyborg record`` and ``cyborg play`` show theirs so.
+    """
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self.live = stream.isatty()
+        self._drawn = 0.0
+
+    def text(self) -> str:
+        """The line as it is now (a subclass says it)."""
+        raise NotImplementedError
+
+    def fitted(self, line: str) -> str:
+        """``line`` cut to the terminal's width when drawn in place."""
+        return line[:terminal_width()] if self.live else line
+
+    def update(self) -> None:
+        """Redraws the line when due."""
+        now = time.monotonic()
+        if now - self._drawn < (0.1 if self.live else 10.0):
+            return
+        self._drawn = now
+        self.stream.write("\r\x1b[K" + self.text() if self.live else self.text() + "\n")
+        self.stream.flush()
+
+    def clear(self) -> None:
+        """Wipes the line drawn in place, so that a summary can take its place."""
+        if self.live:
+            self.stream.write("\r\x1b[K")

@@ -23,13 +23,12 @@ import signal
 import sys
 import time
 from pathlib import Path
-from types import FrameType
 from typing import Any, TextIO
 
 from cyborg.app.bus_options import open_context
-from cyborg.app.errors import CommandError
+from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
-from cyborg.app.progress import duration, size, terminal_width
+from cyborg.app.progress import LiveLine, duration, size
 from cyborg.bus import Node
 from cyborg.bus.config import DEFAULT_ROUTER
 from cyborg.record import component
@@ -108,12 +107,12 @@ def record_command(args: argparse.Namespace) -> int:
 
 def _follow(recorder: Recorder, limit: float | None, stream: TextIO) -> int:
     """Shows the live line until Ctrl-C, SIGTERM, ``limit`` or a failure; then finishes."""
-    line = LiveLine(recorder, stream)
+    line = RecordLine(recorder, stream)
     key = "p or " if sys.stdin.isatty() else ""
     print(f"cyborg record: writing {recorder.files.paths[0]}; Ctrl-C stops, "
           f"{key}kill -USR1 {os.getpid()} pauses and resumes", file=stream, flush=True)
     previous = {signum: signal.getsignal(signum) for signum in (signal.SIGTERM, signal.SIGUSR1)}
-    signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
     signal.signal(signal.SIGUSR1, lambda _signum, _frame: recorder.toggle_pause())
     started = time.monotonic()
     try:
@@ -135,46 +134,30 @@ def _follow(recorder: Recorder, limit: float | None, stream: TextIO) -> int:
     return 0
 
 
-def _interrupt(_signum: int, _frame: FrameType | None) -> None:
-    raise KeyboardInterrupt
 
-
-class LiveLine:
+class RecordLine(LiveLine):
     """``recording  1,234 msgs  5.6 MB  120.3 kB/s  14 topics  0:42`` on ``stream``.
 
-    Redrawn in place ten times a second on a terminal; into a pipe or file, one line every ten
-    seconds. ``PAUSED`` shows while the recording is paused.
+    ``PAUSED`` shows while the recording is paused.
     """
 
     def __init__(self, recorder: Recorder, stream: TextIO) -> None:
-        self.recorder, self.stream = recorder, stream
-        self.live = stream.isatty()
+        super().__init__(stream)
+        self.recorder = recorder
         self.started = time.monotonic()
-        self._drawn = 0.0
 
     def text(self) -> str:
         """The line as it is now."""
         stats = self.recorder.stats
         elapsed = max(time.monotonic() - self.started, 1e-9)
         state = "PAUSED   " if self.recorder.paused else "recording"
-        line = (f"{state}  {stats.messages:,} msgs  {size(stats.bytes)}  "
-                f"{size(stats.bytes / elapsed)}/s  {len(stats.topics)} topics  "
-                f"{duration(elapsed)}")
-        return line[:terminal_width()] if self.live else line
-
-    def update(self) -> None:
-        """Redraws the line when due."""
-        now = time.monotonic()
-        if now - self._drawn < (0.1 if self.live else 10.0):
-            return
-        self._drawn = now
-        self.stream.write("\r\x1b[K" + self.text() if self.live else self.text() + "\n")
-        self.stream.flush()
+        return self.fitted(f"{state}  {stats.messages:,} msgs  {size(stats.bytes)}  "
+                           f"{size(stats.bytes / elapsed)}/s  {len(stats.topics)} topics  "
+                           f"{duration(elapsed)}")
 
     def finish(self) -> None:
         """Ends the line and says what was recorded, and what was skipped."""
-        if self.live:
-            self.stream.write("\r\x1b[K")
+        self.clear()
         stats, recorder = self.recorder.stats, self.recorder
         files = ", ".join(str(path) for path in recorder.files.paths)
         print(f"{files}: {stats.messages:,} messages on {len(stats.topics)} topics, "
