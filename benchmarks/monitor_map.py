@@ -54,6 +54,7 @@ if __package__ in (None, ""):  # run as a file: the benchmarks package from the 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.monitor_web import percentile, random_tree
+from benchmarks.results_table import print_results
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus
@@ -434,15 +435,7 @@ def report(header: str, latency: Latency, maps: list[float], trees: list[float],
          f"{tree_cpu:.0f} ms/s (script {statistics.median(cpu['tree_script']):.0f})",
          "baseline", ""),
     ]
-    if markdown:
-        print(header + "\n")
-        print("| measure | result | ratio | goal |\n| --- | --: | --: | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
-    else:
-        print(header)
-        for name, value, ratio, goal in rows:
-            print(f"  {name:<68} {value:>26}  {ratio:<22} {goal}")
+    print_results(header, rows, markdown=markdown, widths=(68, 26, 22))
     ok_latency = p50 <= P50_GOAL_MS and p99 <= P99_GOAL_MS
     ok_paint = map_paint <= FIRST_PAINT_GOAL_MS
     def verdict(ok: bool) -> str:

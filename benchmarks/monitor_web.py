@@ -35,6 +35,10 @@ from typing import Any
 from playwright.sync_api import sync_playwright
 from websockets.sync.client import connect
 
+if __package__ in (None, ""):  # run as a file: the benchmarks package from the repository root
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.results_table import print_results
 from cyborg.bt.dot import structure_to_dot
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.monitor import Monitor
@@ -225,15 +229,7 @@ def report(nodes: int, floor: list[float], ours: list[float], merged: int,
     ]
     header = (f"{nodes}-node tree ticked at {RATE_HZ:g} Hz; {len(ours)} ticks painted "
               f"({merged} merged into a later frame), {len(floor)} received by the floor client")
-    if markdown:
-        print(header + "\n")
-        print("| measure | result | ratio | goal |\n| --- | --: | --: | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
-    else:
-        print(header)
-        for name, value, ratio, goal in rows:
-            print(f"  {name:<62} {value:>16}  {ratio:<18} {goal}")
+    print_results(header, rows, markdown=markdown, widths=(62, 16, 18))
     def verdict(ok: bool) -> str:
         return "meets" if ok else "MISSES"
     verdicts = [f"latency p50 {ours50:.1f} ms ({verdict(ours50 <= LATENCY_GOAL_MS)}"

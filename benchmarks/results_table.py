@@ -1,0 +1,24 @@
+"""A benchmark's results: rows of (measure, result, ratio, goal), as text or as Markdown.
+
+``--markdown`` prints the rows for docs/benchmarks.md under their header line; plain text
+aligns them in columns of the given widths for a terminal.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+
+def print_results(header: str, rows: Sequence[tuple[str, str, str, str]], *, markdown: bool,
+                  widths: tuple[int, int, int]) -> None:
+    """Prints ``header`` and ``rows``; ``widths``: the measure's, the result's, the ratio's."""
+    if markdown:
+        print(header + "\n")
+        print("| measure | result | ratio | goal |\n| --- | --: | --: | --- |")
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+        return
+    print(header)
+    name_width, value_width, ratio_width = widths
+    for name, value, ratio, goal in rows:
+        print(f"  {name:<{name_width}} {value:>{value_width}}  {ratio:<{ratio_width}} {goal}")
