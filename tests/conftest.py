@@ -1,7 +1,8 @@
-"""Shared test fixtures: where the project's shared data lives.
+"""Shared test fixtures: where the project's shared data lives, and a headless Chromium.
 
 The sample trees, maps and models are read from ``../shared`` beside the checkout, or from the
-folder named by the ``CYBORG_SHARED`` environment variable.
+folder named by the ``CYBORG_SHARED`` environment variable. ``browser`` is Debian's Chromium
+under Playwright, one per test module (tests/monitor/browser.py launches it).
 """
 
 from __future__ import annotations
@@ -9,11 +10,15 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 import cyborg.robot  # noqa: F401  (the robot's nodes are part of every test's baseline)
 from cyborg.bt import registry
+
+if TYPE_CHECKING:
+    from playwright.sync_api import Browser
 
 
 def shared_dir() -> Path:
@@ -26,6 +31,18 @@ def shared_dir() -> Path:
 @pytest.fixture
 def shared() -> Path:
     return shared_dir()
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Browser]:
+    from playwright.sync_api import sync_playwright  # only where a test asks for a browser
+
+    from tests.monitor.browser import launch_chromium
+
+    with sync_playwright() as playwright:
+        chromium = launch_chromium(playwright)
+        yield chromium
+        chromium.close()
 
 
 @pytest.fixture(autouse=True, scope="session")

@@ -1,26 +1,17 @@
-"""Fixtures the monitor's browser tests share: one Chromium per module, columbia's map blob
-and a stand-in monitor serving it (a module that needs another browser defines its own)."""
+"""Fixtures the monitor's browser tests share: columbia's map blob and a stand-in monitor
+serving it (the Chromium, one per module, is tests/conftest.py's; a module that needs another
+browser defines its own)."""
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 
 import pytest
-from playwright.sync_api import Browser, sync_playwright
 
 from cyborg.monitor.map_store import map_key
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from tests.conftest import shared_dir
-from tests.monitor.browser import launch_chromium
 from tests.monitor.map_page import BROKEN_KEY, StandInMonitor, first_messages, pack_map_blob
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 @pytest.fixture(scope="module")

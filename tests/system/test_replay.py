@@ -7,30 +7,21 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, sync_playwright
+from playwright.sync_api import Browser
 
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.monitor import Monitor
 from cyborg.nav.arnl_map import read_map
 from tests.bus.test_multiprocess import free_port
-from tests.monitor.browser import CAMPUS_MAP, launch_chromium, open_page, screenshot
+from tests.monitor.browser import CAMPUS_MAP, open_page, screenshot
 from tests.monitor.map_page import on_map
 
 pytestmark = pytest.mark.heavy
 
 ROBOT = "/cyborg"
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 def test_the_monitor_shows_a_played_run_as_it_showed_it_live(browser: Browser,
