@@ -233,3 +233,30 @@ def test_a_recording_with_its_own_clock_plays_that_one_and_makes_none(
     finally:
         player.close()
         recording.close()
+
+
+def test_a_seek_sends_each_topics_recent_last_message_so_a_paused_timeline_shows_that_time(
+        run_file: Path, buses: tuple[Context, Context]) -> None:
+    playing, listening = buses
+    expected = recorded(run_file, playing)
+    listener = Listener(Node("listener", context=listening))
+    listener.listen("/chatter", STRING)
+    listener.listen("/map", STRING, latched=True)
+    recording = open_recording(run_file, playing.types)
+    chatter_times = [p.log_time for p in recording.messages() if p.topic == "/chatter"]
+    player = Player(Node(contract.NAME, context=playing), recording, paused=True)
+    try:
+        until_subscribed(playing, "/chatter", 20)
+        until_subscribed(playing, "/map", 20)
+        just_before_tenth = (chatter_times[10] - recording.start_ns) / 1e9 - 0.001
+        player.seek(just_before_tenth)
+        assert wait_for(lambda: listener.data("/chatter") == [expected["/chatter"][9]], 20)
+        assert wait_for(lambda: listener.data("/map") == expected["/map"], 20)
+        assert player.paused, "a seek keeps the player paused"
+        player.seek(0.0)  # nothing lies before the start: the map is its first message
+        player.step()
+        assert wait_for(lambda: listener.data("/map") == 2 * expected["/map"], 20)
+        assert listener.data("/chatter") == [expected["/chatter"][9]]
+    finally:
+        player.close()
+        recording.close()

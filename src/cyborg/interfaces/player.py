@@ -36,3 +36,15 @@ PAUSE = Service(f"{NAME}/pause", SetBool)
 SEEK = Service(f"{NAME}/seek", Seek)
 STEP = Service(f"{NAME}/step", Trigger)
 SERVICES: tuple[Service, ...] = (PAUSE, SEEK, STEP)
+
+
+def player_namespace(topic: str, type_name: str) -> str | None:
+    """The namespace of the player that publishes ``topic`` of ``type_name``, or None.
+
+    Only a player's state topic names one (``/player/state`` → ``/``, ``/replay/player/state``
+    → ``/replay``); ``type_name`` is the topic's type as the bus graph shows it.
+    """
+    suffix = "/" + STATE.name
+    if type_name != STATE.type_name or not topic.endswith(suffix):
+        return None
+    return topic.removesuffix(suffix) or "/"

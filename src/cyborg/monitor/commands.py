@@ -29,11 +29,16 @@ set_pose     ns, pose: [x, y] or [x, y, θ]               relocalise it
 stop         ns                                          stop it (needs no seat)
 drive        ns, vx, wz                                  drive it by hand (10 Hz while held)
 tour         ns, points                                  drive it through the points in order
+player_pause paused                                      pause (true) or resume (false) the
+                                                         played recording (player_link.py)
+player_seek  position: s from the start, 0 to duration   go to that time of the recording
+player_step  —                                           play its next message, stay paused
 ping         —                                           answered with pong (for latency)
 ===========  ==========================================  =====================================
 
 ``enable``, ``control``, ``step`` and ``resume`` need the control seat; so do the robot
-commands (``go`` … ``tour``) but ``stop``, which any page that may control sends. The robot
+commands (``go`` … ``tour``) but ``stop``, which any page that may control sends, and the
+player's (``player_pause``, ``player_seek``, ``player_step``). The robot
 commands, their answers (``result``, ``robot_result``, ``tour``, ``manual_pause``) and why a
 manual goal pauses the tree are in :mod:`cyborg.monitor.robot_commands`.
 
@@ -58,6 +63,7 @@ from typing import Any
 from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import MessageError, check_namespace, decode
+from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerCommandError, PlayerError
 from cyborg.monitor.robot_commands import ROBOT_COMMANDS
 from cyborg.monitor.robot_fields import RobotCommandError
 from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY
@@ -131,6 +137,9 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
     if kind in ROBOT_COMMANDS:
         await _robot_command(hub, client, kind, command)
         return
+    if kind in PLAYER_COMMANDS:
+        await _player_command(hub, client, kind, command)
+        return
     if kind == "hello":
         secret = command.get("seat")
         if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
@@ -140,6 +149,7 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
             client.send(hub.seat_message(client))
         client.send(hub.robots())
         hub.robot_commands.resend(client)
+        hub.player.resend(client)
     elif kind == "watch":
         try:
             hub.watch(client, command.get("ns") or hub.default_namespace)
@@ -187,6 +197,21 @@ async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str,
         return
     if done is not None:
         client.send({**answer, "ok": True, **done})
+
+
+async def _player_command(hub: Hub, client: Client, kind: str,
+                          command: dict[str, Any]) -> None:
+    """A command to the player (:mod:`cyborg.monitor.player_link`), answered with ``result``."""
+    answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
+    try:
+        message = await hub.player.handle(client, kind, command)
+    except PlayerCommandError as exc:
+        client.send({**answer, "ok": False, "field": exc.field,
+                     "message": located_error(client, command, exc)["message"]})
+    except PlayerError as exc:
+        client.send({**answer, "ok": False, "field": None, "message": str(exc)})
+    else:
+        client.send({**answer, "ok": True, "message": message})
 
 
 async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> str:

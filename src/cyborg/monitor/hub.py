@@ -21,7 +21,8 @@ bus ever waits for a browser.
   it (*pinned*) or while its runner is on the bus; once the runner has left and no page watches
   it, it is freed with all kept for it. Watching a namespace no runner is in subscribes to
   nothing. Connections are counted per address.
-* **Robots**: their maps in :attr:`Hub.robot_hub`, acting on them in :attr:`Hub.robot_commands`.
+* **Robots**: their maps in :attr:`Hub.robot_hub`, acting on them in :attr:`Hub.robot_commands`;
+  a played recording's timeline in :attr:`Hub.player` (:mod:`cyborg.monitor.player_link`).
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from starlette.websockets import WebSocket
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import Limits, check_namespace
 from cyborg.monitor.off_loop import ShutdownError, in_thread
+from cyborg.monitor.player_link import PlayerLink
 from cyborg.monitor.robot_commands import RobotCommands
 from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
@@ -86,6 +88,7 @@ class Hub:
         self.robot_hub = RobotHub(self.clients, self.sources,
                                   lambda: self.broadcast(self.robots()))
         self.robot_commands = RobotCommands(self.clients, seat, self.sources, self.robot_hub)
+        self.player = PlayerLink(self.clients, seat, self.sources)
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
@@ -267,6 +270,7 @@ class Hub:
         """Binds the hub to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
         self.robot_hub.attach(loop)
+        self.player.attach(loop)
 
     def refusal(self, host: str | None) -> str | None:
         """Why one more connection from ``host`` is refused, or None when it is not."""
@@ -343,6 +347,7 @@ class Hub:
         if changed:
             self.broadcast(self.robots())
         await self.robot_hub.periodic()
+        await self.player.periodic()
         watched = {client.watching for client in self.clients if client.watching}
         for namespace in watched:
             source = self.sources.get(namespace)

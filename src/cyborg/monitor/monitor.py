@@ -14,7 +14,9 @@ or only watch. See docs/security.md.
 
 The bus node (``/cyborg/monitor`` by default) subscribes to each runner's topics and calls its
 services (:mod:`cyborg.monitor.source`); tree runners that appear on the bus later are found by
-their ``behavior_tree`` topic and offered on the page too. The web side
+their ``behavior_tree`` topic and offered on the page too; a player of a recording
+(``cyborg play``) is found by its ``player/state`` topic and drives the page's timeline
+(:mod:`cyborg.monitor.player_link`). The web side
 (:mod:`cyborg.monitor.server`) runs on uvicorn in its own thread.
 """
 
@@ -32,10 +34,11 @@ import uvicorn
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
-from cyborg.interfaces import robot, tree_runner
+from cyborg.interfaces import player, robot, tree_runner
 from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
+from cyborg.monitor.player_source import PlayerSource
 from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.robot_source import RobotSource
 from cyborg.monitor.seat import ControlSeat
@@ -79,6 +82,7 @@ class Monitor:
             self.hub.follow(namespace, pinned=True)
         self.hub.robot_hub.use(self._make_robot, self.discover_robots)
         self.hub.robot_commands.use(partial(RobotClients, self.node))
+        self.hub.player.use(partial(PlayerSource, self.node), self.discover_players)
         names = [*allow_hosts, host] if host not in EVERY_INTERFACE else list(allow_hosts)
         self.hosts = HostPolicy(names)
         self.app = create_app(self.hub, hosts=self.hosts)
@@ -101,6 +105,12 @@ class Monitor:
     def discover_robots(self) -> list[str]:
         """Namespaces of the robots on the bus (found by their pose topic)."""
         found = {robot.robot_namespace(entity.topic, entity.type_name)
+                 for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
+        return sorted(namespace for namespace in found if namespace is not None)
+
+    def discover_players(self) -> list[str]:
+        """Namespaces of the players of recordings on the bus (found by their state topic)."""
+        found = {player.player_namespace(entity.topic, entity.type_name)
                  for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
         return sorted(namespace for namespace in found if namespace is not None)
 
@@ -172,6 +182,7 @@ class Monitor:
             source.destroy()
         self.hub.robot_commands.destroy()
         self.hub.robot_hub.destroy()
+        self.hub.player.destroy()
         self.node.destroy()
 
     def __enter__(self) -> Monitor:

@@ -71,6 +71,7 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
             with contextlib.suppress(asyncio.CancelledError):
                 await periodic
             await hub.robot_hub.detach()
+            hub.player.detach()
 
     files = files or page_files()
     exports = asyncio.Semaphore(EXPORTS_AT_ONCE)

@@ -16,7 +16,10 @@ the messages of a :class:`~cyborg.record.playback_source.Recording` on their top
   holds ``/clock`` itself (a simulator's) plays that one instead: its time is the one the
   recorded messages' stamps speak of;
 * **from a start:** ``start`` seconds into the recording; the latched topics' last messages
-  before it are published first, so the map is there at once. The same for a seek;
+  before it are published first, so the map is there at once. A seek does the same and more:
+  every other topic's last message of the :data:`RECENT` seconds before the target goes out
+  too, so a timeline that seeks while paused shows the state at that time (the robot where it
+  was, the tree's last tick), not what the other timeline left;
 * **paused, stepped, sought:** :meth:`Player.set_paused`, :meth:`Player.step` (one message,
   then paused), :meth:`Player.seek` (to seconds from the start), and the services
   ``<ns>/player/pause`` (SetBool), ``<ns>/player/step`` (Trigger) and ``<ns>/player/seek``
@@ -60,6 +63,8 @@ CLOCK_PERIOD = 0.01
 simulator's steps)."""
 QUEUE_DEPTH = 100
 """History depth of a played topic that was not latched."""
+RECENT = 2.0
+"""Seconds before a seek's target in which each topic's last message is published again."""
 
 Published = Callable[[Played, float, float], object]
 """Told of each message played: the message, when it was due and when it went out (monotonic
@@ -119,6 +124,7 @@ class Player:
         self._changed = threading.Condition()
         self._position = recording.start_ns + int(start * 1e9)
         self._seek_to: int | None = self._position
+        self._sought = False  # the next reposition is a seek: the recent state goes out too
         self._steps = 0
         self._anchor = (time.monotonic(), self._position)  # (wall, recording ns) in step
         self._upcoming: Iterator[Played] = iter(())
@@ -174,6 +180,7 @@ class Player:
                              f"{self.recording.duration:.3f} s)")
         with self._changed:
             self._seek_to = self.recording.start_ns + int(seconds * 1e9)
+            self._sought = True
             self._changed.notify_all()
 
     def wait_finished(self, timeout: float | None = None) -> bool:
@@ -265,8 +272,32 @@ class Player:
         for played in self.recording.latched_before(target):
             if played.topic in self._publishers:
                 self._send(played)
+        if self._sought:
+            self._sought = False
+            for played in self._recent_before(target):
+                self._send(played)
         self._said_state = 0.0
         self._changed.notify_all()
+
+    def _recent_before(self, target: int) -> list[Played]:
+        """Each unlatched topic's last message of the :data:`RECENT` s before ``target``."""
+        since = max(self.recording.start_ns, target - int(RECENT * 1e9))
+        last: dict[str, Played] = {}
+        if since >= target:
+            return []
+        upcoming = self.recording.messages(since)
+        try:
+            for played in upcoming:
+                if played.log_time >= target:
+                    break
+                topic = self.topics.get(played.topic)
+                if topic is not None and not topic.latched:
+                    last[played.topic] = played
+        finally:
+            close = getattr(upcoming, "close", None)
+            if close is not None:
+                close()
+        return sorted(last.values(), key=lambda played: played.log_time)
 
     def _at_end(self) -> None:
         if self.loop:

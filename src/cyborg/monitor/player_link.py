@@ -1,0 +1,246 @@
+"""The page's timeline over a played recording: the player's state out, pause/seek/step in.
+
+Owned by :class:`~cyborg.monitor.hub.Hub`; everything here runs on the web server's event loop
+except :meth:`PlayerLink.notify`, which the bus calls from its threads.
+
+* **Finding the player.** ``cyborg play`` serves the contract of
+  :mod:`cyborg.interfaces.player` under its namespace (``/`` by default). The link looks for a
+  publisher of a ``<ns>/player/state`` topic in the bus graph every half second (the hub's
+  periodic work) and follows one player at a time, the first by name (there is normally one),
+  through a :class:`~cyborg.monitor.player_source.PlayerSource`. One that left is let go, and
+  another is followed once one is there.
+* **To the pages:** ``{"t": "player", "player": {...}}`` with the played file's name,
+  ``duration``, ``position`` (s from the first message), ``rate``, ``paused``, ``finished``,
+  ``time`` (the recording's time at the position, s since the epoch), the player's ``ns`` and
+  ``jumps``; ``"player": null`` when no player is there (or it left). It goes to every page,
+  when it changed, at most once per :data:`PLAYER_INTERVAL` (the newest state goes out when
+  the interval has passed), and to a page that says hello.
+* **A jump** is the position going backwards (a seek back, a loop starting over) or a seek the
+  monitor made. The history of ticks the monitor keeps for each tree is then cleared, so it
+  never mixes two timelines, and ``jumps`` counts one more, which tells a page showing that
+  history to go back to the tree as played. (The player sends the latched topics again on a
+  seek: the tree's structure, which starts the tree's state over, and the map.)
+* **From the pages:** ``player_pause`` {``paused``: bool}, ``player_seek`` {``position``: s,
+  a finite number from 0 to the duration} and ``player_step`` {} become the player's
+  services, called in a worker thread. They need the control seat, as every command that
+  changes what the robot's side does; a refusal names the field at fault
+  (:class:`PlayerCommandError`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import math
+import time
+from collections.abc import Callable, Collection, Mapping
+from typing import Any
+
+from cyborg.monitor.client import Client
+from cyborg.monitor.off_loop import ShutdownError, in_thread
+from cyborg.monitor.player_source import Listener, PlayerError, PlayerSource
+from cyborg.monitor.robot_fields import short
+from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
+from cyborg.monitor.source import TreeSource
+
+log = logging.getLogger("cyborg.monitor")
+
+PLAYER_INTERVAL = 0.25
+"""Shortest time between two ``player`` messages (s): at most four a second."""
+BACKWARDS = 1e-3
+"""Seconds the position must go back by to count as a jump (not rounding)."""
+PLAYER_COMMANDS = ("player_pause", "player_seek", "player_step")
+"""The page's commands to the player."""
+
+MakeSource = Callable[[str, Listener], PlayerSource]
+"""``make(namespace, listener)``: follows the player under ``namespace``."""
+
+
+class PlayerCommandError(ValueError):
+    """A command to the player refused; the message says why, ``field`` which field."""
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+class PlayerLink:
+    """Connects the player on the bus to every page's timeline; see the module docstring.
+
+    ``clients`` are the hub's pages, ``seat`` its control seat and ``trees`` the tree sources
+    it follows (their histories are cleared at a jump). Players are made and found by the
+    functions given to :meth:`use` (none until then).
+    """
+
+    def __init__(self, clients: Collection[Client], seat: ControlSeat,
+                 trees: Mapping[str, TreeSource]) -> None:
+        self._clients, self._seat, self._trees = clients, seat, trees
+        self.source: PlayerSource | None = None
+        self.jumps = 0
+        self._make: MakeSource | None = None
+        self._discover: Callable[[], list[str]] = list
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._position: float | None = None
+        self._sent = ""
+        self._sent_at = -math.inf
+        self._later = False
+        self._pending = False
+
+    def use(self, make_source: MakeSource, discover: Callable[[], list[str]]) -> None:
+        """Follows players from now on: ``discover()`` lists their namespaces on the bus."""
+        self._make, self._discover = make_source, discover
+
+    def attach(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Binds the link to the server's event loop; :meth:`notify` drops changes until then."""
+        self._loop = loop
+
+    def detach(self) -> None:
+        """Lets go of the event loop as the server stops: changes are dropped from now on."""
+        self._loop = None
+
+    # ------------------------------------------------------------------ the player
+    async def periodic(self) -> None:
+        """Lets go of a player that left and follows one that is there; from the hub's loop."""
+        if self._loop is None or self._make is None:
+            return
+        try:
+            found = await in_thread(self._discover)
+        except ShutdownError:
+            return
+        source = self.source
+        if source is not None and not source.alive and source.namespace not in found:
+            self._release()
+        if self.source is None and found and self._loop is not None:
+            self.source = self._make(found[0], self.notify)
+            self._position = None
+            self._changed()
+
+    def _release(self) -> None:
+        source, self.source = self.source, None
+        if source is not None:
+            try:
+                source.destroy()
+            except Exception:
+                log.exception("could not stop following the player %s", source.namespace)
+        self._changed()
+
+    def destroy(self) -> None:
+        """Stops following the player."""
+        source, self.source = self.source, None
+        if source is not None:
+            source.destroy()
+
+    # ------------------------------------------------------------------ to the pages
+    def notify(self) -> None:
+        """Called from any thread when the player's state changed, or it came or left."""
+        loop = self._loop
+        if loop is None or loop.is_closed() or self._pending:
+            return
+        self._pending = True
+        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
+            loop.call_soon_threadsafe(self._changed)
+
+    def message(self) -> dict[str, Any]:
+        """The ``player`` message for the player's state now (``player`` null when none)."""
+        source = self.source
+        view = source.view if source is not None and source.alive else None
+        if source is None or view is None:
+            return {"t": "player", "player": None}
+        return {"t": "player", "player": {**view.wire(), "ns": source.namespace,
+                                          "jumps": self.jumps}}
+
+    def resend(self, client: Client) -> None:
+        """Sends ``client`` the player's state as the pages have it (a page saying hello)."""
+        client.send(self._sent or json.dumps(self.message(), separators=(",", ":")))
+
+    def _changed(self) -> None:
+        self._pending = False
+        source = self.source
+        view = source.view if source is not None else None
+        if view is not None:
+            if self._position is not None and view.position < self._position - BACKWARDS:
+                self._jump()
+            self._position = view.position
+        self._send_due()
+
+    def _send_due(self) -> None:
+        """Sends the newest state if it changed: now, or once :data:`PLAYER_INTERVAL` passed."""
+        wait = self._sent_at + PLAYER_INTERVAL - time.monotonic()
+        if wait > 0:
+            if not self._later and self._loop is not None:
+                self._later = True
+                self._loop.call_later(wait, self._due)
+            return
+        text = json.dumps(self.message(), separators=(",", ":"))
+        if text == self._sent:
+            return
+        self._sent, self._sent_at = text, time.monotonic()
+        for client in self._clients:
+            client.send(text)
+
+    def _due(self) -> None:
+        self._later = False
+        self._send_due()
+
+    def _jump(self) -> None:
+        """The played time jumped: the kept tick histories are cleared, the pages told."""
+        self.jumps += 1
+        for tree in list(self._trees.values()):
+            state = tree.state
+            if state is not None:
+                state.clear_history()
+
+    # ------------------------------------------------------------------ from the pages
+    async def handle(self, client: Client, kind: str, command: dict[str, Any]) -> str:
+        """Carries out a page's command to the player; the player's answer.
+
+        Raises :class:`PlayerCommandError` (naming the field) for a command that is refused
+        before the bus, and :class:`~cyborg.monitor.player_source.PlayerError` when the player
+        refuses it or does not answer.
+        """
+        if not client.may_control:
+            raise PlayerCommandError(VIEW_ONLY)
+        if not self._seat.holds(client.number):
+            raise PlayerCommandError(NOT_HOLDER)
+        source = self.source
+        view = source.view if source is not None and source.alive else None
+        if source is None or view is None:
+            raise PlayerCommandError("no recording is played: no player is on the bus "
+                                     "(start one with cyborg play)")
+        if kind == "player_pause":
+            paused = command.get("paused")
+            if not isinstance(paused, bool):
+                raise PlayerCommandError(f"paused is {short(paused)}, not true or false",
+                                         "paused")
+            return await in_thread(source.set_paused, paused)
+        if kind == "player_seek":
+            position = seek_position(command.get("position"), view.duration)
+            answer = await in_thread(source.seek, position)
+            self._jump()
+            self._position = None  # the states still on their way are of either timeline
+            self._send_due()
+            return answer
+        if kind == "player_step":
+            return await in_thread(source.step)
+        raise PlayerCommandError(f"unknown command {kind[:40]!r}", "t")
+
+
+def seek_position(value: Any, duration: float) -> float:
+    """``value`` as a position to seek to, within 0 to ``duration`` s.
+
+    :class:`PlayerCommandError` naming ``position`` otherwise.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not math.isfinite(value):
+        raise PlayerCommandError(f"position is {short(value)}, not a finite number of "
+                                 "seconds", "position")
+    if not 0 <= value <= duration:
+        raise PlayerCommandError(f"position {value} s is outside the recording (0 to "
+                                 f"{duration:.3f} s)", "position")
+    return float(value)
+
+
+__all__ = ["PLAYER_COMMANDS", "PlayerCommandError", "PlayerError", "PlayerLink",
+           "seek_position"]
