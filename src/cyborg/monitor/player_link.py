@@ -16,10 +16,12 @@ except :meth:`PlayerLink.notify`, which the bus calls from its threads.
   when it changed, at most once per :data:`PLAYER_INTERVAL` (the newest state goes out when
   the interval has passed), and to a page that says hello.
 * **A jump** is the position going backwards (a seek back, a loop starting over) or a seek the
-  monitor made. The history of ticks the monitor keeps for each tree is then cleared, so it
-  never mixes two timelines, and ``jumps`` counts one more, which tells a page showing that
-  history to go back to the tree as played. (The player sends the latched topics again on a
-  seek: the tree's structure, which starts the tree's state over, and the map.)
+  monitor made: ``jumps`` counts one more, which tells a page showing the history of ticks to
+  go back to the tree as played. The history the monitor keeps never mixes two timelines: the
+  player sends the latched topics again at a seek, the tree's structure first, and a structure
+  starts the tree's state, history and all, over (before the recent tick the player sends
+  next). A tree whose structure did not come again since the previous state has its history
+  cleared when the position goes backwards.
 * **From the pages:** ``player_pause`` {``paused``: bool}, ``player_seek`` {``position``: s,
   a finite number from 0 to the duration} and ``player_step`` {} become the player's
   services, called in a worker thread. They need the control seat, as every command that
@@ -83,6 +85,8 @@ class PlayerLink:
         self._discover: Callable[[], list[str]] = list
         self._loop: asyncio.AbstractEventLoop | None = None
         self._position: float | None = None
+        self._generations: dict[str, int] = {}
+        """Each tree's structure generation at the previous state."""
         self._sent = ""
         self._sent_at = -math.inf
         self._later = False
@@ -163,6 +167,7 @@ class PlayerLink:
             if self._position is not None and view.position < self._position - BACKWARDS:
                 self._jump()
             self._position = view.position
+            self._generations = {name: tree.generation for name, tree in self._trees.items()}
         self._send_due()
 
     def _send_due(self) -> None:
@@ -185,11 +190,11 @@ class PlayerLink:
         self._send_due()
 
     def _jump(self) -> None:
-        """The played time jumped: the kept tick histories are cleared, the pages told."""
+        """The played time jumped: the pages are told; histories not started over are cleared."""
         self.jumps += 1
-        for tree in list(self._trees.values()):
+        for name, tree in list(self._trees.items()):
             state = tree.state
-            if state is not None:
+            if state is not None and tree.generation == self._generations.get(name):
                 state.clear_history()
 
     # ------------------------------------------------------------------ from the pages
@@ -218,8 +223,7 @@ class PlayerLink:
         if kind == "player_seek":
             position = seek_position(command.get("position"), view.duration)
             answer = await in_thread(source.seek, position)
-            self._jump()
-            self._position = None  # the states still on their way are of either timeline
+            self.jumps += 1  # (its state, when it went back, clears what needs clearing)
             self._send_due()
             return answer
         if kind == "player_step":
