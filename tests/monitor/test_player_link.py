@@ -153,6 +153,12 @@ def test_the_seat_holder_pauses_seeks_and_steps_and_the_tree_and_robot_follow(
         assert state is not None
         wait_until(lambda: state.tick == 11, 20, "the step to play the tick at 1.1 s")
 
+        assert _answer(socket, {"t": "player_seek", "position": 0, "req": 6})["ok"] is True
+        # before the first message nothing of the tree has run: it starts over
+        wait_until(lambda: monitor.hub.sources[TREE].state is not state, 20, "a new state")
+        fresh = monitor.hub.sources[TREE].state
+        assert fresh is not None and fresh.tick == 0 and _status_of(monitor, "work") == 0
+
 
 @pytest.mark.parametrize(("command", "field"), [
     ({"t": "player_pause"}, "paused"),

@@ -20,8 +20,9 @@ except :meth:`PlayerLink.notify`, which the bus calls from its threads.
   go back to the tree as played. The history the monitor keeps never mixes two timelines: the
   player sends the latched topics again at a seek, the tree's structure first, and a structure
   starts the tree's state, history and all, over (before the recent tick the player sends
-  next). A tree whose structure did not come again since the previous state has its history
-  cleared when the position goes backwards.
+  next). A tree whose structure did not come again since the previous state (a seek to the
+  start, before the structure's own message) starts over when the position goes backwards:
+  nothing of it has run yet at that time.
 * **From the pages:** ``player_pause`` {``paused``: bool}, ``player_seek`` {``position``: s,
   a finite number from 0 to the duration} and ``player_step`` {} become the player's
   services, called in a worker thread. They need the control seat, as every command that
@@ -190,12 +191,11 @@ class PlayerLink:
         self._send_due()
 
     def _jump(self) -> None:
-        """The played time jumped: the pages are told; histories not started over are cleared."""
+        """The played time went back: the pages are told; trees not started over start over."""
         self.jumps += 1
         for name, tree in list(self._trees.items()):
-            state = tree.state
-            if state is not None and tree.generation == self._generations.get(name):
-                state.clear_history()
+            if tree.generation == self._generations.get(name):
+                tree.start_over()
 
     # ------------------------------------------------------------------ from the pages
     async def handle(self, client: Client, kind: str, command: dict[str, Any]) -> str:

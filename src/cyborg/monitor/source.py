@@ -89,6 +89,18 @@ class TreeSource:
         self.generation += 1
         self._tell("structure")
 
+    def start_over(self) -> None:
+        """Starts the tree's state over from its structure, as if the structure came again.
+
+        For a played recording whose time jumped back to before anything of the tree ran: no
+        status, no history of the other timeline.
+        """
+        state = self.state
+        if state is not None:
+            self.state = TreeState(state.text)
+            self.generation += 1
+            self._tell("structure")
+
     def _on_active(self, message: Any) -> None:
         state = self.state
         if state is not None:

@@ -217,11 +217,6 @@ class TreeState:
             entries = list(self.history)
         return [entry.to_json() for entry in entries]
 
-    def clear_history(self) -> None:
-        """Forgets the kept ticks (the played time jumped: they belong to another timeline)."""
-        with self._lock:
-            self.history.clear()
-
     def running_label(self) -> str:
         """The label of the node running now: the deepest node of the active path, or "".
 

@@ -14,6 +14,7 @@ import { LazyMapPanel } from "./map/lazy_panel.js";
 import { TreeModel } from "./model.js";
 import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
+import { PlayerBar } from "./player_bar.js";
 import { learnRobots, onRobotSelected, treeOfRobot } from "./robots.js";
 import { TreeView } from "./tree_view.js";
 
@@ -72,6 +73,8 @@ mapPanel.onEmpty = (empty) => layout.setMapEmpty(empty);
 new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("tree"));
 // The ticks the monitor kept, one at a time (js/history.js); `tickHistory.state` is null while live.
 const tickHistory = new History({ onShow: () => markDirty("all"), say });
+// A played recording's timeline (js/player_bar.js); a jump of the played time leaves the history.
+const playerBar = new PlayerBar({ send: (body) => command(body), onJump: () => { if (tickHistory.state) tickHistory.live(); } });
 
 // ------------------------------------------------------------------ messages
 function receive(message) {
@@ -139,6 +142,7 @@ function receive(message) {
       page.seat = message;
       if (message.secret) keepSeatSecret(message.secret);
       if (message.may_control && message.holder === null) connection.post({ t: "claim" });
+      playerBar.setSeat(message);
       toolbar();
       break;
     case "timing":
@@ -155,6 +159,9 @@ function receive(message) {
       break;
     case "history":
       tickHistory.start(message, model.version);
+      break;
+    case "player":
+      playerBar.show(message.player);
       break;
     case "manual_pause": // the monitor paused a tree before a goal sent from the map
       page.manualPause = message.tree;
