@@ -18,6 +18,7 @@ from cyborg.bus.wire import Durability, EntityKind
 from cyborg.interfaces import detector, player, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
+from cyborg.monitor.player_source import PlayerSource
 from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.source import TreeSource
 from cyborg.nav.arnl_map import read_map
@@ -236,7 +237,7 @@ def test_the_camera_serves_everything_the_detector_uses(bus: Context) -> None:
 
 
 # ---------------------------------------------------------------------- the descriptors
-def test_the_player_serves_its_state_and_services_under_its_namespace(
+def test_the_player_serves_its_state_and_services_under_its_namespace_to_the_monitor(
         bus: Context, tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     recording_file = McapFile(path, bus.types)
@@ -253,6 +254,13 @@ def test_the_player_serves_its_state_and_services_under_its_namespace(
         assert_serves(bus.graph, node, "/replay", player.TOPICS, player.SERVICES)
         assert names == {"/replay/player/state", "/replay/player/pause", "/replay/player/seek",
                          "/replay/player/step"}
+        found = [player.player_namespace(e.topic, e.type_name)
+                 for e in endpoints(bus.graph, node, SERVING)]
+        assert [name for name in found if name is not None] == ["/replay"]
+        timeline = PlayerSource(Node("monitor", "/cyborg", context=bus), "/replay", lambda: None)
+        settle(bus.graph, lambda: len(endpoints(bus.graph, "/cyborg/monitor", USING)) >= 4)
+        assert assert_client_is_served(bus.graph, "/cyborg/monitor", node) == names
+        timeline.destroy()
     finally:
         playing.close()
         recording.close()
