@@ -12,6 +12,9 @@ The rate is kept on the tree's clock: ticks are due at ``start + k / rate``. Whe
 overruns its slot the next one starts at once and the schedule restarts from there, so a slow
 tick never causes a burst of catch-up ticks. On a simulated or manual clock the runner goes as
 fast as the clock lets it, so a long mission can run faster than real time.
+
+The loop ticks anything :class:`Tickable`: a :class:`~cyborg.bt.tree.Tree`, or a machine that
+ticks one of several trees (a mode machine, :mod:`cyborg.modes`).
 """
 
 from __future__ import annotations
@@ -19,11 +22,12 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable
+from typing import Generic, Protocol, TypeVar
 
 from cyborg.bt.clock import Clock
+from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.status import RUNNING
-from cyborg.bt.tree import Tree
 
 log = logging.getLogger("cyborg.bt")
 
@@ -33,10 +37,43 @@ DEFAULT_RATE = 10.0
 """Ticks per second unless told otherwise, as in 2018."""
 
 
-class TickLoop:
-    """Ticks a :class:`~cyborg.bt.tree.Tree` at ``rate_hz`` (default 10 Hz, as in 2018)."""
+class Tickable(Protocol):
+    """What the loop ticks: a :class:`~cyborg.bt.tree.Tree`, or anything that ticks like one."""
 
-    def __init__(self, tree: Tree, *, rate_hz: float = DEFAULT_RATE,
+    @property
+    def clock(self) -> Clock:
+        """The clock the ticks are scheduled on."""
+        ...
+
+    @property
+    def hooks(self) -> TreeHooks:
+        """The hooks of the tree that ticks next (released when the loop pauses or stops)."""
+        ...
+
+    @property
+    def title(self) -> str:
+        """A name for the loop's thread."""
+        ...
+
+    def tick(self) -> TickSnapshot:
+        """Ticks once; the snapshot goes to the loop's listeners."""
+        ...
+
+    def halt(self) -> object:
+        """Halts every RUNNING node."""
+        ...
+
+
+T = TypeVar("T", bound=Tickable)
+
+
+class TickLoop(Generic[T]):
+    """Ticks a :class:`~cyborg.bt.tree.Tree` (or another :class:`Tickable`) at ``rate_hz``.
+
+    The default rate is 10 Hz, as in 2018.
+    """
+
+    def __init__(self, tree: T, *, rate_hz: float = DEFAULT_RATE,
                  clock: Clock | None = None) -> None:
         if not rate_hz > 0:
             raise ValueError(f"the tick rate must be more than 0 Hz, not {rate_hz}")
@@ -112,7 +149,7 @@ class TickLoop:
             with self._tick_lock:
                 self.tree.halt()
 
-    def replace_tree(self, tree: Tree) -> Tree:
+    def replace_tree(self, tree: T) -> T:
         """Ticks ``tree`` from the next tick on, and returns the old one, halted.
 
         The old tree's RUNNING nodes are halted (their actions cancel) and its hooks move to

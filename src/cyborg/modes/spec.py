@@ -1,0 +1,117 @@
+"""A mode machine as its file declares it, checked and resolved, before any tree is built.
+
+:func:`cyborg.modes.mode_file.read_mode_file` produces a :class:`MachineSpec`; the engine
+(:class:`cyborg.modes.machine.ModeMachine`) runs one. Every name in it has been checked: each
+mode's tree exists in its file, every ``from``, ``to`` and ``then`` names a mode, every mode can
+be reached from the initial one, and every expression parsed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from cyborg.bt.editor_format import ProjectSpec
+from cyborg.modes.conditions import Condition
+
+ANY = "*"
+"""The ``from`` of a transition that may leave every mode (but the one it leads to)."""
+
+
+@dataclass(frozen=True)
+class ModeSpec:
+    """One mode: a name and the tree that runs while the machine is in it."""
+
+    name: str
+    tree: str
+    """The tree's id in :attr:`project` (resolved from the id, title or file the file gave)."""
+    project: ProjectSpec = field(repr=False, compare=False)
+    """The behavior3editor file the tree is read from."""
+    min_dwell: float
+    """Seconds on the tree clock before a condition, event or request may leave the mode."""
+    max_time: float | None = None
+    """Seconds after which the mode is left for :attr:`then`; None: no limit."""
+    then: str | None = None
+    description: str = ""
+    line: int | None = None
+    """The line of the mode's table in the mode file."""
+
+
+@dataclass(frozen=True)
+class TransitionSpec:
+    """One way from mode to mode; exactly one trigger (``when``, ``event`` or ``on_request``)."""
+
+    number: int
+    """Its place among the file's transitions, from 1: lower numbers are tried first."""
+    sources: tuple[str, ...]
+    """The modes it may leave; ``("*",)`` for every mode but :attr:`target`."""
+    target: str
+    when: Condition | None = None
+    """Fires after a tick in which this condition on the global blackboard is true."""
+    event: str | None = None
+    """Fires when this event is published (:meth:`ModeMachine.fire_event`)."""
+    on_request: bool = False
+    """May be taken by a request (:meth:`ModeMachine.request`), the ``cyborg bt mode`` call."""
+    guard: Condition | None = None
+    """Must also be true, whatever the trigger."""
+    reason: str = ""
+    """What the transition log says when it fires (default: the trigger itself)."""
+    line: int | None = None
+
+    def leaves(self, mode: str) -> bool:
+        """Whether the transition may leave ``mode``."""
+        if self.sources == (ANY,):
+            return mode != self.target
+        return mode in self.sources
+
+    @property
+    def label(self) -> str:
+        """``transition 3 (normal → demo)``: how messages name it."""
+        sources = ", ".join(self.sources)
+        return f"transition {self.number} ({sources} → {self.target})"
+
+    @property
+    def trigger(self) -> str:
+        """The trigger in words: ``when battery.percent < 20``, ``event help``, ``request``."""
+        if self.when is not None:
+            return f"when {self.when.source}"
+        if self.event is not None:
+            return f"event {self.event}"
+        return "request"
+
+
+@dataclass(frozen=True)
+class MachineSpec:
+    """The whole machine: its modes, the initial one, its transitions in priority order."""
+
+    source: str
+    """The mode file."""
+    modes: dict[str, ModeSpec]
+    initial: str
+    transitions: tuple[TransitionSpec, ...]
+    min_dwell: float = 0.0
+    """The default dwell of modes that set none."""
+
+    def reachable(self) -> set[str]:
+        """The modes a path of transitions or timeouts leads to from :attr:`initial`."""
+        return reachable(self.initial, self.modes, self.transitions)
+
+
+def reachable(initial: str, modes: dict[str, ModeSpec],
+              transitions: tuple[TransitionSpec, ...]) -> set[str]:
+    """Modes reached from ``initial`` by any transition (condition, event, request) or ``then``.
+
+    A force reaches any mode, so it is no path: a mode only an operator can enter is a mistake
+    in the file, most often a transition forgotten.
+    """
+    seen, frontier = {initial}, [initial]
+    while frontier:
+        mode = frontier.pop()
+        following = [t.target for t in transitions if t.leaves(mode)]
+        then = modes[mode].then if mode in modes else None
+        if then is not None:
+            following.append(then)
+        for target in following:
+            if target not in seen and target in modes:
+                seen.add(target)
+                frontier.append(target)
+    return seen
