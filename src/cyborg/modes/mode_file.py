@@ -135,8 +135,11 @@ class _Reader:
             self.problem(f"'initial' names the mode {initial!r}, which is not declared"
                          f"{_suggest(initial, names)}", "initial", field="initial")
             initial = None
-        transitions = self.transitions(data.get("transitions", []), names)
-        if initial is not None and len(modes) == len(raw_modes):
+        raw_transitions = data.get("transitions", [])
+        transitions = self.transitions(raw_transitions, names)
+        whole = len(modes) == len(raw_modes) and isinstance(raw_transitions, list) \
+            and len(transitions) == len(raw_transitions)
+        if initial is not None and whole:  # else a broken transition may be the missing path
             for name in sorted(set(modes) - reachable(initial, modes, transitions)):
                 self.problem(f"mode {name!r} cannot be reached from the initial mode "
                              f"{initial!r}: no transition or 'then' leads to it", "modes", name)
