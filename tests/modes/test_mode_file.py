@@ -78,6 +78,7 @@ def test_a_good_file_resolves_every_name(tmp_path: Path) -> None:
     assert (spec.modes["demo"].max_time, spec.modes["demo"].then) == (60.0, "normal")
     assert spec.modes["demo"].line == line_of(GOOD, "[modes.demo]")
     first, second, third = spec.transitions
+    assert second.sources == ("low_battery",) and second.target == "normal"
     assert first.label == "transition 1 (normal → low_battery)"
     assert first.when is not None and first.when.source == "battery.percent < 20"
     assert third.on_request and third.guard is not None and third.line == line_of(
