@@ -105,8 +105,9 @@ class _Reader:
 
     def problem(self, message: str, *path: str | int, field: str | None = None,
                 column: int | None = None) -> None:
-        self.problems.append(Problem(printable(message), self.source, self.lines.line(*path),
-                                     column, field=field))
+        line = self.lines.line(*path) or 1  # a key missing from the file: its top
+        self.problems.append(Problem(printable(message), self.source, line, column,
+                                     field=field))
 
     # ------------------------------------------------------------------ the whole file
     def read(self, data: dict[str, Any]) -> MachineSpec | None:
@@ -167,8 +168,11 @@ class _Reader:
         for index, name in enumerate(written):
             if name in written[:index]:
                 self.problem(f"{key!r} names {name!r} twice", key, field=key)
-        sources, problems = read_sources(self.folder, list(dict.fromkeys(written)))
-        self.problems.extend(problems)
+        sources, failed = read_sources(self.folder, list(dict.fromkeys(written)))
+        for name, problems in failed.items():
+            self.problem(f"{key!r} names {name!r}, which does not load (its problems follow)",
+                         key, field=key)
+            self.problems.extend(problems)
         return sources
 
     # ------------------------------------------------------------------ modes

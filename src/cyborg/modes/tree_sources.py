@@ -33,19 +33,20 @@ class TreeSource:
     project: ProjectSpec
 
 
-def read_sources(folder: Path, written: list[str]) -> tuple[list[TreeSource], list[Problem]]:
-    """Reads every file (relative to ``folder``); the problems of those that fail to load."""
+def read_sources(folder: Path, written: list[str]
+                 ) -> tuple[list[TreeSource], dict[str, list[Problem]]]:
+    """Reads every file (relative to ``folder``); the problems of each that fails to load."""
     sources: list[TreeSource] = []
-    problems: list[Problem] = []
+    failed: dict[str, list[Problem]] = {}
     for name in written:
         path = folder / name
         try:
             project = read_project(path)
         except TreeLoadError as exc:
-            problems.extend(exc.problems)
+            failed[name] = exc.problems
             continue
         sources.append(TreeSource(name, path, project))
-    return sources, problems
+    return sources, failed
 
 
 def find_tree(sources: list[TreeSource], name: str) -> tuple[ProjectSpec, str] | str:
