@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from cyborg.bt import Problem
-from cyborg.modes import ModeFileError, read_mode_file
+from cyborg.modes import ModeFileError, parse_mode_file, read_mode_file
 from tests.modes.machines import write_modes, write_project
 
 GOOD = """\
@@ -263,3 +263,17 @@ def test_a_file_that_cannot_be_read_names_itself(tmp_path: Path) -> None:
         read_mode_file(tmp_path)
     assert caught.value.problems[0].source == str(tmp_path)
     assert "not a regular file" in str(caught.value)
+
+
+def test_a_lone_surrogate_in_the_text_is_located() -> None:
+    with pytest.raises(ModeFileError) as caught:
+        parse_mode_file('project = "a\ud800.json"\n', "odd.modes.toml")
+    problem = caught.value.problems[0]
+    assert (problem.line, problem.column) == (1, 13) and "U+D800" in problem.message
+    str(caught.value).encode("utf-8")
+
+
+def test_a_file_name_with_a_nul_character_is_refused(tmp_path: Path) -> None:
+    text = GOOD.replace('"mission.b3.json"', '"mission\\u0000.json"')
+    problem = only(tmp_path, text)
+    assert "'project' must be a file name" in problem.message and problem.line == 1

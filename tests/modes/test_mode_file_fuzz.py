@@ -23,7 +23,8 @@ from tests.modes.test_mode_file import GOOD, TREES
 _VALUES = ["1", "-1", "0", "nan", "inf", "1e400", '"x"', '""', "true", "[]", '["normal"]',
            "{}", '{ tree = "patrol" }', '"*"', '"normal"', '"low_battery"', '"demo"',
            '"patrol"', '"battery.percent <"', '"a ? b"', '"\\ud800"', "'''\nx\n'''", "[1, [2]]",
-           '"' + "(" * 60 + '"', "99999999999999999999999999"]
+           '"' + "(" * 60 + '"', "99999999999999999999999999",
+           '"a\\u0000b"', '["x", "\\u0000"]']
 _FRAGMENTS = ["[", "]", "[[", "=", '"', "'", "#", ".", "\n", "[modes.x]", "[[transitions]]",
               "[modes]", "modes = 3", "transitions = 1", "from", "to = ", "\ud800", "\x00"]
 _MUTATIONS = st.one_of(

@@ -51,6 +51,7 @@ NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*\Z")
 """Mode and event names: they appear on the command line and in the monitor."""
 _AT = re.compile(r"\(at line (\d+), column (\d+)\)")
 _COLUMN = re.compile(r"at column (\d+)")
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 class ModeFileError(TreeLoadError):
@@ -78,16 +79,22 @@ def read_mode_file(path: str | Path) -> MachineSpec:
 def parse_mode_file(text: str, source: str = "<string>",
                     folder: Path | None = None) -> MachineSpec:
     """Checks the mode file ``text``; tree files are found relative to ``folder``."""
+    surrogate = _SURROGATE.search(text)
+    if surrogate is not None:  # no file name or message could carry it
+        line = text.count("\n", 0, surrogate.start()) + 1
+        column = surrogate.start() - (text.rfind("\n", 0, surrogate.start()) + 1) + 1
+        raise ModeFileError([Problem(
+            f"the text holds a lone UTF-16 surrogate (U+{ord(surrogate.group()):04X}), which "
+            "is not a character", source, line, column)])
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         message = str(exc)
         at = _AT.search(message)
-        line = int(at.group(1)) if at else max(1, len(text.splitlines()))
-        column = int(at.group(2)) if at else None
+        where = (int(at.group(1)), int(at.group(2))) if at else (
+            max(1, len(text.splitlines())), None)
         reason = _AT.sub("", message).replace("(at end of document)", "at the end").strip()
-        raise ModeFileError([Problem(f"not valid TOML: {reason}", source, line,
-                                     column)]) from None
+        raise ModeFileError([Problem(f"not valid TOML: {reason}", source, *where)]) from None
     reader = _Reader(text, source, folder if folder is not None else Path.cwd())
     spec = reader.read(data)
     if reader.problems or spec is None:
@@ -160,8 +167,8 @@ class _Reader:
             return []
         key = "project" if project is not None else "files"
         written = [project] if project is not None else files
-        if not isinstance(written, list) or not written \
-                or not all(isinstance(item, str) and item for item in written):
+        if not isinstance(written, list) or not written or not all(
+                isinstance(item, str) and item and "\0" not in item for item in written):
             wanted = "a file name" if key == "project" else "a list of file names"
             self.problem(f"{key!r} must be {wanted}, not {shown(data[key])}", key, field=key)
             return []
