@@ -30,8 +30,16 @@ def test_independent_packages_import_only_themselves(package: str) -> None:
             assert name.startswith(f"cyborg.{package}"), f"{path} imports {name}"
 
 
+GENERATED = SOURCE / "bus" / "msgs"
+"""Message classes written by ``python3 -m cyborg.bus.codegen``, one per interface file and
+package kind (tests/bus/test_codegen.py keeps them current): they grow with the .msg and .srv
+files, not by hand, so the size rule below does not apply to them."""
+
+
 def test_modules_stay_small() -> None:
     for path in sorted(SOURCE.rglob("*.py")):
+        if path.is_relative_to(GENERATED):
+            continue
         lines = len(path.read_text().splitlines())
         assert lines <= 420, f"{path} has {lines} lines; split it"
 
@@ -41,8 +49,8 @@ ALLOWED = {"interfaces": ("cyborg.interfaces", "cyborg.bus"),
            "sim": ("cyborg.sim", "cyborg.nav", "cyborg.bus", "cyborg.interfaces"),
            "robot": ("cyborg.robot", "cyborg.bt", "cyborg.bus", "cyborg.nav.geometry",
                      "cyborg.interfaces"),
-           "runner": ("cyborg.runner", "cyborg.robot.interface", "cyborg.bt", "cyborg.bus",
-                      "cyborg.interfaces"),
+           "runner": ("cyborg.runner", "cyborg.robot.interface", "cyborg.bt", "cyborg.modes",
+                      "cyborg.bus", "cyborg.interfaces"),
            "monitor": ("cyborg.monitor", "cyborg.bus", "cyborg.bt.dot", "cyborg.bt.status",
                        "cyborg.bt.json_text", "cyborg.bt.outline", "cyborg.interfaces",
                        "cyborg.access"),
@@ -64,7 +72,8 @@ recordings (the recorder's scan and metadata names), decodes them with the bus's
 the robots by the contracts and borrows only the engine's statuses and structure outline; the
 Foxglove server relays the bus, drawing robots' maps with navigation's grid and naming tick
 statuses as the engine does; the mode machine builds one engine tree per mode and needs
-nothing but the engine (no bus: the runner puts it on the bus). The monitor and the Foxglove
+nothing but the engine (no bus: the tree runner, which may run a mode file instead of a tree
+file, puts it on the bus). The monitor and the Foxglove
 server share the access rules of ``cyborg.access``, which imports nothing else of cyborg. All
 but the contracts and the modes use the contracts."""
 

@@ -22,10 +22,11 @@ from cyborg.modes.loading import build_machine, load_machine
 from cyborg.modes.machine import ModeMachine
 from cyborg.modes.mode_file import ModeFileError, parse_mode_file, read_mode_file
 from cyborg.modes.records import Decision, ModeTick, Transition, Trigger
-from cyborg.modes.spec import ANY, MachineSpec, ModeSpec, TransitionSpec
+from cyborg.modes.spec import ANY, SCHEMA, MachineSpec, ModeSpec, TransitionSpec
 
 __all__ = [
     "ANY",
+    "SCHEMA",
     "Condition",
     "Decision",
     "MachineSpec",

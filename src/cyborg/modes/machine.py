@@ -123,6 +123,11 @@ class ModeMachine:
         """The machine's name: its mode file."""
         return self.spec.source
 
+    @property
+    def entered(self) -> float | None:
+        """The clock time at which the current mode was entered; None before the start."""
+        return self._entered
+
     def time_in_mode(self) -> float:
         """Seconds on the clock since the current mode was entered (0 before the start)."""
         return 0.0 if self._entered is None else self.clock.now() - self._entered

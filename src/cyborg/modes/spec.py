@@ -9,12 +9,15 @@ be reached from the initial one, and every expression parsed.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 from cyborg.bt.editor_format import ProjectSpec
 from cyborg.modes.conditions import Condition
 
 ANY = "*"
 """The ``from`` of a transition that may leave every mode (but the one it leads to)."""
+SCHEMA = "cyborg.modes.machine/1"
+"""The name of :meth:`MachineSpec.to_json`'s form, for monitors that draw the machine."""
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,30 @@ class MachineSpec:
     transitions: tuple[TransitionSpec, ...]
     min_dwell: float = 0.0
     """The default dwell of modes that set none."""
+
+    def to_json(self) -> dict[str, Any]:
+        """The machine as JSON, for monitors: modes with their trees, transitions in order.
+
+        ``{"schema": "cyborg.modes.machine/1", "source", "initial", "min_dwell", "modes":
+        [{"name", "tree", "title", "description", "min_dwell", "max_time", "then"}, ...],
+        "transitions": [{"number", "from": [...], "to", "trigger": "condition" | "event" |
+        "request", "when", "event", "guard", "reason"}, ...]}``; absent values are null.
+        """
+        modes = []
+        for mode in self.modes.values():
+            titles = [tree.title for tree in mode.project.trees if tree.id == mode.tree]
+            modes.append({"name": mode.name, "tree": mode.tree,
+                          "title": titles[0] if titles else mode.tree,
+                          "description": mode.description, "min_dwell": mode.min_dwell,
+                          "max_time": mode.max_time, "then": mode.then})
+        transitions = [{
+            "number": t.number, "from": list(t.sources), "to": t.target,
+            "trigger": "condition" if t.when else "event" if t.event else "request",
+            "when": t.when.source if t.when else None, "event": t.event,
+            "guard": t.guard.source if t.guard else None, "reason": t.reason or None}
+            for t in self.transitions]
+        return {"schema": SCHEMA, "source": self.source, "initial": self.initial,
+                "min_dwell": self.min_dwell, "modes": modes, "transitions": transitions}
 
     def reachable(self) -> set[str]:
         """The modes a path of transitions or timeouts leads to from :attr:`initial`."""

@@ -28,8 +28,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Generic, TypeVar
 
-from cyborg.bt import Tree, TreeLoadError
+from cyborg.bt import TreeLoadError
 from cyborg.bus.services import Responder
 
 log = logging.getLogger("cyborg.runner")
@@ -38,6 +39,8 @@ STUCK_RELOADS = 2
 """Timed-out loads that may still be running before further reloads are refused."""
 
 Answer = Callable[[Responder, bool, str], None]
+Loaded = TypeVar("Loaded")
+"""What a reload builds: a tree, or a mode machine."""
 """``answer(responder, success, message)``: reply to a reload request."""
 
 
@@ -55,14 +58,15 @@ class _Reload:
     """Answered: by the load's end, its timeout or the runner's end, whichever came first."""
 
 
-class BackgroundReloads:
+class BackgroundReloads(Generic[Loaded]):
     """Reload requests of one tree runner; see the module docstring.
 
     ``load(path)`` builds the next tree (raises :class:`~cyborg.bt.TreeLoadError`),
-    ``install(tree, path)`` makes it the running one, ``answer`` replies to a request.
+    ``install(tree, path)`` makes it the running one and says what was loaded, ``answer``
+    replies to a request.
     """
 
-    def __init__(self, load: Callable[[Path], Tree], install: Callable[[Tree, Path], object],
+    def __init__(self, load: Callable[[Path], Loaded], install: Callable[[Loaded, Path], str],
                  answer: Answer) -> None:
         self._load, self._install, self._answer = load, install, answer
         self._lock = threading.Lock()
@@ -110,7 +114,7 @@ class BackgroundReloads:
         return None
 
     def _run(self, job: _Reload) -> None:
-        tree: Tree | None = None
+        tree: Loaded | None = None
         message = ""
         try:
             tree = self._load(job.path)
@@ -128,13 +132,12 @@ class BackgroundReloads:
             self._answer(job.responder, False, message)
             return
         try:
-            self._install(tree, job.path)
+            loaded = self._install(tree, job.path)
         except Exception as exc:
             log.exception("installing the tree reloaded from %s failed", job.path)
             self._answer(job.responder, False, f"{type(exc).__name__}: {exc}")
             return
-        self._answer(job.responder, True,
-                     f"loaded {tree.title!r} ({len(tree)} nodes) from {job.path}")
+        self._answer(job.responder, True, f"loaded {loaded} from {job.path}")
 
     def _timed_out(self, job: _Reload) -> None:
         if not self._settle(job, timed_out=True):

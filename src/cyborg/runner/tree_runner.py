@@ -49,6 +49,13 @@ and caps size, nesting and node instances.
 
 **Time.** The tree ticks on the clock it is given: the wall clock, or simulated time from
 ``/clock`` (:class:`cyborg.bus.SimClock`) with ``use_sim_time``.
+
+**Modes.** Given a mode file (``*.toml``, docs/modes.md) instead of a tree file, the runner
+ticks a :class:`~cyborg.modes.ModeMachine` and serves :mod:`cyborg.interfaces.modes` as well
+(:mod:`cyborg.runner.mode_endpoints`). Everything above then concerns the current mode's tree:
+``behavior_tree`` is published again, and the per-node controls follow, whenever the mode
+changes. A reload reads the mode file again (or another mode file; a runner started on a tree
+file reloads tree files).
 """
 
 from __future__ import annotations
@@ -70,6 +77,7 @@ from cyborg.bt import (
     default_registry,
     load_tree,
 )
+from cyborg.bt.problems import Problem, TreeLoadError
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.tick_loop import DEFAULT_RATE
 from cyborg.bus import Node, SimClock
@@ -84,8 +92,10 @@ from cyborg.bus.msgs.std_msgs.msg import Bool
 from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
+from cyborg.modes import ModeMachine, Transition, load_machine
 from cyborg.robot.interface import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
+from cyborg.runner.mode_endpoints import ModeEndpoints
 from cyborg.runner.tree_control import TreeControl
 
 log = logging.getLogger("cyborg.runner")
@@ -94,6 +104,8 @@ RELOAD_TIMEOUT = 30.0
 """Seconds (wall time) a reload may take before it is answered with an error."""
 HALT_WAIT = 0.5
 """Seconds ``enable(false)`` waits for the halt before it answers (see ``set_enabled``)."""
+MODE_FILE_SUFFIX = ".toml"
+"""A file with this suffix is a mode file (docs/modes.md), any other a tree file."""
 
 
 class TreeRunnerNode:
@@ -113,13 +125,15 @@ class TreeRunnerNode:
         self.registry = registry if registry is not None else default_registry()
         self.clock = clock
         self.resources: dict[str, Any] = {ROBOT: robot} if robot is not None else {}
-        self.tree = self._load(self.path, Blackboard(resources=self.resources))
-        self.runner = TickLoop(self.tree, rate_hz=rate_hz)
+        self.ticked = self._load(self.path, Blackboard(resources=self.resources))
+        """What the loop ticks: the tree, or the mode machine of a mode file."""
+        self.runner: TickLoop[Tree | ModeMachine] = TickLoop(self.ticked, rate_hz=rate_hz)
         self._enabled = enabled
         self._active: tuple[str, ...] | None = None
         self._lock = threading.Lock()
         self._halting: threading.Thread | None = None  # halts the tree once its tick ends
-        self._reloads = BackgroundReloads(self._load_next, self._install, self._answer_reload)
+        self._reloads = BackgroundReloads(self._load_next, self._install_saying,
+                                          self._answer_reload)
         if "reload_timeout" not in node.parameters:
             node.parameters.declare("reload_timeout", float(reload_timeout), "seconds (wall "
                                     "time) a reload may take before it is answered with an "
@@ -133,14 +147,50 @@ class TreeRunnerNode:
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
+        self.modes: ModeEndpoints | None = None
+        if isinstance(self.ticked, ModeMachine):
+            self.modes = ModeEndpoints(node, self._machine)
+            self._follow(self.ticked)
         self._publish_structure()
         self._publish_enabled()
         self._thread: threading.Thread | None = None
 
+    @property
+    def tree(self) -> Tree:
+        """The tree that ticks: the runner's, or the current mode's."""
+        ticked = self.ticked
+        return ticked.tree if isinstance(ticked, ModeMachine) else ticked
+
     # ------------------------------------------------------------------ loading
-    def _load(self, path: Path, blackboard: Blackboard) -> Tree:
+    def _load(self, path: Path, blackboard: Blackboard) -> Tree | ModeMachine:
+        if path.suffix == MODE_FILE_SUFFIX:
+            return load_machine(path, registry=self.registry, clock=self.clock,
+                                blackboard=blackboard)
         return load_tree(path, tree=self.tree_choice, registry=self.registry, clock=self.clock,
                          blackboard=blackboard)
+
+    def _machine(self) -> ModeMachine:
+        ticked = self.ticked
+        assert isinstance(ticked, ModeMachine), "only a runner of a mode file serves modes"
+        return ticked
+
+    def _follow(self, machine: ModeMachine) -> None:
+        """Publishes the machine's transitions and follows its trees with the controls."""
+        machine.add_listener(self._on_transition)
+        if self.modes is not None:
+            self.modes.publish_state()
+
+    def _on_transition(self, transition: Transition) -> None:
+        machine = self.ticked
+        if not isinstance(machine, ModeMachine):
+            return
+        self.control.tree_replaced(machine.trees[transition.source],
+                                   machine.trees[transition.target])
+        with self._lock:
+            self._active = None
+        self._publish_structure()
+        if self.modes is not None:
+            self.modes.publish_transition(transition)
 
     @property
     def reload_timeout(self) -> float:
@@ -150,27 +200,41 @@ class TreeRunnerNode:
     def reload(self, path: str | Path | None = None) -> Tree:
         """Load ``path`` (default: the current file) and tick it from the next tick on.
 
-        Raises :class:`~cyborg.bt.TreeLoadError` (the old tree keeps running) on errors. This
-        waits for the load, however long it takes; the ``reload`` service does not.
+        Returns the tree that now ticks (of a mode file: the initial mode's; the machine is
+        :attr:`ticked`). Raises :class:`~cyborg.bt.TreeLoadError` (the old tree keeps running)
+        on errors. This waits for the load, however long it takes; the ``reload`` service
+        does not.
         """
         path = Path(path) if path else self.path
-        return self._install(self._load_next(path), path)
+        self._install(self._load_next(path), path)
+        return self.tree
 
-    def _load_next(self, path: Path) -> Tree:
+    def _load_next(self, path: Path) -> Tree | ModeMachine:
         """Load ``path`` as the next tree: same globals and resources as the running one."""
-        old = self.tree
-        return self._load(path, Blackboard(old.blackboard.globals,
-                                           resources=old.blackboard.resources))
+        modes = isinstance(self.ticked, ModeMachine)
+        if (path.suffix == MODE_FILE_SUFFIX) != modes:
+            kind = "a mode file (*.toml)" if modes else "a tree file"
+            raise TreeLoadError([Problem(f"this runner runs {kind}; it reloads only {kind}s",
+                                         str(path), field="file")])
+        old = self.tree.blackboard
+        return self._load(path, Blackboard(old.globals, resources=old.resources))
 
-    def _install(self, tree: Tree, path: Path) -> Tree:
+    def _install(self, ticked: Tree | ModeMachine, path: Path) -> Tree | ModeMachine:
         # between two ticks: may wait for one, so not under _lock (enable never waits on it)
-        old = self.runner.replace_tree(tree)
+        old_tree = self.tree
+        self.runner.replace_tree(ticked)
         with self._lock:
-            self.tree, self.path, self._active = tree, path, None
-        self.control.tree_replaced(old, tree)
+            self.ticked, self.path, self._active = ticked, path, None
+        tree = self.tree
+        self.control.tree_replaced(old_tree, tree)
+        if isinstance(ticked, ModeMachine):
+            self._follow(ticked)
         self._publish_structure()
-        log.info("reloaded %s: %r, %d nodes", path, tree.title, len(tree))
-        return tree
+        log.info("reloaded %s: %s", path, describe(ticked))
+        return ticked
+
+    def _install_saying(self, ticked: Tree | ModeMachine, path: Path) -> str:
+        return describe(self._install(ticked, path))
 
     # ------------------------------------------------------------------ running
     @property
@@ -302,3 +366,12 @@ class TreeRunnerNode:
     def _answer_reload(self, responder: Responder[ReloadTree_Response], success: bool,
                        message: str) -> None:
         responder.reply(ReloadTree.Response(success=success, message=message))
+
+
+def describe(ticked: Tree | ModeMachine) -> str:
+    """``'Root tree' (18 nodes)``, or ``4 modes, in 'normal' ('Patrol', 12 nodes)``."""
+    if isinstance(ticked, ModeMachine):
+        tree = ticked.tree
+        return (f"{len(ticked.trees)} modes, in {ticked.mode!r} ({tree.title!r}, "
+                f"{len(tree)} nodes)")
+    return f"{ticked.title!r} ({len(ticked)} nodes)"

@@ -151,6 +151,31 @@ class cyborg_msgs__msg__MapObject:
 
 
 @dataclass
+class cyborg_msgs__msg__ModeState:
+    """Class for cyborg_msgs/msg/ModeState."""
+
+    entered: builtin_interfaces__msg__Time
+    mode: str
+    held: bool
+    transitions: int
+    machine: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ModeState'
+
+
+@dataclass
+class cyborg_msgs__msg__ModeTransition:
+    """Class for cyborg_msgs/msg/ModeTransition."""
+
+    stamp: builtin_interfaces__msg__Time
+    from_mode: str
+    to_mode: str
+    reason: str
+    trigger: str
+    number: int
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ModeTransition'
+
+
+@dataclass
 class cyborg_msgs__msg__PlayerState:
     """Class for cyborg_msgs/msg/PlayerState."""
 
@@ -194,6 +219,8 @@ BumperState = cyborg_msgs__msg__BumperState
 GoalWithHeading = cyborg_msgs__msg__GoalWithHeading
 MapGeometry = cyborg_msgs__msg__MapGeometry
 MapObject = cyborg_msgs__msg__MapObject
+ModeState = cyborg_msgs__msg__ModeState
+ModeTransition = cyborg_msgs__msg__ModeTransition
 PlayerState = cyborg_msgs__msg__PlayerState
 Prediction = cyborg_msgs__msg__Prediction
 Predictions = cyborg_msgs__msg__Predictions

@@ -279,6 +279,40 @@ class cyborg_msgs__srv__Seek_Response:
 
 
 @dataclass
+class cyborg_msgs__srv__SetMode_Event:
+    """Class for cyborg_msgs/srv/SetMode_Event."""
+
+    info: service_msgs__msg__ServiceEventInfo
+    request: list[cyborg_msgs__srv__SetMode_Request]
+    response: list[cyborg_msgs__srv__SetMode_Response]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetMode_Event'
+
+
+@dataclass
+class cyborg_msgs__srv__SetMode_Request:
+    """Class for cyborg_msgs/srv/SetMode_Request."""
+
+    action: int
+    mode: str
+    reason: str
+    REQUEST: ClassVar[int] = 0
+    FORCE: ClassVar[int] = 1
+    HOLD: ClassVar[int] = 2
+    RELEASE: ClassVar[int] = 3
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetMode_Request'
+
+
+@dataclass
+class cyborg_msgs__srv__SetMode_Response:
+    """Class for cyborg_msgs/srv/SetMode_Response."""
+
+    success: bool
+    message: str
+    mode: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/srv/SetMode_Response'
+
+
+@dataclass
 class cyborg_msgs__srv__SetPose_Event:
     """Class for cyborg_msgs/srv/SetPose_Event."""
 
@@ -332,6 +366,9 @@ ReloadTree_Response = cyborg_msgs__srv__ReloadTree_Response
 Seek_Event = cyborg_msgs__srv__Seek_Event
 Seek_Request = cyborg_msgs__srv__Seek_Request
 Seek_Response = cyborg_msgs__srv__Seek_Response
+SetMode_Event = cyborg_msgs__srv__SetMode_Event
+SetMode_Request = cyborg_msgs__srv__SetMode_Request
+SetMode_Response = cyborg_msgs__srv__SetMode_Response
 SetPose_Event = cyborg_msgs__srv__SetPose_Event
 SetPose_Request = cyborg_msgs__srv__SetPose_Request
 SetPose_Response = cyborg_msgs__srv__SetPose_Response
@@ -388,6 +425,12 @@ Seek = ServiceType(
     "cyborg_msgs/srv/Seek",
     Seek_Request,
     Seek_Response,
+)
+
+SetMode = ServiceType(
+    "cyborg_msgs/srv/SetMode",
+    SetMode_Request,
+    SetMode_Response,
 )
 
 SetPose = ServiceType(
