@@ -17,6 +17,8 @@ that every client endpoint finds its server.
 * :mod:`~cyborg.interfaces.detector` — the camera's and the detector's topics.
 * :mod:`~cyborg.interfaces.player` — the player's state and its pause, seek and step services
   (`cyborg play` ↔ a timeline).
+* :mod:`~cyborg.interfaces.modes` — a mode machine's state, transitions, events and its
+  request/force/hold service (tree runner of a mode file ↔ ``cyborg bt mode``, monitors).
 
 **Adding to a contract.** Declare the endpoint in the module of the program that serves it,
 e.g. ``BUMPERS = Topic("bumper_state", BumperState, latched=True)`` with ``BumperState``

@@ -8,7 +8,8 @@ read-only bus parameters:
 =======================  ============================================================
 parameter                meaning (default)
 =======================  ============================================================
-``tree_file``            the behavior3editor export to run (required)
+``tree_file``            the behavior3editor export to run, or a mode file (``*.toml``,
+                         docs/modes.md) whose machine to run (required)
 ``tree``                 tree id or title (the file's selected tree)
 ``rate``                 ticks per second (:data:`RATE`, 10)
 ``use_sim_time``         tick on simulated time from ``/clock`` (false)
@@ -103,7 +104,8 @@ def start(context: Context, spec: NodeSpec, *,
     robot_node: Node | None = None
     try:
         params = node.parameters
-        tree_file = params.declare("tree_file", "", "behavior3editor export", read_only=True)
+        tree_file = params.declare("tree_file", "", "behavior3editor export or mode file",
+                                   read_only=True)
         if not tree_file:
             raise spec.error("the tree runner needs a `tree_file` parameter")
         choice = params.declare("tree", "", "tree id or title (default: selectedTree)",
@@ -140,7 +142,8 @@ def start(context: Context, spec: NodeSpec, *,
                                     registry=registry, enabled=bool(enabled))
         except TreeLoadError as exc:
             problems = "\n".join(f"  {problem}" for problem in exc.problems)
-            raise spec.error(f"the tree file has errors:\n{problems}") from exc
+            kind = "mode" if str(tree_file).endswith(".toml") else "tree"
+            raise spec.error(f"the {kind} file has errors:\n{problems}") from exc
         runner.start()
     except BaseException:
         node.destroy()
