@@ -15,7 +15,7 @@ from cyborg.bt import HookMode, Status
 from cyborg.bus import BusConfig, Context, MessageTypes, Node, Qos
 from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.wire import Durability, EntityKind
-from cyborg.interfaces import detector, player, robot, tree_runner
+from cyborg.interfaces import detector, modes, player, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
 from cyborg.monitor.player_source import PlayerSource
@@ -266,6 +266,26 @@ def test_the_player_serves_its_state_and_services_under_its_namespace_to_the_mon
         recording.close()
 
 
+def test_a_runner_of_a_mode_file_serves_the_modes_contract(bus: Context,
+                                                            tmp_path: Path) -> None:
+    write_tree(tmp_path, {"name": "Runner"}, "mission.b3.json")
+    (tmp_path / "mission.modes.toml").write_text(
+        'project = "mission.b3.json"\ninitial = "only"\n[modes.only]\ntree = "Test tree"\n')
+    runner = TreeRunnerNode(Node("tree_runner", "/cyborg/bt", context=bus),
+                            tmp_path / "mission.modes.toml", enabled=False)
+    try:
+        offered = (modes.STATE, modes.TRANSITIONS)
+        names = contract_names("/cyborg/bt", offered, modes.SERVICES)
+        node = "/cyborg/bt/tree_runner"
+        settle(bus.graph, lambda: names <= {e.topic for e in endpoints(bus.graph, node, SERVING)})
+        assert_serves(bus.graph, node, "/cyborg/bt", offered, modes.SERVICES)
+        assert_subscribes(bus.graph, node, "/cyborg/bt", [modes.EVENTS])
+        assert names == {"/cyborg/bt/mode", "/cyborg/bt/mode/transitions",
+                         "/cyborg/bt/mode/set"}
+    finally:
+        runner.destroy()
+
+
 def test_names_resolve_as_the_bus_resolves_them() -> None:
     pose = robot.POSE
     assert pose.full_name("/cyborg") == pose.full_name("cyborg/") == "/cyborg/pose"
@@ -301,9 +321,11 @@ def test_every_type_in_the_contracts_is_known() -> None:
     """The classes the descriptors carry are the bus's own, under the names the graph shows."""
     types = MessageTypes()
     for topic in (*robot.TOPICS, *robot.COMMANDS, *tree_runner.TOPICS,
-                  *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS, *player.TOPICS):
+                  *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS, *player.TOPICS,
+                  *modes.TOPICS):
         assert types.message_class(topic.type_name) is topic.message_type, topic
-    for service in (*robot.SERVICES, *tree_runner.SERVICES, *player.SERVICES):
+    for service in (*robot.SERVICES, *tree_runner.SERVICES, *player.SERVICES,
+                    *modes.SERVICES):
         assert service.type_name in types.services, service
         assert types.message_class(service.request_type) is service.service_type.Request
         assert types.message_class(service.response_type) is service.service_type.Response
@@ -342,6 +364,7 @@ def test_enums_are_the_message_definitions_constants() -> None:
     assert members(tree_runner.HookStatus) == {
         name: value for name, value in constants_of(control).items()
         if name in ("SUCCESS", "FAILURE", "RUNNING")}
+    assert members(modes.ModeAction) == constants_of(modes.SET_MODE.request_type)
     hooks = constants_of(tree_runner.HOOKS.type_name)  # the hooks topic: CLEAR is no hook
     assert hooks == {action.name: action.value for action in tree_runner.HookAction
                      if action is not tree_runner.HookAction.CLEAR}

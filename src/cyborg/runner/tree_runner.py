@@ -186,8 +186,7 @@ class TreeRunnerNode:
             return
         self.control.tree_replaced(machine.trees[transition.source],
                                    machine.trees[transition.target])
-        with self._lock:
-            self._active = None
+        self._active = None  # the next tick publishes its path (no lock: this may run in a tick)
         self._publish_structure()
         if self.modes is not None:
             self.modes.publish_transition(transition)
