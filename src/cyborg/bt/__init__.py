@@ -9,9 +9,10 @@ Load a tree exported by behavior3editor and tick it::
     print(snapshot.status, snapshot.active)
 
 Write your own nodes by subclassing :class:`Action`, :class:`Condition`, :class:`Decorator` or
-:class:`Composite` and registering them with :func:`register`. Run a tree at a fixed rate with
-:class:`TickLoop`. This package does no I/O beyond reading tree files and imports nothing
-else of cyborg.
+:class:`Composite` and registering them with :func:`register`; attach background work to
+composites with a :class:`Service` registered by :func:`register_service`. Run a tree at a
+fixed rate with :class:`TickLoop`. This package does no I/O beyond reading tree files and
+imports nothing else of cyborg.
 """
 
 from cyborg.bt.blackboard import Blackboard
@@ -39,6 +40,14 @@ from cyborg.bt.loader import check_file, load_tree, loads_tree
 from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, NodeType, default_registry, register
+from cyborg.bt.service_registry import (
+    ServiceRegistry,
+    ServiceType,
+    default_service_registry,
+    register_service,
+)
+from cyborg.bt.service_runner import ServiceRunner, ServiceState
+from cyborg.bt.services import Service, ServiceBoard, ServiceTiming
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 from cyborg.bt.tick_loop import TickLoop
@@ -85,6 +94,13 @@ __all__ = [
     "RunOnce",
     "Runner",
     "Sequence",
+    "Service",
+    "ServiceBoard",
+    "ServiceRegistry",
+    "ServiceRunner",
+    "ServiceState",
+    "ServiceTiming",
+    "ServiceType",
     "Severity",
     "Status",
     "Subtree",
@@ -99,10 +115,12 @@ __all__ = [
     "Wait",
     "check_file",
     "default_registry",
+    "default_service_registry",
     "load_tree",
     "loads_tree",
     "parse_project",
     "read_project",
     "register",
+    "register_service",
     "render_title",
 ]

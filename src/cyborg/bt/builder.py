@@ -8,6 +8,8 @@
   (nested references add more prefixes). A cycle of references is an error naming the trees.
 * Every other node is looked up in the :class:`~cyborg.bt.registry.NodeRegistry`; its
   properties are checked against the class's signature and passed to its constructor.
+* A composite's ``services`` property declares the services attached to it
+  (:mod:`cyborg.bt.service_binding`); they are returned beside the root, for the tree.
 * With ``stub_missing``, a stub stands in for each node without a class, and for each node
   whose :attr:`~cyborg.bt.node.Node.requires` names a resource the blackboard lacks.
 * The caps of :class:`~cyborg.bt.limits.Limits` hold while building. A node deeper than
@@ -33,6 +35,7 @@ from pathlib import Path
 from typing_extensions import override
 
 from cyborg.bt.blackboard import Blackboard
+from cyborg.bt.definitions_check import check_definitions
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
 from cyborg.bt.editor_v1_names import REPLACED_IN_CYBORG
 from cyborg.bt.expansion import Size, measure
@@ -42,6 +45,9 @@ from cyborg.bt.ports import bind_ports
 from cyborg.bt.problems import Problem, Severity, shown
 from cyborg.bt.properties import bind
 from cyborg.bt.registry import NodeRegistry
+from cyborg.bt.service_binding import SERVICES, attach_services, owns_services, without_services
+from cyborg.bt.service_registry import ServiceRegistry, default_service_registry
+from cyborg.bt.service_runner import ScheduledService
 from cyborg.bt.specs import choose_tree
 from cyborg.bt.status import Status
 from cyborg.bt.stubs import stub_class
@@ -78,6 +84,8 @@ class BuildResult:
     """The chosen tree's spec; ``None`` if none could be chosen."""
     problems: list[Problem]
     """Every problem found, errors and warnings; with an error, ``root`` is incomplete."""
+    services: list[ScheduledService]
+    """The services the chosen tree's composites declare (``services`` property)."""
 
 
 class _TooManyNodesError(Exception):
@@ -90,8 +98,11 @@ class _TooManyNodesError(Exception):
 
 class _Builder:
     def __init__(self, project: ProjectSpec, registry: NodeRegistry, blackboard: Blackboard,
-                 record: TickRecord, stub_missing: Status | None, limits: Limits) -> None:
+                 record: TickRecord, stub_missing: Status | None, limits: Limits,
+                 services: ServiceRegistry | None = None) -> None:
         self.project = project
+        self.service_registry = services  # made when a file first declares a service
+        self.services: list[ScheduledService] = []
         self.limits = limits
         self.count = 0
         """Node instances built so far, for ``max_nodes``."""
@@ -221,6 +232,8 @@ class _Builder:
                   tree_uid=tree_uid, subtree_depth=depth, blackboard=self.blackboard,
                   record=self.record)
         self.wire(tree, spec, node)
+        if SERVICES in spec.properties and not owns_services(type(node)):
+            self.attach(tree, spec, node)
         if len(children) == len(spec.children):
             node.adopt(children)
             for message in node.check():
@@ -251,6 +264,16 @@ class _Builder:
             for message in ignored:
                 self.report(message, tree, spec, direction, Severity.WARNING)
         node.ports = ports
+
+    def attach(self, tree: TreeSpec, spec: NodeSpec, node: Node) -> None:
+        """Attaches the services the node's ``services`` property declares (or reports)."""
+        if self.service_registry is None:
+            self.service_registry = default_service_registry()
+        attached, problems = attach_services(spec.properties[SERVICES], node,
+                                             self.service_registry, self.blackboard)
+        for message in problems:
+            self.report(message, tree, spec, SERVICES)
+        self.services.extend(attached)
 
     def reference(self, tree: TreeSpec, spec: NodeSpec, prefix: str, depth: int,
                   stack: tuple[TreeSpec, ...], outer_uid: str, level: int) -> Node | None:
@@ -302,7 +325,7 @@ class _Builder:
                         "stub stands in", tree, spec, "name", Severity.WARNING)
             same_kind = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
             return stub_class(spec, same_kind, self.stub_missing)()
-        binding = bind(node_type.signature, spec.properties)
+        binding = bind(node_type.signature, without_services(node_type.cls, spec.properties))
         for field, message in binding.warnings:
             self.report(message, tree, spec, field, Severity.WARNING)
         for field, message in binding.errors:
@@ -320,18 +343,21 @@ class _Builder:
 def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = None,
           blackboard: Blackboard | None = None, record: TickRecord | None = None,
           stub_missing: Status | None = None, check_all: bool = False,
-          limits: Limits | None = None) -> BuildResult:
+          limits: Limits | None = None, services: ServiceRegistry | None = None) -> BuildResult:
     """Builds the chosen tree (and every tree it references) into live nodes.
 
     With ``check_all`` every other tree in the project is also built, to find its problems;
     only the chosen tree is returned. Problems of both severities are in the result.
     ``limits`` (default: :meth:`Limits.resolve() <cyborg.bt.limits.Limits.resolve>`) caps
-    the depth and the number of instances of each tree built.
+    the depth and the number of instances of each tree built. ``services`` (default:
+    :func:`~cyborg.bt.service_registry.default_service_registry`) resolves the composites'
+    ``services`` declarations.
     """
     builder = _Builder(project, registry, Blackboard() if blackboard is None else blackboard,
                        TickRecord() if record is None else record,
                        stub_missing,
-                       limits if limits is not None else Limits.resolve(source=project.source))
+                       limits if limits is not None else Limits.resolve(source=project.source),
+                       services)
     builder.problems.extend(project.problems)
     chosen, reason = choose_tree(project, tree)
     root = None
@@ -340,6 +366,7 @@ def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = No
             builder.report(reason, field="selectedTree")
     else:
         root = _build_top(builder, chosen)
+    attached = list(builder.services)
     if check_all:
         # Each other tree is built once, without expanding again the subtrees built already,
         # so checking costs time in proportion to the file, not to the instances it makes.
@@ -347,8 +374,8 @@ def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = No
         for other in project.trees:
             if other.id not in builder.built:  # the chosen tree too, if it was too big
                 _build_top(builder, other)
-        _check_definitions(builder)
-    return BuildResult(root, chosen, builder.problems)
+        builder.problems.extend(check_definitions(project, registry, stub_missing is not None))
+    return BuildResult(root, chosen, builder.problems, attached)
 
 
 def _build_top(builder: _Builder, tree: TreeSpec) -> Subtree | None:
@@ -381,35 +408,6 @@ def _reach_below(tree: TreeSpec, spec: NodeSpec, reached: set[str]) -> None:
         if node_id in tree.nodes and node_id not in reached:
             reached.add(node_id)
             pending.extend(tree.nodes[node_id].children)
-
-
-def _check_definitions(builder: _Builder) -> None:
-    project = builder.project
-    # a v1 node-config file is the editor's whole palette: only the nodes used are checked
-    used = {node.name for tree in project.trees for node in tree.nodes.values()}
-    for definition in project.definitions:
-        if project.kind == "v1" and definition.name not in used:
-            continue
-        node_type = builder.registry.get(definition.name)
-        where = Problem("", definition.source or project.source, definition.line,
-                        node_title=definition.name,
-                        field="node definitions" if project.kind == "v1" else "custom_nodes")
-        if node_type is None:
-            if builder.stub_missing is None and project.kind != "v1":  # v1: an error per use
-                builder.problems.append(_at(where, f"custom node {definition.name!r} is declared "
-                                               "but no Python class is registered for it",
-                                            Severity.WARNING))
-            continue
-        if definition.category and definition.category != node_type.category.value:
-            builder.problems.append(_at(
-                where, f"custom node {definition.name!r} is declared as a {definition.category}"
-                f" but {node_type.cls.__name__} is a {node_type.category.value}",
-                Severity.WARNING))
-
-
-def _at(where: Problem, message: str, severity: Severity) -> Problem:
-    return Problem(message, where.source, where.line, None, None, None, where.node_title,
-                   where.field, severity)
 
 
 def _kwargs(kwargs: dict[str, object]) -> str:

@@ -29,6 +29,8 @@ from cyborg.bt.limits import Limits, size
 from cyborg.bt.node import TickRecord
 from cyborg.bt.problems import Problem, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, default_registry
+from cyborg.bt.service_registry import ServiceRegistry
+from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.status import Status
 from cyborg.bt.tree import Tree
 
@@ -39,14 +41,17 @@ def load_tree(source: str | Path | ProjectSpec, *, tree: str | None = None,
               registry: NodeRegistry | None = None, clock: Clock | None = None,
               blackboard: Blackboard | None = None,
               stub_missing: Status | None = None, max_bytes: int | None = None,
-              max_depth: int | None = None, max_nodes: int | None = None) -> Tree:
+              max_depth: int | None = None, max_nodes: int | None = None,
+              services: ServiceRegistry | None = None) -> Tree:
     """Loads a behavior3editor export (a path or a parsed project) into a runnable tree.
 
     ``tree`` picks a tree by id or title (default: the file's selectedTree). ``registry``
     defaults to :func:`~cyborg.bt.registry.default_registry`. ``stub_missing`` stands a stub
     returning that status in for every node without a Python class. ``max_bytes``,
     ``max_depth`` and ``max_nodes`` raise or lower the caps of :mod:`cyborg.bt.limits`
-    (``max_bytes`` does not apply to a project already parsed).
+    (``max_bytes`` does not apply to a project already parsed). ``services`` defaults to
+    :func:`~cyborg.bt.service_registry.default_service_registry`, read only when a composite
+    declares services.
     """
     limits = _limits(source, max_bytes, max_depth, max_nodes)
     project = source if isinstance(source, ProjectSpec) else read_project(source, limits=limits)
@@ -54,14 +59,15 @@ def load_tree(source: str | Path | ProjectSpec, *, tree: str | None = None,
     record = TickRecord()
     result = build(project, default_registry() if registry is None else registry, tree=tree,
                    blackboard=blackboard, record=record, stub_missing=stub_missing,
-                   limits=limits)
+                   limits=limits, services=services)
     errors = [p for p in result.problems if p.is_error]
     if errors or result.root is None or result.tree is None:
         raise TreeLoadError(result.problems)
     for problem in result.problems:
         log.warning("%s", problem)
     return Tree(result.root, record=record, blackboard=blackboard, clock=clock,
-                source=project.source, tree_id=result.tree.id, title=result.tree.title)
+                source=project.source, tree_id=result.tree.id, title=result.tree.title,
+                services=ServiceRunner(result.services) if result.services else None)
 
 
 def loads_tree(text: str, **options: object) -> Tree:
@@ -78,7 +84,7 @@ def loads_tree(text: str, **options: object) -> Tree:
 
 
 def check_file(path: str | Path, *, tree: str | None = None,
-               registry: NodeRegistry | None = None,
+               registry: NodeRegistry | None = None, services: ServiceRegistry | None = None,
                stub_missing: Status | None = None, max_bytes: int | None = None,
                max_depth: int | None = None, max_nodes: int | None = None) -> list[Problem]:
     """Every problem in a file, errors and warnings, checking *all* its trees.
@@ -92,7 +98,7 @@ def check_file(path: str | Path, *, tree: str | None = None,
     except TreeLoadError as exc:
         return exc.problems
     result = build(project, default_registry() if registry is None else registry, tree=tree,
-                   stub_missing=stub_missing, check_all=True, limits=limits)
+                   stub_missing=stub_missing, check_all=True, limits=limits, services=services)
     return result.problems
 
 

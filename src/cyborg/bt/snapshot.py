@@ -18,6 +18,7 @@ from cyborg.bt.status import Status
 
 if TYPE_CHECKING:
     from cyborg.bt.node import Node
+    from cyborg.bt.service_runner import ScheduledService, ServiceState
     from cyborg.bt.tree import Tree
 
 SCHEMA = "cyborg.bt.structure/1"
@@ -27,11 +28,12 @@ class TickSnapshot:
     """The result of one tick: root status, nodes visited with their status, active path."""
 
     __slots__ = ("_active", "_durations", "_halted", "_halted_ids", "_running", "_statuses",
-                 "_visited", "_visits", "duration", "status", "tick", "time")
+                 "_visited", "_visits", "duration", "services", "status", "tick", "time")
 
     def __init__(self, tick: int, time: float, duration: float, status: Status,
                  visits: list[tuple[Node, Status]], running: list[Node],
-                 halted: list[Node], durations: dict[int, float] | None = None) -> None:
+                 halted: list[Node], durations: dict[int, float] | None = None,
+                 services: tuple[ServiceState, ...] | None = None) -> None:
         self.tick = tick
         """Tick number, from 1."""
         self.time = time
@@ -40,6 +42,10 @@ class TickSnapshot:
         """Wall time the tick took, in seconds."""
         self.status = status
         """The root's status."""
+        self.services = services
+        """After the tick, each service attached to a composite: whether it runs, when it
+        last ran, what it wrote (:class:`~cyborg.bt.service_runner.ServiceState`); ``None``
+        when the tree has no services."""
         self._visits = visits
         self._running = running
         self._halted = halted
@@ -107,9 +113,11 @@ class TickSnapshot:
     def to_json(self) -> dict[str, Any]:
         """The tick as a JSON-ready dict, with statuses as lower-case names.
 
-        Its keys: ``{"tick", "time", "duration", "status", "visited", "active", "halted"}``.
+        Its keys: ``{"tick", "time", "duration", "status", "visited", "active", "halted"}``,
+        and ``"services"`` (each :meth:`ServiceState.to_json
+        <cyborg.bt.service_runner.ServiceState.to_json>`) when the tree has services.
         """
-        return {
+        data: dict[str, Any] = {
             "tick": self.tick,
             "time": self.time,
             "duration": self.duration,
@@ -118,6 +126,9 @@ class TickSnapshot:
             "active": self.active,
             "halted": self.halted,
         }
+        if self.services is not None:
+            data["services"] = [state.to_json() for state in self.services]
+        return data
 
     def __repr__(self) -> str:
         return (f"<TickSnapshot tick={self.tick} status={self.status.name} "
@@ -141,14 +152,20 @@ class TreeStructure:
     @classmethod
     def of(cls, tree: Tree) -> TreeStructure:
         """The structure of ``tree``, its nodes walked without recursion."""
-        return cls(_describe(tree.root), tree.tree_id, tree.title, tree.source, len(tree.nodes))
+        attached: dict[Node, list[ScheduledService]] = {}
+        for scheduled in tree.services.services if tree.services is not None else ():
+            attached.setdefault(scheduled.composite, []).append(scheduled)
+        return cls(_describe(tree.root, attached), tree.tree_id, tree.title, tree.source,
+                   len(tree.nodes))
 
     def to_json(self) -> dict[str, Any]:
         """The JSON form, schema ``cyborg.bt.structure/1``, as JSON-ready nested dicts.
 
         ``{"schema", "tree_id", "title", "source", "node_count", "root"}``; each node is
         ``{"id", "node_id", "name", "title", "label", "category", "depth", "index",
-        "properties", "children"}`` and tree nodes add ``"tree_id"``.
+        "properties", "children"}``; tree nodes add ``"tree_id"`` and composites carrying
+        services add ``"services"``: ``[{"name", "declaration", "interval", "deviation",
+        "restart_on_activation", "run_on_activation"}]``, in declaration order.
         """
         return {
             "schema": SCHEMA,
@@ -160,21 +177,21 @@ class TreeStructure:
         }
 
 
-def _describe(root: Node) -> dict[str, Any]:
+def _describe(root: Node, attached: dict[Node, list[ScheduledService]]) -> dict[str, Any]:
     """The nested entries of ``root`` and its descendants, built without recursion."""
-    top = _entry(root)
+    top = _entry(root, attached)
     pending = [(root, top)]
     while pending:
         node, entry = pending.pop()
         children = entry["children"]
         for child in node.children:
-            child_entry = _entry(child)
+            child_entry = _entry(child, attached)
             children.append(child_entry)
             pending.append((child, child_entry))
     return top
 
 
-def _entry(node: Node) -> dict[str, Any]:
+def _entry(node: Node, attached: dict[Node, list[ScheduledService]]) -> dict[str, Any]:
     """One node's entry, its ``children`` still empty."""
     entry: dict[str, Any] = {
         "id": node.uid,
@@ -190,5 +207,10 @@ def _entry(node: Node) -> dict[str, Any]:
     tree_id = getattr(node, "tree_id", None)
     if tree_id is not None:
         entry["tree_id"] = tree_id
+    services = attached.get(node)
+    if services:
+        entry["services"] = [{"name": scheduled.service.name,
+                              "declaration": scheduled.declaration,
+                              **scheduled.timing.to_json()} for scheduled in services]
     entry["children"] = []
     return entry

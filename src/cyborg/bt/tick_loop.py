@@ -15,17 +15,24 @@ fast as the clock lets it, so a long mission can run faster than real time.
 
 The loop ticks anything :class:`Tickable`: a :class:`~cyborg.bt.tree.Tree`, or a machine that
 ticks one of several trees (a mode machine, :mod:`cyborg.modes`).
+
+Between two ticks the loop also runs the tree's services (:mod:`cyborg.bt.service_runner`):
+when one is due before the next tick, it sleeps until then on the same clock, runs the due
+services in the ticking thread, and goes back to sleep, so a service's interval holds even
+when it is shorter than the tick period. While paused, services do not run either.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import threading
 from collections.abc import Callable
 from typing import Generic, Protocol, TypeVar
 
 from cyborg.bt.clock import Clock
 from cyborg.bt.hooks import TreeHooks
+from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.status import RUNNING
 
@@ -53,6 +60,11 @@ class Tickable(Protocol):
     @property
     def title(self) -> str:
         """A name for the loop's thread."""
+        ...
+
+    @property
+    def services(self) -> ServiceRunner | None:
+        """The services of the tree that ticks next, run between ticks; None when it has none."""
         ...
 
     def tick(self) -> TickSnapshot:
@@ -212,10 +224,26 @@ class TickLoop(Generic[T]):
                 before, now = now, clock.now()
                 if due < now or now < before:  # overran, or the clock went back (a restarted
                     anchor, slot, due = now, 0, now  # simulation): restart the schedule
-                clock.sleep_until(due, self._wake)
+                self._sleep_until(due)
         finally:
             with self._tick_lock:
                 self.tree.halt()
+
+    def _sleep_until(self, due: float) -> None:
+        """Sleeps until the tick due at ``due``, running the services due before it."""
+        clock, wake = self.clock, self._wake
+        while not wake.is_set():
+            services = self.tree.services
+            next_run = math.inf if services is None else services.next_due()
+            if next_run >= due:
+                break
+            clock.sleep_until(next_run, wake)
+            if wake.is_set():
+                return
+            with self._tick_lock:
+                if self.tree.services is services and services is not None:
+                    services.run_due(clock.now())
+        clock.sleep_until(due, wake)
 
     def _tick(self) -> TickSnapshot:
         with self._tick_lock:

@@ -9,6 +9,10 @@ The same pass also halts a node left RUNNING under a parent that itself complete
 composite that forgot its child), so an abandoned action can always cancel what it started.
 Every tick returns a :class:`~cyborg.bt.snapshot.TickSnapshot`.
 
+**Services.** When composites carry services (:mod:`cyborg.bt.services`), :attr:`Tree.services`
+runs them: due ones before each tick, activations and deactivations after it and on
+:meth:`Tree.halt`. A tree without services pays one test per tick for this.
+
 **Timing.** ``Tree(..., timing=True)``, or ``tree.timing = True`` at any time from any thread,
 makes every tick from the next one on record each visit's wall time in its snapshot
 (:attr:`~cyborg.bt.snapshot.TickSnapshot.visit_durations`); a change is applied when a tick
@@ -24,6 +28,7 @@ from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.clock import Clock, MonotonicClock
 from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.node import Node, TickRecord
+from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
 from cyborg.bt.status import RUNNING, Status
 
@@ -33,7 +38,8 @@ class Tree:
 
     def __init__(self, root: Node, *, record: TickRecord, blackboard: Blackboard,
                  clock: Clock | None = None, source: str = "", tree_id: str = "",
-                 title: str = "", timing: bool = False) -> None:
+                 title: str = "", timing: bool = False,
+                 services: ServiceRunner | None = None) -> None:
         self.root = root
         self.blackboard = blackboard
         self.clock: Clock = clock or MonotonicClock()
@@ -51,6 +57,8 @@ class Tree:
             node.index = index
         self.by_uid: dict[str, Node] = {node.uid: node for node in self.nodes}
         self._structure: TreeStructure | None = None
+        self.services = services
+        """Runs the services attached to composites; ``None`` when the tree has none."""
         self.hooks = TreeHooks(self.nodes, self)
         """Per-node control: disable, force, breakpoints (see :mod:`cyborg.bt.hooks`)."""
         self._timing = False  # what the nodes do now
@@ -105,6 +113,9 @@ class Tree:
         record.visits, record.running, record.halted = visits, running, halted
         record.durations = durations
         started = perf_counter()
+        services = self.services
+        if services is not None:
+            services.run_due(now)
         status = self.root.execute()
         previous = self._running
         if previous:
@@ -120,9 +131,12 @@ class Tree:
             if halted:
                 running = [node for node in running if node.status is RUNNING]
         self._running = running
+        if services is not None:
+            services.after_tick(running, halted, now)
         self.ticks = ticks = self.ticks + 1
-        self.last = snapshot = TickSnapshot(ticks, now, perf_counter() - started, status,
-                                            visits, running, halted, durations)
+        self.last = snapshot = TickSnapshot(
+            ticks, now, perf_counter() - started, status, visits, running, halted, durations,
+            None if services is None else services.states())
         return snapshot
 
     def halt(self) -> list[Node]:
@@ -132,19 +146,26 @@ class Tree:
         record.halted = halted
         self.root.halt()
         self._running = []
+        if self.services is not None:
+            self.services.stop_all(self.clock.now())
         return halted
 
     def missing_resources(self) -> dict[str, list[Node]]:
         """Resource key -> the nodes that need it but find none in the blackboard's resources.
 
-        A node needs the keys of its :attr:`Node.requires <cyborg.bt.node.Node.requires>`. The
-        dict is empty when every node has what it needs.
+        A node needs the keys of its :attr:`Node.requires <cyborg.bt.node.Node.requires>`, and
+        a composite those of its services' ``requires``. The dict is empty when every node has
+        what it needs.
         """
         missing: dict[str, list[Node]] = {}
         for node in self.nodes:
             for key in node.requires:
                 if key not in self.blackboard.resources:
                     missing.setdefault(key, []).append(node)
+        for scheduled in self.services.services if self.services is not None else ():
+            for key in scheduled.service.requires:  # a service needs it: its composite does
+                if key not in self.blackboard.resources:
+                    missing.setdefault(key, []).append(scheduled.composite)
         return missing
 
     @property

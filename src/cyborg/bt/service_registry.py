@@ -1,0 +1,167 @@
+"""The service registry: which Python class implements each service name in the editor.
+
+Services are registered as nodes are (:mod:`cyborg.bt.registry`), in a registry of their own:
+
+    @register_service("BatteryWatch")      # default: the class name
+    class BatteryWatch(Service): ...
+
+Another package adds services without being imported by hand, by declaring an entry point in
+the group ``cyborg.services`` (in its ``pyproject.toml``)::
+
+    [project.entry-points."cyborg.services"]
+    my_services = "my_package.services"            # a module: its @register_service lines
+    Watch = "my_package.services:Watch"            # or one class, under the entry's name
+
+:func:`default_service_registry` holds everything registered with the decorator and every
+entry point's services. A tree file names services only in composites' ``services``
+property, so the registry is read only when a file declares one.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import logging
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, TypeVar, overload
+
+from cyborg.bt.properties import Signature, signature_of
+from cyborg.bt.services import Service
+
+SERVICE_ENTRY_POINT_GROUP = "cyborg.services"
+
+S = TypeVar("S", bound=type[Service])
+
+
+@dataclass(frozen=True)
+class ServiceType:
+    """A registered service: its editor name, implementing class and options."""
+
+    name: str
+    cls: type[Service]
+    signature: Signature
+    """Its own options, from its ``__init__``; the common options come beside them."""
+    origin: str
+    """Where it came from: a module name, or ``entry point <name>``."""
+
+
+class ServiceRegistry:
+    """Maps editor service names to service classes."""
+
+    def __init__(self) -> None:
+        self._types: dict[str, ServiceType] = {}
+
+    def add(self, cls: type[Service], name: str | None = None, *,
+            origin: str = "") -> ServiceType:
+        """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
+
+        Raises :class:`TypeError` for a class that is not a :class:`Service`,
+        :class:`ValueError` for a name that is not an identifier (a declaration could not
+        name it).
+        """
+        if not (inspect.isclass(cls) and issubclass(cls, Service)):
+            raise TypeError(f"{cls!r} is not a Service subclass")
+        key = name if name is not None else cls.__name__
+        if not key.isidentifier():
+            raise ValueError(f"a service name is letters, digits and '_' (not starting with a "
+                             f"digit), so a declaration can name it; not {key!r}")
+        service_type = ServiceType(key, cls, signature_of(cls), origin or cls.__module__)
+        self._types[key] = service_type
+        return service_type
+
+    def get(self, name: str) -> ServiceType | None:
+        """The service registered under ``name``, or ``None``."""
+        return self._types.get(name)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._types
+
+    def names(self) -> list[str]:
+        """All registered names, sorted."""
+        return sorted(self._types)
+
+    def copy(self) -> ServiceRegistry:
+        """An independent registry with the same entries (for adding services locally)."""
+        other = ServiceRegistry()
+        other._types = dict(self._types)
+        return other
+
+    def load_entry_points(self, group: str = SERVICE_ENTRY_POINT_GROUP) -> list[str]:
+        """Registers the services of every installed entry point in ``group``.
+
+        Returns a message for each entry point that could not be loaded (they are skipped).
+        Services that a loaded module registers with the decorator are added too.
+        """
+        problems = []
+        for entry in entry_points(group=group):
+            try:
+                loaded = entry.load()
+            except Exception as exc:
+                problems.append(f"entry point {entry.name!r} ({entry.value}): "
+                                f"{type(exc).__name__}: {exc}")
+                continue
+            if inspect.isclass(loaded) and issubclass(loaded, Service):
+                self.add(loaded, entry.name, origin=f"entry point {entry.name}")
+            elif not inspect.ismodule(loaded):
+                problems.append(f"entry point {entry.name!r} ({entry.value}) is neither a "
+                                "module nor a Service subclass")
+        self._take_registered()
+        return problems
+
+    def import_modules(self, modules: Iterable[str]) -> None:
+        """Imports modules whose ``@register_service`` lines add services.
+
+        Raises :class:`ImportError` naming the first module that cannot be imported.
+        """
+        for module in modules:
+            try:
+                importlib.import_module(module)
+            except Exception as exc:
+                raise ImportError(f"cannot import service module {module!r}: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+        self._take_registered()
+
+    def _take_registered(self) -> None:
+        if self is not _REGISTERED:
+            self._types.update({key: value for key, value in _REGISTERED._types.items()
+                                if key not in self._types})
+
+
+_REGISTERED = ServiceRegistry()
+"""Where :func:`register_service` puts services; :func:`default_service_registry` starts
+from it."""
+
+
+@overload
+def register_service(name: S, /) -> S: ...
+@overload
+def register_service(name: str | None = None, /) -> Callable[[S], S]: ...
+def register_service(name: Any = None, /) -> Any:
+    """Class decorator: makes a service available to declarations under ``name``.
+
+    ``name`` defaults to the class name; ``@register_service`` works without parentheses too.
+    """
+    if inspect.isclass(name) and issubclass(name, Service):
+        _REGISTERED.add(name)
+        return name
+
+    def decorate(cls: S) -> S:
+        _REGISTERED.add(cls, name)
+        return cls
+
+    return decorate
+
+
+def default_service_registry(*, entry_points: bool = True) -> ServiceRegistry:
+    """A new registry of every service a tree may declare.
+
+    It holds every ``@register_service``-ed service and, with ``entry_points``, those of
+    installed entry points (one that cannot be loaded is logged and skipped).
+    """
+    registry = _REGISTERED.copy()
+    if entry_points:
+        for problem in registry.load_entry_points():
+            logging.getLogger("cyborg.bt").warning("skipping service %s", problem)
+    return registry
