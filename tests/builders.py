@@ -21,6 +21,7 @@ from cyborg.bt import (
     Decorator,
     ManualClock,
     NodeRegistry,
+    ServiceRegistry,
     Status,
     Tree,
     default_registry,
@@ -118,12 +119,13 @@ def project_json(trees: list[dict[str, Any]], selected: str | None = None) -> st
 
 
 def tree_from(spec: N, *, clock: ManualClock | None = None,
-              reg: NodeRegistry | None = None) -> Tree:
+              reg: NodeRegistry | None = None, services: ServiceRegistry | None = None,
+              resources: dict[str, Any] | None = None) -> Tree:
     """A live tree for `spec`, on a ManualClock at 0 unless given, with an `events` list."""
     reg = reg or registry()
     text = json.dumps(tree_json(spec, reg=reg), indent=2)
-    return loads_tree(text, registry=reg, clock=clock or ManualClock(),
-                      blackboard=Blackboard({"events": []}))
+    return loads_tree(text, registry=reg, clock=clock or ManualClock(), services=services,
+                      blackboard=Blackboard({"events": []}, resources=resources))
 
 
 def events(tree: Tree) -> list[tuple[str, str]]:

@@ -63,8 +63,10 @@ def attach_services(declaration: Any, composite: Node, registry: ServiceRegistry
     With any problem, no service is returned: nothing of a bad declaration runs.
     """
     if composite.category is not Category.COMPOSITE:
+        category = composite.category.value
+        article = "an" if category[0] in "aeiou" else "a"
         return [], [f"services attach to composites only (Sequence, Priority, Parallel, ...); "
-                    f"this node is a {composite.category.value}: move the property to the "
+                    f"{composite.name} is {article} {category}: move the property to the "
                     "composite above it"]
     if not isinstance(declaration, str):
         return [], [f"the services property is text such as \"BatteryWatch(interval=1.0); "

@@ -87,6 +87,14 @@ class ScheduledService:
         self.error: str | None = None
         self._last_exception: tuple[type, tuple[Any, ...]] | None = None
 
+    def after(self, time: float) -> float:
+        """The due time one interval after ``time``, rounded to the nanosecond.
+
+        The rounding keeps sums of intervals such as 0.1 from drifting past the tick they
+        are meant to fall on (twenty of them make 2.0, not 2.0000000000000004).
+        """
+        return round(time + self.interval(), 9)
+
     def interval(self) -> float:
         """One interval, with the deviation drawn when there is one."""
         timing = self.timing
@@ -98,7 +106,7 @@ class ScheduledService:
         """Starts the service: the timer, :meth:`Service.on_activate`, the activation run."""
         self.active = True
         if self.timing.restart_on_activation or self.due == math.inf:
-            self.due = now + self.interval()
+            self.due = self.after(now)
         if self._call("on_activate", now) and self.timing.run_on_activation:
             self._run(now)
 
@@ -106,8 +114,8 @@ class ScheduledService:
         """Runs the service once if its time has come, and sets the next due time."""
         if now < self.due:
             return
-        due = self.due + self.interval()
-        self.due = due if due > now else now + self.interval()
+        due = self.after(self.due)
+        self.due = due if due > now else self.after(now)
         self._run(now)
 
     def deactivate(self, now: float) -> None:
