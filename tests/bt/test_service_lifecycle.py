@@ -284,3 +284,26 @@ def test_a_node_class_with_its_own_services_parameter_keeps_it() -> None:
     assert tree.services is None
     announce = next(node for node in tree if isinstance(node, Announce))
     assert announce.services == "taxi; bus"
+
+
+def test_a_composite_halted_and_entered_again_in_one_tick_restarts_its_services() -> None:
+    from cyborg.bt import Decorator, Status
+
+    class Restart(Decorator):
+        """Halts a RUNNING child and ticks it afresh, in the same tick."""
+
+        def tick(self) -> Status:
+            if self.child.status is RUNNING:
+                self.child.halt()
+            return self.child.execute()
+
+    reg = registry()
+    reg.add(Restart)
+    spec = N("Restart", N("Sequence", N("Runner"), id="seq", services="Probe"))
+    text = json.dumps(tree_json(spec, reg=reg))
+    tree = loads_tree(text, registry=reg, clock=ManualClock(), services=probe_registry())
+    tree.blackboard.resources[LOG] = []
+    tree.tick()
+    tree.tick()
+    assert [event for event, _, _ in _events(tree)] == ["on_activate", "on_deactivate",
+                                                         "on_activate"]
