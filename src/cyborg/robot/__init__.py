@@ -14,15 +14,20 @@ BlackboardCompare{key,    decorator   tick the child when a blackboard entry mat
 value,equal}
 ========================  ==========  =====================================================
 
+Two services (:mod:`cyborg.robot.watch_services`) keep the robot's state in the blackboard while
+the composite they are attached to runs: ``BatteryWatch{key,low}`` (the battery reading) and
+``ClosestGoal{key}`` (the closest goal by path length).
+
 They act on the robot through :class:`~cyborg.robot.interface.Robot` (see that module); the tree
 runner (:mod:`cyborg.runner.tree_runner`) provides one on the bus. This package is an entry
-point of the group ``cyborg.nodes``, so every registry built with
-:func:`cyborg.bt.default_registry` knows these nodes — a user's own package adds nodes the same
+point of the groups ``cyborg.nodes`` and ``cyborg.services``, so every registry built with
+:func:`cyborg.bt.default_registry` (:func:`cyborg.bt.default_service_registry`) knows these nodes
+(services) — a user's own package adds nodes the same
 way (see the README).
 """
 
-from cyborg.robot import battery, blackboard_compare, docking, goals, move_to
+from cyborg.robot import battery, blackboard_compare, docking, goals, move_to, watch_services
 from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
 
 __all__ = ["ROBOT", "Robot", "RobotError", "battery", "blackboard_compare", "docking", "goals",
-           "move_to", "robot_of"]
+           "move_to", "robot_of", "watch_services"]
