@@ -175,6 +175,9 @@ class ServiceRunner:
         self._active: list[Node] = []
         """Composites whose services are activated, outermost first."""
         self._states: tuple[ServiceState, ...] | None = None
+        self._changed = True
+        """Whether a service started or stopped since :meth:`states` was last built (a
+        service writes only while active, so only active ones need a look besides)."""
 
     def of(self, composite: Node) -> list[ScheduledService]:
         """The services attached to ``composite`` (empty for any other node)."""
@@ -187,6 +190,8 @@ class ServiceRunner:
 
     def after_tick(self, running: list[Node], halted: list[Node], now: float) -> None:
         """Ends the activations the tick ended, then starts those it began."""
+        if not (running or self._active):
+            return
         if self._active:
             ended = set(halted) if halted else ()
             for composite in reversed(list(self._active)):  # innermost first
@@ -207,6 +212,8 @@ class ServiceRunner:
 
         A composite found no longer RUNNING (halted outside a tick) is deactivated instead.
         """
+        if not self._active:
+            return
         for composite in list(self._active):
             if composite.status is not RUNNING:
                 self._deactivate(composite, now)
@@ -225,27 +232,34 @@ class ServiceRunner:
         return due
 
     def states(self) -> tuple[ServiceState, ...]:
-        """Every attached service's state, in tree order; rebuilt only after a change."""
-        changed = False
-        for scheduled in self.services:
-            if scheduled.board.changed:
-                scheduled.board.changed = False
-                changed = True
+        """Every attached service's state, in tree order; rebuilt only after a change.
+
+        While no service is active this costs a test, however many are attached.
+        """
+        changed = self._changed
+        for composite in self._active:
+            for scheduled in self._by_node[composite]:
+                if scheduled.board.changed:
+                    scheduled.board.changed = False
+                    changed = True
         if changed or self._states is None:
+            self._changed = False
+            for scheduled in self.services:
+                scheduled.board.changed = False
             self._states = tuple(scheduled.state() for scheduled in self.services)
         return self._states
 
     def _activate(self, composite: Node, now: float) -> None:
         self._active.append(composite)
         self._active.sort(key=_index)
+        self._changed = True
         for scheduled in self._by_node[composite]:
-            scheduled.board.changed = True
             scheduled.activate(now)
 
     def _deactivate(self, composite: Node, now: float) -> None:
         self._active.remove(composite)
+        self._changed = True
         for scheduled in reversed(self._by_node[composite]):
-            scheduled.board.changed = True
             scheduled.deactivate(now)
 
 
