@@ -123,3 +123,21 @@ def test_a_tree_without_a_robot_names_the_composite_and_stops_the_service(
     assert "service BatteryWatch on composite top" in caplog.text
     assert snapshot.services is not None and not snapshot.services[0].active
     assert "needs a robot to watch" in (snapshot.services[0].error or "")
+
+
+def test_without_a_robot_stubs_leave_the_services_out_with_a_warning(
+        caplog: pytest.LogCaptureFixture) -> None:
+    import json
+
+    from cyborg.bt import RUNNING
+
+    text = json.dumps(tree_json(N("Sequence", N("Runner"), id="top",
+                                  services="BatteryWatch; ClosestGoal")))
+    plain = loads_tree(text, registry=registry(),
+                       services=default_service_registry(entry_points=False))
+    assert [node.uid for node in plain.missing_resources()[ROBOT]] == ["top"]  # named once
+    with caplog.at_level(logging.WARNING, logger="cyborg.bt"):
+        stubbed = loads_tree(text, registry=registry(), stub_missing=RUNNING,
+                             services=default_service_registry(entry_points=False))
+    assert stubbed.services is None and stubbed.missing_resources() == {}
+    assert "service 'ClosestGoal' needs a 'robot' resource and this tree has none" in caplog.text

@@ -34,6 +34,7 @@ from pathlib import Path
 
 from typing_extensions import override
 
+from cyborg.bt import service_binding as attaching
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.definitions_check import check_definitions
 from cyborg.bt.editor_format import NodeDefinition, NodeSpec, ProjectSpec, TreeSpec
@@ -45,7 +46,6 @@ from cyborg.bt.ports import bind_ports
 from cyborg.bt.problems import Problem, Severity, shown
 from cyborg.bt.properties import bind
 from cyborg.bt.registry import NodeRegistry
-from cyborg.bt.service_binding import SERVICES, attach_services, owns_services, without_services
 from cyborg.bt.service_registry import ServiceRegistry, default_service_registry
 from cyborg.bt.service_runner import ScheduledService
 from cyborg.bt.specs import choose_tree
@@ -232,7 +232,7 @@ class _Builder:
                   tree_uid=tree_uid, subtree_depth=depth, blackboard=self.blackboard,
                   record=self.record)
         self.wire(tree, spec, node)
-        if SERVICES in spec.properties and not owns_services(type(node)):
+        if attaching.SERVICES in spec.properties and not attaching.owns_services(type(node)):
             self.attach(tree, spec, node)
         if len(children) == len(spec.children):
             node.adopt(children)
@@ -269,10 +269,14 @@ class _Builder:
         """Attaches the services the node's ``services`` property declares (or reports)."""
         if self.service_registry is None:
             self.service_registry = default_service_registry()
-        attached, problems = attach_services(spec.properties[SERVICES], node,
-                                             self.service_registry, self.blackboard)
+        attached, problems = attaching.attach_services(spec.properties[attaching.SERVICES], node,
+                                                       self.service_registry, self.blackboard)
         for message in problems:
-            self.report(message, tree, spec, SERVICES)
+            self.report(message, tree, spec, attaching.SERVICES)
+        if self.stub_missing is not None:  # as nodes get stubs: left out, with a warning
+            attached, left_out = attaching.without_unprovided(attached, self.blackboard.resources)
+            for message in left_out:
+                self.report(message, tree, spec, attaching.SERVICES, Severity.WARNING)
         self.services.extend(attached)
 
     def reference(self, tree: TreeSpec, spec: NodeSpec, prefix: str, depth: int,
@@ -325,7 +329,8 @@ class _Builder:
                         "stub stands in", tree, spec, "name", Severity.WARNING)
             same_kind = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
             return stub_class(spec, same_kind, self.stub_missing)()
-        binding = bind(node_type.signature, without_services(node_type.cls, spec.properties))
+        properties = attaching.without_services(node_type.cls, spec.properties)
+        binding = bind(node_type.signature, properties)
         for field, message in binding.warnings:
             self.report(message, tree, spec, field, Severity.WARNING)
         for field, message in binding.errors:

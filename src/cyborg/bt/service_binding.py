@@ -88,6 +88,25 @@ def attach_services(declaration: Any, composite: Node, registry: ServiceRegistry
     return ([] if problems else attached), problems
 
 
+def without_unprovided(attached: list[ScheduledService], resources: dict[str, Any]
+                       ) -> tuple[list[ScheduledService], list[str]]:
+    """The services whose required resources are all there, and a warning for each other.
+
+    For a tree loaded with stubs for what it lacks (``stub_missing``): a service that needs
+    the robot is left out of a tree that has none, as a node that needs it is stubbed.
+    """
+    kept: list[ScheduledService] = []
+    warnings: list[str] = []
+    for scheduled in attached:
+        absent = [key for key in scheduled.service.requires if key not in resources]
+        if absent:
+            warnings.append(f"service {scheduled.service.name!r} needs a {absent[0]!r} resource "
+                            "and this tree has none; it is left out")
+        else:
+            kept.append(scheduled)
+    return kept, warnings
+
+
 def _make(call: ServiceCall, service_type: ServiceType, composite: Node,
           problems: list[str]) -> Service | None:
     """The service of one call, bound; ``None`` after adding its problems."""

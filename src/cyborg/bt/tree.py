@@ -164,8 +164,9 @@ class Tree:
                     missing.setdefault(key, []).append(node)
         for scheduled in self.services.services if self.services is not None else ():
             for key in scheduled.service.requires:  # a service needs it: its composite does
-                if key not in self.blackboard.resources:
-                    missing.setdefault(key, []).append(scheduled.composite)
+                if key not in self.blackboard.resources and \
+                        scheduled.composite not in missing.setdefault(key, []):
+                    missing[key].append(scheduled.composite)
         return missing
 
     @property
