@@ -30,17 +30,21 @@ from tests.bt.hostile_helpers import _bounded, _chain, _registry, assert_located
 # Placeholders stand for what json.dumps cannot write (or would recurse on); _expand fills them.
 _SPLICES = {"@@NAN@@": "NaN", "@@INF@@": "-Infinity", "@@E400@@": "1e400",
             "@@DIGITS@@": "9" * 1200, "@@SURROGATE@@": '"a\\udc00"'}
+_DECLARATIONS = ["BatteryWatch(interval=0.01, run_on_activation=true); ClosestGoal",
+                 "BatteryWatch(interval=1e-300)", "Nope(", "ClosestGoal; ClosestGoal",
+                 "BatteryWatch(interval=nan)", "BatteryWatch(key='\udc00')", "x" * 300 + "("]
+"""Values of a composite's ``services`` property, good and bad (docs/services.md)."""
 _SCALARS = st.one_of(
     st.none(), st.booleans(), st.integers(-(2 ** 70), 2 ** 70),
     st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6),
     st.sampled_from([10 ** 400, -(10 ** 400), -1, 0, 1, 2.5, "nan", "inf", "-Infinity",
-                     "1e400", "9" * 400, "\ud800", "x\udfffy", *_SPLICES]))
+                     "1e400", "9" * 400, "\ud800", "x\udfffy", *_SPLICES, *_DECLARATIONS]))
 _VALUES = st.recursive(_SCALARS, lambda inner: st.lists(inner, max_size=3)
                        | st.dictionaries(st.text(max_size=4), inner, max_size=3), max_leaves=6)
 _DEEP = st.integers(0, 1300).map(lambda n: f"@@DEEP{n}@@")
 _PROPERTY = st.sampled_from(["milliseconds", "maxLoop", "maxTime", "maxAttempts", "below",
                              "radius", "count", "successThreshold", "location", "time",
-                             "value", "expr", "x"])
+                             "value", "expr", "x", "services"])
 _PROPERTIES = st.dictionaries(_PROPERTY, _VALUES | _DEEP, max_size=3)
 _TEXT = st.text(max_size=6) | st.sampled_from(["a\ud800", "<x> \udbff", "\U0001f916",
                                                "<value> <milliseconds>", "<expr><time>"])

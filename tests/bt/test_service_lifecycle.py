@@ -307,3 +307,20 @@ def test_a_composite_halted_and_entered_again_in_one_tick_restarts_its_services(
     tree.tick()
     assert [event for event, _, _ in _events(tree)] == ["on_activate", "on_deactivate",
                                                          "on_activate"]
+
+
+def test_a_timing_made_in_python_below_the_minimum_still_moves_time_on() -> None:
+    from cyborg.bt.service_runner import ScheduledService
+    from cyborg.bt.services import MIN_INTERVAL, ServiceTiming
+    from tests.bt.service_helpers import Probe
+
+    tree = probe_tree(N("Sequence", N("Runner"), id="seq"))
+    probe = Probe()
+    probe.name, probe.composite_uid = "Probe", "seq"
+    probe.timing = ServiceTiming(interval=1e-300)
+    scheduled = ScheduledService(probe, tree.by_uid["seq"], tree.blackboard, 0)
+    tree.blackboard.resources[LOG] = []
+    scheduled.activate(5.0)
+    assert scheduled.due >= 5.0 + MIN_INTERVAL
+    scheduled.run_if_due(scheduled.due)
+    assert scheduled.due >= 5.0 + 2 * MIN_INTERVAL

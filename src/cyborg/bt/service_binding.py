@@ -25,7 +25,7 @@ from cyborg.bt.problems import shown
 from cyborg.bt.properties import bind, convert, signature_of, snake_case
 from cyborg.bt.service_runner import ScheduledService
 from cyborg.bt.service_syntax import ServiceCall, ServiceSyntaxError, parse_services
-from cyborg.bt.services import Service, ServiceTiming
+from cyborg.bt.services import MIN_INTERVAL, Service, ServiceTiming
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
@@ -157,13 +157,15 @@ def _timing(call: ServiceCall, cls: type[Service], common: dict[str, Any],
             problems.append(_at(column, f"{call.name}: option {name!r}: {exc}"))
     interval, deviation = values["interval"], values["deviation"]
     if len(problems) == count:
-        if not (isinstance(interval, float | int) and math.isfinite(interval) and interval > 0):
+        if not (isinstance(interval, float | int) and math.isfinite(interval)
+                and interval >= MIN_INTERVAL):
             problems.append(_at(call.column, f"{call.name}: interval must be a number of "
-                                             f"seconds above 0, not {shown(interval)}"))
-        elif not 0 <= deviation < interval:
+                                             f"seconds, at least {MIN_INTERVAL}, not "
+                                             f"{shown(interval)}"))
+        elif not 0 <= deviation <= interval - MIN_INTERVAL:
             problems.append(_at(call.column, f"{call.name}: deviation must be at least 0 and "
-                                             f"less than the interval ({interval} s), not "
-                                             f"{shown(deviation)}"))
+                                             f"leave at least {MIN_INTERVAL} s of the interval "
+                                             f"({interval} s), not {shown(deviation)}"))
     if len(problems) > count:
         return None
     return ServiceTiming(float(interval), float(deviation),

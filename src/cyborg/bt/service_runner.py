@@ -29,7 +29,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from cyborg.bt.services import Service, ServiceBoard
+from cyborg.bt.services import MIN_INTERVAL, Service, ServiceBoard
 from cyborg.bt.status import RUNNING
 
 if TYPE_CHECKING:
@@ -91,9 +91,11 @@ class ScheduledService:
         """The due time one interval after ``time``, rounded to the nanosecond.
 
         The rounding keeps sums of intervals such as 0.1 from drifting past the tick they
-        are meant to fall on (twenty of them make 2.0, not 2.0000000000000004).
+        are meant to fall on (twenty of them make 2.0, not 2.0000000000000004). It is never
+        less than :data:`~cyborg.bt.services.MIN_INTERVAL` after ``time``, even for timing
+        made in Python without the load's checks.
         """
-        return round(time + self.interval(), 9)
+        return max(round(time + self.interval(), 9), time + MIN_INTERVAL)
 
     def interval(self) -> float:
         """One interval, with the deviation drawn when there is one."""

@@ -53,9 +53,10 @@ a tree scope of its own) or in another mode's tree.
 
 **Common options.** Every service takes four options in its declaration, beside its own:
 
-* ``interval`` — seconds between runs (default: the class's :attr:`Service.interval`);
+* ``interval`` — seconds between runs (default: the class's :attr:`Service.interval`), at
+  least :data:`MIN_INTERVAL`;
 * ``deviation`` — a random ± seconds added to each interval (default: the class's
-  :attr:`Service.deviation`); must be less than ``interval``;
+  :attr:`Service.deviation`); ``interval - deviation`` must be at least :data:`MIN_INTERVAL`;
 * ``restart_on_activation`` — restart the timer each time the composite becomes active
   (default true); when false, the next due time is kept across activations, so a service
   whose composite becomes RUNNING again after its due time has passed runs at once;
@@ -78,6 +79,10 @@ from cyborg.bt.problems import shown
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
+
+MIN_INTERVAL = 0.001
+"""The shortest time between two runs of a service, in seconds: an ``interval`` less its
+``deviation`` must leave at least this much, so a loop running due services always moves on."""
 
 SHOWN_VALUE_LENGTH = 60
 """Characters at most of a written value as a monitor shows it (``wrote``)."""
