@@ -324,3 +324,21 @@ def test_a_timing_made_in_python_below_the_minimum_still_moves_time_on() -> None
     assert scheduled.due >= 5.0 + MIN_INTERVAL
     scheduled.run_if_due(scheduled.due)
     assert scheduled.due >= 5.0 + 2 * MIN_INTERVAL
+
+
+def test_a_background_loop_on_the_wall_clock_runs_services_and_stops_promptly() -> None:
+    import time
+
+    from cyborg.bt import MonotonicClock
+
+    tree = probe_tree(N("Sequence", N("Runner"), id="seq", services="Probe(interval=0.02)"))
+    tree.clock = MonotonicClock()
+    loop = TickLoop(tree, rate_hz=0.5)  # one tick, then a long sleep full of service runs
+    loop.start()
+    deadline = time.monotonic() + 30.0
+    while tree.blackboard.get("probe", 0) < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert tree.blackboard.get("probe", 0) >= 3
+    loop.stop(timeout=30.0)  # wakes the sleep between two service runs, halts the tree
+    assert loop.stopped and tree.services is not None and tree.services.active == []
+    assert [event for event, _, _ in _events(tree)][-1] == "on_deactivate"
