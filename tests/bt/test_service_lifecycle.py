@@ -342,3 +342,15 @@ def test_a_background_loop_on_the_wall_clock_runs_services_and_stops_promptly() 
     loop.stop(timeout=30.0)  # wakes the sleep between two service runs, halts the tree
     assert loop.stopped and tree.services is not None and tree.services.active == []
     assert [event for event, _, _ in _events(tree)][-1] == "on_deactivate"
+
+
+def test_the_dot_export_names_a_composites_services_under_its_label() -> None:
+    from cyborg.bt.dot import structure_to_dot
+
+    tree = probe_tree(N("Sequence", N("Runner"), id="seq", title="Patrol",
+                        services="Probe(interval=2); OtherProbe(interval=0.25)"))
+    text = structure_to_dot(tree.structure.to_json())
+    assert '"seq" [label="Patrol\\n\u27f3 Probe 2s, OtherProbe 0.25s"' in text
+    structure = tree.structure.to_json()
+    structure["root"]["children"][0]["services"] = [{"name": 3}, "junk"]
+    assert '"seq" [label="Patrol",' in structure_to_dot(structure)

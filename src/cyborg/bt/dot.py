@@ -7,7 +7,8 @@ status name) to colour a tick's result, and ``active`` to draw the running path 
 active nodes outlined in green, the edges between them dashed red. ``collapsed`` ids are drawn
 as one node standing for their whole subtree ("+N" nodes hidden), which is how a monitor
 exports what it shows; ``rankdir="LR"`` lays a wide tree out left to right, siblings then
-running top to bottom.
+running top to bottom. A composite carrying services names them, with their intervals, on a
+second line of its label.
 """
 
 from __future__ import annotations
@@ -75,7 +76,7 @@ def structure_to_dot(structure: Mapping[str, Any], *,
             continue
         node: Mapping[str, Any] = item
         uid = node["id"]
-        label = node["label"] or node["name"]
+        label = (node["label"] or node["name"]) + _services_line(node.get("services"))
         children = node.get("children", [])
         attributes = _SHAPES.get(node["category"], "shape=box")
         if uid in folded and children:
@@ -108,6 +109,22 @@ def structure_to_dot(structure: Mapping[str, Any], *,
     lines.append("  }")
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _services_line(services: Any) -> str:
+    """A composite's services as a second line of its label: ``⟳ BatteryWatch 1s, ClosestGoal 2s``.
+
+    Empty for a node without any, or with a malformed list (a structure from elsewhere).
+    """
+    if not isinstance(services, list):
+        return ""
+    named = []
+    for entry in services:
+        if isinstance(entry, dict) and isinstance(entry.get("name"), str):
+            interval = entry.get("interval")
+            every = f" {interval:g}s" if isinstance(interval, int | float) else ""
+            named.append(entry["name"] + every)
+    return "\n\u27f3 " + ", ".join(named) if named else ""
 
 
 def _count(node: Mapping[str, Any]) -> int:
