@@ -11,7 +11,7 @@ Every tick returns a :class:`~cyborg.bt.snapshot.TickSnapshot`.
 
 **Services.** When composites carry services (:mod:`cyborg.bt.services`), :attr:`Tree.services`
 runs them: due ones before each tick, activations and deactivations after it and on
-:meth:`Tree.halt`. A tree without services pays one test per tick for this.
+:meth:`Tree.halt`. A tree without services pays three `is None` tests per tick for this.
 
 **Timing.** ``Tree(..., timing=True)``, or ``tree.timing = True`` at any time from any thread,
 makes every tick from the next one on record each visit's wall time in its snapshot
