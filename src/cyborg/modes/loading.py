@@ -19,6 +19,7 @@ from cyborg.bt.clock import Clock
 from cyborg.bt.loader import load_tree
 from cyborg.bt.problems import Problem, TreeLoadError
 from cyborg.bt.registry import NodeRegistry
+from cyborg.bt.service_registry import ServiceRegistry
 from cyborg.bt.status import Status
 from cyborg.bt.tree import Tree
 from cyborg.modes.machine import ModeMachine
@@ -28,19 +29,21 @@ from cyborg.modes.spec import MachineSpec
 
 def load_machine(path: str | Path, *, registry: NodeRegistry | None = None,
                  clock: Clock | None = None, blackboard: Blackboard | None = None,
-                 stub_missing: Status | None = None) -> ModeMachine:
+                 stub_missing: Status | None = None,
+                 services: ServiceRegistry | None = None) -> ModeMachine:
     """Reads the mode file at ``path`` and builds its machine; :class:`ModeFileError` if bad.
 
-    ``registry``, ``clock`` and ``stub_missing`` are passed to every
+    ``registry``, ``services``, ``clock`` and ``stub_missing`` are passed to every
     :func:`~cyborg.bt.load_tree`; ``blackboard`` gives the shared global scope and resources.
     """
     return build_machine(read_mode_file(path), registry=registry, clock=clock,
-                         blackboard=blackboard, stub_missing=stub_missing)
+                         blackboard=blackboard, stub_missing=stub_missing, services=services)
 
 
 def build_machine(spec: MachineSpec, *, registry: NodeRegistry | None = None,
                   clock: Clock | None = None, blackboard: Blackboard | None = None,
-                  stub_missing: Status | None = None) -> ModeMachine:
+                  stub_missing: Status | None = None,
+                  services: ServiceRegistry | None = None) -> ModeMachine:
     """Builds the tree of every mode of ``spec`` and the machine over them."""
     shared = blackboard if blackboard is not None else Blackboard()
     trees: dict[str, Tree] = {}
@@ -50,7 +53,8 @@ def build_machine(spec: MachineSpec, *, registry: NodeRegistry | None = None,
         own.globals, own.resources = shared.globals, shared.resources
         try:
             trees[name] = load_tree(mode.project, tree=mode.tree, registry=registry,
-                                    clock=clock, blackboard=own, stub_missing=stub_missing)
+                                    clock=clock, blackboard=own, stub_missing=stub_missing,
+                                    services=services)
         except TreeLoadError as exc:
             problems.append(Problem(f"mode {name!r}: its tree {mode.tree!r} does not load "
                                     "(the problems follow)", spec.source, mode.line,

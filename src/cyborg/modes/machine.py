@@ -50,6 +50,7 @@ from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.clock import Clock
 from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.node import Node
+from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.tree import Tree
 from cyborg.modes.records import Decision, ModeTick, Transition, Trigger
@@ -112,6 +113,11 @@ class ModeMachine:
     def hooks(self) -> TreeHooks:
         """The current mode's tree's hooks (breakpoints, forced statuses)."""
         return self.tree.hooks
+
+    @property
+    def services(self) -> ServiceRunner | None:
+        """The current mode's tree's services, which the tick loop runs between ticks."""
+        return self.tree.services
 
     @property
     def blackboard(self) -> Blackboard:
