@@ -14,12 +14,21 @@ from pathlib import Path
 
 import pytest
 
-from cyborg.app.play_commands import PlayLine
+from cyborg.app.cli import main
+from cyborg.app.play_commands import PlayLine, notes
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
 from cyborg.bus.wire import EntityKind
 from cyborg.record.playback_source import open_recording
 from tests.bus.bus_peer import wait_for
 from tests.bus.test_multiprocess import free_port
+from tests.record.bad_recordings import (
+    REFUSED,
+    STRANGE_TOPICS,
+    cut_in_its_middle,
+    refused,
+    small_recording,
+    with_strange_schemas,
+)
 from tests.record.playing import CHATTER, Listener, record_run
 
 STRING = "std_msgs/msg/String"
@@ -47,17 +56,36 @@ def test_cyborg_play_publishes_the_recording_to_another_process(tmp_path: Path) 
     assert f"played {CHATTER + 1} messages on 2 topics" in result.stderr
 
 
-@pytest.mark.parametrize(("content", "said"), [(b"", "the file is empty"),
-                                               (b"#ROSBAG V2.0\n", "a ROS 1 bag")])
-def test_a_bad_file_is_refused_naming_it_before_joining_the_bus(
-        tmp_path: Path, content: bytes, said: str) -> None:
-    path = tmp_path / "run.mcap"
-    path.write_bytes(content)
-    result = subprocess.run(
-        [sys.executable, "-m", "cyborg", "play", str(path), "--connect", "tcp/127.0.0.1:9"],
-        capture_output=True, text=True, timeout=120, check=False)
-    assert result.returncode == 1
-    assert f"cyborg: error: {path}: {said}" in result.stderr
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_a_bad_file_is_refused_in_one_line_naming_it_before_joining_the_bus(
+        tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]) -> None:
+    path, said = refused(name, tmp_path)
+    assert main(["play", str(path), "--connect", "tcp/127.0.0.1:9"]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith(f"cyborg: error: {path}: ") and said in error
+    assert error.count("\n") == 1
+
+
+def test_before_play_a_cut_file_and_the_topics_not_played_are_said_in_a_line_each(
+        tmp_path: Path) -> None:
+    whole = small_recording(tmp_path / "whole.mcap")
+    cut = open_recording(cut_in_its_middle(whole, tmp_path / "cut.mcap"), MessageTypes())
+    strange = open_recording(with_strange_schemas(tmp_path / "strange.mcap"), MessageTypes())
+    try:
+        said = notes(tmp_path / "cut.mcap", cut)
+        assert len(said) == 1 and "was cut (a record cut short" in said[0]
+        assert f"cyborg record --recover {tmp_path / 'cut.mcap'}" in said[0]
+        [line] = notes(tmp_path / "strange.mcap", strange)
+        assert line.startswith(f"cyborg play: not played, {len(STRANGE_TOPICS)} topics: ")
+        assert "\n" not in line
+        for topic, word in STRANGE_TOPICS.items():
+            assert f"{topic} (" in line and word in line
+    finally:
+        cut.close()
+        strange.close()
+    complete = open_recording(whole, MessageTypes())
+    assert notes(whole, complete) == []
+    complete.close()
 
 
 def test_a_start_outside_the_recording_and_unknown_topics_are_refused_naming_them(

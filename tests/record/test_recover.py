@@ -15,6 +15,7 @@ from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.record.mcap_file import McapFile
 from cyborg.record.recover import NotRecoverableError, recover
+from tests.record.bad_recordings import REFUSED, refused
 from tests.record.readers import raw_messages, read_rosbags
 
 TYPES = MessageTypes()
@@ -170,3 +171,14 @@ def test_recovering_a_whole_file_rebuilds_the_indexes_and_statistics_the_writer_
         assert second.statistics == first.statistics
         assert second.channels == first.channels and second.schemas == first.schemas
         assert list(recovered.iter_metadata()) == list(written.iter_metadata())
+
+
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_recover_refuses_what_play_and_report_refuse_in_one_line(
+        tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]) -> None:
+    source, said = refused(name, tmp_path)
+    target = tmp_path / "fixed.mcap"
+    assert main(["record", "--recover", str(source), "-o", str(target)]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith(f"cyborg: error: {source}: ") and said in error
+    assert error.count("\n") == 1 and not target.exists()

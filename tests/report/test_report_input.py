@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import html
+import re
 from pathlib import Path
 
 import pytest
@@ -10,35 +12,48 @@ from cyborg.app.cli import main
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.nav.arnl_map import read_map
 from cyborg.nav.map_message import map_geometry
+from cyborg.record.playback_source import RecordingError
 from cyborg.record.scan import scan
 from cyborg.report.build import build_report
 from cyborg.report.map_svg import MAX_POINT_CELLS
-from cyborg.report.recording import ReportInputError
 from tests.conftest import shared_dir
+from tests.record.bad_recordings import (
+    REFUSED,
+    STRANGE_TOPICS,
+    refused,
+    sqlite_bag,
+    with_strange_schemas,
+)
 from tests.report.page_reader import polyline_points, read_page
 from tests.report.recordings import RecordingWriter, mission
 
 
-@pytest.mark.parametrize("content, said", [
-    (b"", "the file is empty"),
-    (b"#ROSBAG V2.0\n" + bytes(200), "a ROS 1 bag"),
-    (b"time,x,y\n0,1,2\n", "a text file"),
-    (b"\x89MCAP0\r\n\x01\x20\x00", "cut before the end of its header"),
-])
-def test_a_file_that_is_no_recording_is_refused_naming_it_and_why(
-        tmp_path: Path, content: bytes, said: str) -> None:
-    path = tmp_path / "run.mcap"
-    path.write_bytes(content)
-    with pytest.raises(ReportInputError, match=said) as caught:
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_a_file_that_is_no_recording_is_refused_in_one_line_naming_it_and_why(
+        tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]) -> None:
+    path, said = refused(name, tmp_path)
+    with pytest.raises(RecordingError, match=re.escape(said)) as caught:
         build_report(path)
-    assert str(path) in str(caught.value)
+    assert str(caught.value).startswith(f"{path}: ")
+    assert main(["report", str(path), "-o", str(tmp_path / "run.html")]) == 1
+    error = capsys.readouterr().err
+    assert error == f"cyborg: error: {caught.value}\n"
+    assert not (tmp_path / "run.html").exists()
 
 
-def test_a_missing_file_or_a_folder_is_refused_naming_it(tmp_path: Path) -> None:
-    with pytest.raises(ReportInputError, match=f"{tmp_path / 'none.mcap'}: no such file"):
-        build_report(tmp_path / "none.mcap")
-    with pytest.raises(ReportInputError, match="a folder, not an MCAP file"):
-        build_report(tmp_path)
+def test_a_ros2_bag_folder_is_reported_as_a_recording_is(tmp_path: Path) -> None:
+    text = build_report(sqlite_bag(tmp_path / "bag", messages=7))
+    page = read_page(text)
+    meta = page.one("table", "meta").all_text()
+    assert "7 on 1 topics" in meta and "/chatter" in text
+
+
+def test_topics_that_cannot_be_read_are_named_under_log_and_the_rest_reported(
+        tmp_path: Path) -> None:
+    text = build_report(with_strange_schemas(tmp_path / "run.mcap"))
+    assert "25 on 6 topics" in read_page(text).one("table", "meta").all_text()
+    for topic, word in STRANGE_TOPICS.items():
+        assert f"{topic}: " in text and html.escape(word) in text
 
 
 def test_a_cut_file_is_reported_as_far_as_it_is_readable_saying_it_was_cut(

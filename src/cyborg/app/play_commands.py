@@ -104,11 +104,8 @@ def _check(args: argparse.Namespace, recording: Recording) -> None:
 def _play(args: argparse.Namespace, context: Context, recording: Recording,
           stream: TextIO) -> int:
     accept = topic_filter(args.topics, args.exclude)
-    if recording.cut is not None:
-        print(f"cyborg play: {args.recording} was cut ({recording.cut}); playing the "
-              f"{duration(recording.duration)} before it", file=stream)
-    for topic, why in sorted(recording.skipped.items()):
-        print(f"  not played: {topic} ({why})", file=stream)
+    for note in notes(args.recording, recording):
+        print(note, file=stream)
     player = Player(Node(contract.NAME, args.namespace, context=context), recording,
                     rate=args.rate, start=args.start, loop=args.loop, paused=True,
                     accept=accept)
@@ -134,6 +131,23 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
         print(f"  not published: {topic} ({why})", file=stream)
     return 0
 
+
+def notes(path: Path, recording: Recording) -> list[str]:
+    """What a user is told before play starts, one line each: the file was cut, topics skipped.
+
+    The first suggests ``--recover`` for an indexed copy; the second names every topic that is
+    not played with its reason.
+    """
+    said: list[str] = []
+    if recording.cut is not None:
+        said.append(f"cyborg play: {path} was cut ({recording.cut}); playing the "
+                    f"{duration(recording.duration)} before it (cyborg record --recover "
+                    f"{path} -o FIXED.mcap writes an indexed copy)")
+    if recording.skipped:
+        listed = "; ".join(f"{topic} ({why})" for topic, why in sorted(recording.skipped.items()))
+        said.append(f"cyborg play: not played, {len(recording.skipped)} "
+                    f"topic{'s' if len(recording.skipped) > 1 else ''}: {listed}")
+    return said
 
 
 class PlayLine(LiveLine):

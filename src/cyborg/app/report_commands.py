@@ -17,8 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from cyborg.app.errors import CommandError
+from cyborg.record.playback_source import RecordingError
 from cyborg.report.build import write_report
-from cyborg.report.recording import ReportInputError
 
 
 def add_parser(commands: Any) -> None:
@@ -43,7 +43,7 @@ def report_command(args: argparse.Namespace) -> int:
                            "file with -o")
     try:
         recording = write_report(source, output)
-    except ReportInputError as exc:
+    except RecordingError as exc:
         raise CommandError(str(exc)) from None
     except OSError as exc:
         raise CommandError(f"{output}: cannot be written: {exc.strerror or exc}") from None

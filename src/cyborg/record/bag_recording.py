@@ -65,7 +65,8 @@ class BagRecording(Recording):
                 what = "empty" if not start else "not a ROS 1 bag (no #ROSBAG V2.0 header)"
                 raise RecordingError(f"{path}: {what}")
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
-            raise RecordingError(f"{path}: a folder without metadata.yaml, not a ROS 2 bag")
+            raise RecordingError(f"{path}: a folder without metadata.yaml, neither an MCAP file "
+                                 "nor a ROS 2 bag")
         reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         try:
             reader.open()
@@ -77,7 +78,8 @@ class BagRecording(Recording):
         for connection in reader.connections:
             why = recording._why_not(connection)
             if why is not None:
-                recording.skipped[connection.topic] = why
+                recording.skip(PlayedTopic(connection.topic, connection.msgtype,
+                                           _latched(connection), connection.msgcount), why)
                 continue
             recording._connections.append(connection)
             known = recording.topics.get(connection.topic)

@@ -21,7 +21,7 @@ from typing import BinaryIO
 
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, Message, Schema
+from mcap.records import Channel, Chunk, Message, Metadata, MetadataIndex, Schema
 
 from cyborg.bus import MessageTypes
 from cyborg.record import layout
@@ -64,18 +64,26 @@ class McapRecording(Recording):
         recording._chunks = sorted(found.chunks, key=lambda c: c.record.message_start_time)
         recording._channels = {}
         for channel_id, channel in sorted(found.channels.items()):
+            schema = found.schemas.get(channel.schema_id)
+            topic = PlayedTopic(channel.topic, schema.name if schema else "",
+                                is_latched(channel.metadata.get(layout.QOS_KEY, "")),
+                                found.message_counts.get(channel_id, 0))
             why = recording._why_not(types, channel, found.schemas)
-            count = found.message_counts.get(channel_id, 0)
             if why is not None:
-                recording.skipped[channel.topic] = why
+                recording.skip(topic, why)
                 continue
-            schema = found.schemas[channel.schema_id]
             recording._channels[channel_id] = channel.topic
-            recording.topics[channel.topic] = PlayedTopic(
-                channel.topic, schema.name, is_latched(channel.metadata.get(layout.QOS_KEY, "")),
-                count)
+            recording.topics[channel.topic] = topic
         recording._stream = open(path, "rb")  # noqa: SIM115 (closed by close())
+        recording.metadata = [recording._metadata_at(item) for item in found.metadata]
         return recording
+
+    def _metadata_at(self, where: MetadataIndex) -> tuple[str, dict[str, str]]:
+        """The metadata record the scan found at ``where`` (checked whole by the scan)."""
+        content = os.pread(self._stream.fileno(), where.length - _RECORD.size,
+                           where.offset + _RECORD.size)
+        record = Metadata.read(ReadDataStream(io.BytesIO(content)))
+        return record.name, dict(record.metadata)
 
     @staticmethod
     def _why_not(types: MessageTypes, channel: Channel, schemas: dict[int, Schema]
@@ -84,7 +92,9 @@ class McapRecording(Recording):
             return f"message encoding {channel.message_encoding!r}, not cdr"
         schema = schemas.get(channel.schema_id)
         if schema is None:
-            return "no schema"
+            return f"no schema (schema id {channel.schema_id}), so its type is not known"
+        if not schema.name:
+            return "a schema without a type name"
         if schema.encoding != layout.SCHEMA_ENCODING and schema.name not in types:
             return (f"unknown type {schema.name} with a {schema.encoding or 'missing'} schema, "
                     "not ros2msg")

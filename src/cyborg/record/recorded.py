@@ -57,6 +57,10 @@ class Recording:
     topics: dict[str, PlayedTopic] = field(default_factory=dict)
     skipped: dict[str, str] = field(default_factory=dict)
     """Topics that are not played, with the reason."""
+    unplayed: dict[str, PlayedTopic] = field(default_factory=dict)
+    """The topics of :attr:`skipped` as recorded: their type and how many messages they have."""
+    metadata: list[tuple[str, dict[str, str]]] = field(default_factory=list)
+    """The recording's metadata records (name and values) in file order; none for a bag."""
     start_ns: int = 0
     """Log time of the first message."""
     end_ns: int = 0
@@ -68,6 +72,18 @@ class Recording:
     def duration(self) -> float:
         """Seconds from the first message to the last."""
         return max(self.end_ns - self.start_ns, 0) / 1e9
+
+    @property
+    def size(self) -> int:
+        """Bytes on disk: the file's, or every file's of a bag folder."""
+        if self.path.is_dir():
+            return sum(item.stat().st_size for item in self.path.iterdir() if item.is_file())
+        return self.path.stat().st_size
+
+    def skip(self, topic: PlayedTopic, why: str) -> None:
+        """Notes that ``topic`` is not played, and why."""
+        self.skipped[topic.name] = why
+        self.unplayed[topic.name] = topic
 
     def messages(self, start_ns: int = 0) -> Iterator[Played]:
         """The messages of the played topics from ``start_ns`` on, in log-time order."""
@@ -93,7 +109,9 @@ def learn_type(types: MessageTypes, type_name: str, definition: str) -> str | No
     try:
         types.add_definition(type_name, definition)
     except ValueError as exc:
-        return str(exc)
+        reason = str(exc)
+        first = reason.splitlines()[0]  # a parser's report of the text runs over lines
+        return first if first == reason else first.split(" (")[0]
     return None if type_name in types else f"unknown type {type_name}"
 
 

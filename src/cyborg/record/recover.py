@@ -64,6 +64,9 @@ def recover(source: Path, target: Path) -> Recovery:
             raise ValueError(f"{target}: the recovered copy must go to another file than "
                              "the cut one")
         raise FileExistsError(f"{target} exists already; choose another name or remove it")
+    if source.is_dir():
+        raise NotRecoverableError(f"{source}: a folder, not an MCAP file (recover the .mcap "
+                                  "files of a bag folder one by one)")
     if not source.is_file():
         raise NotRecoverableError(f"{source}: no such file")
     found = scan(source)

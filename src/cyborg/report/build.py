@@ -38,7 +38,7 @@ _RUN_FIELDS = (("cyborg_version", "cyborg version"), ("started", "started"),
 def build_report(path: Path) -> str:
     """The report of the recording at ``path`` as HTML text.
 
-    Raises :class:`~cyborg.report.recording.ReportInputError` naming the file when it is no
+    Raises :class:`~cyborg.record.playback_source.RecordingError` naming the file when it is no
     recording (empty, foreign, cut inside its header) or cannot be read.
     """
     return render(read_recording(path, wanted))
