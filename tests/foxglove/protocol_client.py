@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import re
 import struct
 import time
 from collections.abc import Callable
@@ -38,7 +37,6 @@ class ProtocolClient:
         self.messages: dict[int, list[tuple[int, bytes]]] = {}
         self._next_id = 1
         self.statuses: list[dict[str, Any]] = []
-        self._asked: dict[int, int] = {}  # channel id -> the subscription asked for it
 
     def close(self) -> None:
         self._stack.close()
@@ -69,7 +67,6 @@ class ProtocolClient:
                 self.channels[channel["topic"]] = channel
         elif message["op"] == "status":
             self.statuses.append(message)
-            self._retry(str(message.get("message", "")))
         elif message["op"] == "unadvertise":
             gone = set(message["channelIds"])
             self.channels = {topic: channel for topic, channel in self.channels.items()
@@ -97,24 +94,12 @@ class ProtocolClient:
         subscription = self._next_id
         self._next_id += 1
         channel = self.channel(topic)["id"]
-        self._asked[channel] = subscription
         self._send_subscribe(subscription, channel)
         return subscription
 
     def _send_subscribe(self, subscription: int, channel: int) -> None:
         self.connection.send(json.dumps({"op": "subscribe", "subscriptions": [
             {"id": subscription, "channelId": channel}]}))
-
-    def _retry(self, status: str) -> None:
-        """Subscribe again to a channel the server said it did not know yet.
-
-        foxglove-sdk 0.30 sends a new channel's ``advertise`` a moment before it records the
-        channel for the client; a client that subscribes within that moment is told
-        ``Unknown channel ID: N``. The Foxglove app is rarely that quick; this client is.
-        """
-        match = re.fullmatch(r"Unknown channel ID: (\d+)", status)
-        if match and int(match[1]) in self._asked:
-            self._send_subscribe(self._asked[int(match[1])], int(match[1]))
 
     def unsubscribe(self, subscription: int) -> None:
         self.connection.send(json.dumps({"op": "unsubscribe",

@@ -3,6 +3,8 @@
 * :mod:`~cyborg.foxglove.server` — :class:`FoxgloveServer`: the SDK's server behind the gate;
 * :mod:`~cyborg.foxglove.admission`, :mod:`~cyborg.foxglove.gate` — who may connect (the
   monitor's rules: loopback by default, a token for other machines) and the gate that checks;
+  :mod:`~cyborg.foxglove.resubscribe` — the gate's frame-by-frame copy of a connection, which
+  sends again a subscription the SDK refused for a channel it had only just advertised;
 * :mod:`~cyborg.foxglove.bridge`, :mod:`~cyborg.foxglove.catalogue` — which channels the bus
   calls for, kept in step with it;
 * :mod:`~cyborg.foxglove.relay`, :mod:`~cyborg.foxglove.topic_relay`,

@@ -1,12 +1,14 @@
-"""The gate in front of the Foxglove server: checks each handshake, then passes bytes through.
+"""The gate in front of the Foxglove server: checks each handshake, then passes frames through.
 
 foxglove-sdk's server cannot look at a handshake's headers, so it listens on a free loopback
 port of its own and the gate listens where clients connect (``host:port``). For each
 connection the gate reads the handshake (at most :data:`~cyborg.foxglove.admission.
 HANDSHAKE_LIMIT` bytes, within :data:`HANDSHAKE_TIMEOUT` seconds), asks the
 :class:`~cyborg.foxglove.admission.Admission` rules, answers ``403`` with the reason to a
-refused one, and otherwise connects to the server and copies bytes both ways, unchanged, until
-either side closes. It runs an asyncio loop on a thread of its own.
+refused one, and otherwise connects to the server and copies the connection's frames both ways
+until either side closes, unchanged but for one thing: a subscription the server refused for a
+channel it had only just advertised is sent again (:mod:`cyborg.foxglove.resubscribe`). It runs
+an asyncio loop on a thread of its own.
 
 The SDK's server accepts only the subprotocol ``foxglove.sdk.v1``; clients written before it
 (older Foxglove Studio and Lichtblick releases, roslibjs-foxglove) offer only
@@ -25,13 +27,12 @@ import socket
 import threading
 
 from cyborg.foxglove.admission import HANDSHAKE_LIMIT, Admission, is_loopback, parse_handshake
+from cyborg.foxglove.resubscribe import Resubscriber
 
 log = logging.getLogger("cyborg.foxglove")
 
 HANDSHAKE_TIMEOUT = 10.0
 """Seconds a client has to send its handshake."""
-CHUNK = 1 << 20
-"""Bytes copied at a time."""
 CURRENT = b"foxglove.sdk.v1"
 """The subprotocol the SDK's server requires."""
 LEGACY = b"foxglove.websocket.v1"
@@ -130,19 +131,7 @@ class Gate:
                 upstream_writer.close()
                 return
             writer.write(_PROTOCOL_LINE.sub(rb"\1 " + LEGACY, answer))
-        await asyncio.gather(_pump(reader, upstream_writer), _pump(upstream_reader, writer))
-
-
-async def _pump(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-    """Copy ``reader`` to ``writer`` until the end, then close ``writer``."""
-    try:
-        while data := await reader.read(CHUNK):
-            writer.write(data)
-            await writer.drain()
-    except (ConnectionError, OSError):
-        pass
-    finally:
-        writer.close()
+        await Resubscriber().run((reader, writer), (upstream_reader, upstream_writer))
 
 
 async def _answer(writer: asyncio.StreamWriter, text: str, status: str) -> None:
