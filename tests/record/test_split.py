@@ -45,10 +45,10 @@ def test_bad_sizes_and_durations_name_the_option(parse: object, text: str,
         parse(text)  # type: ignore[operator]
 
 
-def test_split_files_are_named_as_rosbag2_names_them() -> None:
-    assert split_name(Path("out/run.mcap"), 0) == Path("out/run_0.mcap")
-    assert split_name(Path("run.mcap"), 12) == Path("run_12.mcap")
-    assert split_name(Path("run"), 1) == Path("run_1.mcap")
+def test_split_files_are_named_as_rosbag2_names_them_in_a_bag_folder() -> None:
+    assert split_name(Path("out/run.mcap"), 0) == Path("out/run/run_0.mcap")
+    assert split_name(Path("run.mcap"), 12) == Path("run/run_12.mcap")
+    assert split_name(Path("run"), 1) == Path("run/run_1.mcap")
 
 
 def test_a_recording_split_by_size_loses_no_message_and_each_file_stands_alone(
@@ -64,9 +64,11 @@ def test_a_recording_split_by_size_loses_no_message_and_each_file_stands_alone(
         files.write("/log", 10**18 + i, 10**18 + i, data)
         sent.append(data)
     files.close()
-    assert files.paths == [tmp_path / f"run_{i}.mcap" for i in range(len(files.paths))]
+    assert files.paths == [tmp_path / "run" / f"run_{i}.mcap" for i in range(len(files.paths))]
     assert len(files.paths) == 3
     assert not (tmp_path / "run.mcap").exists()
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == [
+        "metadata.yaml", "run_0.mcap", "run_1.mcap", "run_2.mcap"]
     got = [data for path in files.paths for _t, _l, _p, data in raw_messages(path)]
     assert got == sent
     for path in files.paths:
@@ -74,17 +76,20 @@ def test_a_recording_split_by_size_loses_no_message_and_each_file_stands_alone(
         with open(path, "rb") as stream:
             reader = make_reader(stream)
             summary = reader.get_summary()
-            metadata = [item.metadata for item in reader.iter_metadata()]
+            metadata = [(item.name, item.metadata) for item in reader.iter_metadata()]
         assert summary is not None
         assert {channel.topic for channel in summary.channels.values()} == {"/log", "/quiet"}
-        assert metadata == [{"map": "campus.map"}]
+        assert metadata[0] == ("cyborg", {"map": "campus.map"})
+        assert [name for name, _values in metadata] == ["cyborg", "rosbag2"]
 
 
 def test_an_existing_file_is_never_overwritten(tmp_path: Path) -> None:
     (tmp_path / "run.mcap").write_text("keep me")
     with pytest.raises(FileExistsError, match=r"run\.mcap exists already"):
         RecordingFiles(tmp_path / "run.mcap", TYPES)
-    (tmp_path / "parts_0.mcap").write_text("keep me")
-    with pytest.raises(FileExistsError, match=r"parts_0\.mcap exists already"):
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "parts_0.mcap").write_text("keep me")
+    with pytest.raises(FileExistsError, match=f"{tmp_path / 'parts'} exists already"):
         RecordingFiles(tmp_path / "parts.mcap", TYPES, policy=SplitPolicy(duration=60))
+    assert (tmp_path / "parts" / "parts_0.mcap").read_text() == "keep me"
     assert (tmp_path / "run.mcap").read_text() == "keep me"

@@ -3,7 +3,7 @@
     cyborg record -o run.mcap                       every topic but images and hidden ones
     cyborg record /cyborg/pose /cyborg/scan -o run.mcap
     cyborg record -o run.mcap --exclude '/cyborg/camera/*' --images --compression lz4
-    cyborg record -o run.mcap --split-size 1GiB     run_0.mcap, run_1.mcap, ...
+    cyborg record -o run.mcap --split-size 1GiB     a bag folder: run/run_0.mcap, ...
     cyborg record --recover cut.mcap -o fixed.mcap  a readable, indexed copy of a cut file
 
 It joins the bus's router like the other bus commands (``--connect``, ``--wait``) and records
@@ -61,8 +61,8 @@ def add_parser(commands: Any) -> None:
                         default=component.COMPRESSION,
                         help=f"chunk compression (default {component.COMPRESSION})")
     record.add_argument("--split-size", default=None, metavar="SIZE",
-                        help="start a new file past this size, e.g. 1GiB (files run_0.mcap, "
-                             "run_1.mcap, ...)")
+                        help="start a new file past this size, e.g. 1GiB (a bag folder: "
+                             "run/run_0.mcap, run/run_1.mcap, ..., run/metadata.yaml)")
     record.add_argument("--split-duration", default=None, metavar="DURATION",
                         help="start a new file after this long, e.g. 10m")
     record.add_argument("--duration", type=float, default=None, metavar="SECONDS",
@@ -160,6 +160,8 @@ class RecordLine(LiveLine):
         self.clear()
         stats, recorder = self.recorder.stats, self.recorder
         files = ", ".join(str(path) for path in recorder.files.paths)
+        if recorder.files.folder is not None:
+            files = f"{recorder.files.folder} ({len(recorder.files.paths)} files)"
         print(f"{files}: {stats.messages:,} messages on {len(stats.topics)} topics, "
               f"{size(stats.bytes)} of messages", file=self.stream)
         for topic, why in sorted(stats.skipped.items()):

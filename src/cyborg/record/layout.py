@@ -30,6 +30,11 @@ TYPE_HASH_KEY = "topic_type_hash"
 """Channel metadata: the RIHS01 hash of the topic's type, as rosbag2 writes it."""
 LIBRARY = "cyborg record"
 """The MCAP header's library field, before the version."""
+RUN_METADATA = "cyborg"
+"""Name of the metadata record that names the version, map and tree of the run (and whose
+values are the ``custom_data`` of the rosbag2 metadata, :mod:`cyborg.record.bag_metadata`)."""
+MAP_METADATA = "cyborg.map"
+"""Name of the metadata record written for each map the recorded simulator published."""
 
 _INFINITE = "{sec: 9223372036, nsec: 854775807}"
 _RELIABILITY = {"1": "reliable", "2": "best_effort"}

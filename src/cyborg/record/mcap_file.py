@@ -3,7 +3,8 @@
 :class:`McapFile` wraps the ``mcap`` library's writer: profile ``ros2``, one ``ros2msg``
 schema per type, one ``cdr`` channel per topic (:mod:`cyborg.record.layout`), chunked (chunk
 size :data:`CHUNK_SIZE`), compressed as asked, with chunk and message indexes, statistics and
-summary offsets written at :meth:`McapFile.close`.
+summary offsets written at :meth:`McapFile.close`, with rosbag2's own ``rosbag2`` metadata
+record (:mod:`cyborg.record.bag_metadata`) describing the file's topics, counts and times.
 
 **Bounded loss.** The writer closes a chunk when it passes :data:`CHUNK_SIZE`; the recorder
 also calls :meth:`McapFile.flush_if_due` at least every :data:`FLUSH_INTERVAL`, which closes
@@ -30,7 +31,8 @@ from typing import BinaryIO
 from mcap.writer import CompressionType, IndexType, Writer
 
 from cyborg.bus import MessageTypes
-from cyborg.record import layout
+from cyborg.record import bag_metadata, layout
+from cyborg.record.bag_metadata import FileSummary, TopicCount
 from cyborg.record.completion import complete, keep_until
 from cyborg.record.guarded_stream import GuardedStream, StorageError
 from cyborg.record.scan import NotRecoverableError, scan
@@ -69,6 +71,11 @@ class McapFile:
         self._written = self._pending = 0  # bytes in the file; bytes added since it grew
         self.messages = 0
         self.closed = False
+        self.summary = FileSummary(path.name)
+        """Its topics, counts and time span, written as the ``rosbag2`` record at close."""
+        self.custom_data: dict[str, str] = {}
+        """The run's metadata (the ``cyborg`` record), the rosbag2 record's ``custom_data``."""
+        self._counted: dict[int, TopicCount] = {}
         self._writer.start(profile=layout.PROFILE, library=library)
 
     @property
@@ -96,10 +103,13 @@ class McapFile:
             schema = self._writer.register_schema(
                 type_name, layout.SCHEMA_ENCODING, layout.schema_text(self.types, type_name))
             self._schemas[type_name] = schema
+        metadata = layout.channel_metadata(self.types, type_name, offered_qos)
         channel: int = self._writer.register_channel(
-            topic, layout.MESSAGE_ENCODING, schema,
-            layout.channel_metadata(self.types, type_name, offered_qos))
+            topic, layout.MESSAGE_ENCODING, schema, metadata)
         self._channels[topic] = channel
+        counted = TopicCount(topic, type_name, metadata[layout.QOS_KEY],
+                             metadata[layout.TYPE_HASH_KEY])
+        self._counted[channel] = self.summary.topics[topic] = counted
         return channel
 
     def channel_of(self, topic: str) -> int:
@@ -117,10 +127,13 @@ class McapFile:
         self._writer.add_message(channel, log_time, data, publish_time)
         self._pending += len(data) + 31  # the message record's own fields
         self.messages += 1
+        self.summary.count(self._counted[channel], log_time)
 
     def metadata(self, name: str, values: dict[str, str]) -> None:
         """Adds a metadata record (indexed in the summary)."""
         self._writer.add_metadata(name, values)
+        if name == layout.RUN_METADATA:
+            self.custom_data = dict(values)
 
     def flush_if_due(self, now: float | None = None) -> bool:
         """Closes, writes and syncs the open chunk if it is :data:`FLUSH_INTERVAL` old."""
@@ -144,6 +157,9 @@ class McapFile:
         self.closed = True
         try:
             if self.failed is None:
+                self._writer.add_metadata(bag_metadata.RECORD_NAME, {
+                    bag_metadata.RECORD_KEY: bag_metadata.serialized([self.summary],
+                                                                     self.custom_data)})
                 self._writer.finish()
         except StorageError:
             pass

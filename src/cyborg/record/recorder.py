@@ -38,6 +38,7 @@ from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Respo
 from cyborg.bus.raw import RawMessage
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import robot
+from cyborg.record import layout
 from cyborg.record.guarded_stream import StorageError
 from cyborg.record.selection import IMAGE_TYPES, TopicSelection
 from cyborg.record.split import RecordingFiles
@@ -54,9 +55,9 @@ QUEUE_DEPTH = 1000
 """Messages of a topic that may wait for the writer before the oldest are dropped."""
 IMAGE_QUEUE_DEPTH = 30
 """The same for image topics: about a second of a camera, without holding gigabytes."""
-RUN_METADATA = "cyborg"
+RUN_METADATA = layout.RUN_METADATA
 """Name of the metadata record that names the version, map and tree of the run."""
-MAP_METADATA = "cyborg.map"
+MAP_METADATA = layout.MAP_METADATA
 """Name of the metadata record written for each map the recorded simulator published."""
 
 

@@ -1,8 +1,13 @@
 """A recording's files: one, or a series split by size or by duration.
 
 Without a split the recording is the one file named (``run.mcap``). With ``--split-size`` or
-``--split-duration`` it is a series named as rosbag2 names its files, the index before the
-suffix from 0: ``run_0.mcap``, ``run_1.mcap``, ... A new file starts before the message that
+``--split-duration`` it is a rosbag2 bag folder, as ``ros2 bag record -o run`` writes one: the
+name without its suffix is the folder (``run/``), its files are named as rosbag2 names them, the
+index before the suffix from 0 (``run/run_0.mcap``, ``run/run_1.mcap``, ...), and its
+``metadata.yaml`` lists them all with their topics, counts and times
+(:mod:`cyborg.record.bag_metadata`), written again each time a file is closed, so ``cyborg
+play run/``, ``ros2 bag play run/`` and rosbags' ``AnyReader`` read the series as one
+recording. A new file starts before the message that
 would go over the limit is written, between two messages on the recorder's one writing thread,
 so no message is lost or written twice at a split. Every file is complete on its own: it
 repeats the schemas, the channels of every topic recorded so far and the metadata, so each
@@ -12,14 +17,18 @@ first holds the latched topics' messages only if they were published again durin
 
 from __future__ import annotations
 
+import logging
 import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from cyborg.bus import MessageTypes
+from cyborg.record.bag_metadata import FOLDER_FILE, FileSummary, write_folder_metadata
 from cyborg.record.guarded_stream import StorageError
 from cyborg.record.mcap_file import McapFile
+
+log = logging.getLogger(__name__)
 
 _SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]?i?B?)\s*$", re.IGNORECASE)
 _SIZE_UNITS = {"": 1, "B": 1, "K": 1e3, "KB": 1e3, "M": 1e6, "MB": 1e6, "G": 1e9, "GB": 1e9,
@@ -53,10 +62,15 @@ def parse_duration(text: str) -> float:
     return seconds
 
 
+def split_folder(path: Path) -> Path:
+    """The bag folder of a split recording named ``path``: ``run.mcap`` -> ``run/``."""
+    return path.with_name(path.stem if path.suffix else path.name)
+
+
 def split_name(path: Path, index: int) -> Path:
-    """The name of file ``index`` of a split recording: ``run.mcap`` -> ``run_0.mcap``."""
-    suffix = path.suffix or ".mcap"
-    return path.with_name(f"{path.stem if path.suffix else path.name}_{index}{suffix}")
+    """The name of file ``index`` of a split recording: ``run.mcap`` -> ``run/run_0.mcap``."""
+    folder = split_folder(path)
+    return folder / f"{folder.name}_{index}{path.suffix or '.mcap'}"
 
 
 @dataclass(frozen=True)
@@ -83,8 +97,8 @@ class RecordingFiles:
     """The files of one recording; writes go to the current one, which rolls over by policy.
 
     ``path`` is the name given (``run.mcap``); every path this recording wrote is in
-    :attr:`paths`, the current one last. Files that exist already are refused
-    (FileExistsError naming them) before anything is written.
+    :attr:`paths`, the current one last. A file, or a split recording's folder, that exists
+    already is refused (FileExistsError naming it) before anything is written.
     """
 
     path: Path
@@ -96,12 +110,24 @@ class RecordingFiles:
     _metadata: dict[tuple[str, str], dict[str, str]] = field(init=False, default_factory=dict)
     _current: McapFile | None = field(init=False, default=None)
     _opened: float = field(init=False, default=0.0)
+    _closed: list[FileSummary] = field(init=False, default_factory=list)
 
     def __post_init__(self) -> None:
-        first = split_name(self.path, 0) if self.policy.splits else self.path
-        if first.exists():
+        first = self.path
+        if self.policy.splits:
+            first = split_name(self.path, 0)
+            if first.parent.exists():
+                raise FileExistsError(f"{first.parent} exists already; choose another name or "
+                                      "remove it")
+            first.parent.mkdir()
+        elif first.exists():
             raise FileExistsError(f"{first} exists already; choose another name or remove it")
         self._open(first)
+
+    @property
+    def folder(self) -> Path | None:
+        """The bag folder of a split recording (None for one file)."""
+        return split_folder(self.path) if self.policy.splits else None
 
     @property
     def current(self) -> McapFile:
@@ -140,7 +166,7 @@ class RecordingFiles:
     def write(self, topic: str, log_time: int, publish_time: int, data: bytes) -> None:
         """Writes one message of a topic added before, starting a new file first if due."""
         if self._due(len(data)):
-            self.current.close()
+            self._finish_current()
             self._open(split_name(self.path, len(self.paths)))
         current = self.current
         current.write(current.channel_of(topic), log_time, publish_time, data)
@@ -159,6 +185,19 @@ class RecordingFiles:
         self.current.flush_if_due()
 
     def close(self) -> None:
-        """Finishes the current file."""
-        if self._current is not None:
-            self._current.close()
+        """Finishes the current file (and a split recording's ``metadata.yaml``)."""
+        if self._current is not None and not self._current.closed:
+            self._finish_current()
+
+    def _finish_current(self) -> None:
+        """Closes the current file; a split recording's folder describes it from then on."""
+        current = self.current
+        current.close()
+        folder = self.folder
+        if folder is None:
+            return
+        self._closed.append(current.summary)
+        try:
+            write_folder_metadata(folder, self._closed, current.custom_data)
+        except OSError as exc:  # a full disk: the files stand alone, each with its own record
+            log.error("%s: cannot be written: %s", folder / FOLDER_FILE, exc.strerror or exc)
