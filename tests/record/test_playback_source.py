@@ -190,3 +190,31 @@ def test_a_ros2_bag_plays_its_cdr_as_it_is(tmp_path: Path) -> None:
     finally:
         recording.close()
     assert np.isclose(recording.duration, 10e-9)
+
+
+def test_a_file_written_without_chunks_plays_every_message_in_time_order(tmp_path: Path) -> None:
+    path = tmp_path / "unchunked.mcap"
+    types = MessageTypes()
+    with open(path, "wb") as stream:
+        writer = Writer(stream, use_chunking=False)
+        writer.start(profile="ros2", library="test")
+        schema = writer.register_schema(STRING, "ros2msg", b"string data\n")
+        chatter = writer.register_channel("/chatter", "cdr", schema)
+        latched = writer.register_channel("/map", "cdr", schema, {
+            "offered_qos_profiles": "- durability: transient_local\n"})
+        for number in (3, 1, 2):  # out of order, as several writers' messages may be
+            writer.add_message(chatter, number * 1000, bytes(types.serialize(
+                String(data=f"message {number}"), STRING)), number * 1000)
+        writer.add_message(latched, 1500, bytes(types.serialize(String(data="map"), STRING)),
+                           1500)
+        writer.finish()
+    recording = open_recording(path, types)
+    try:
+        played = list(recording.messages())
+        assert [(p.topic, p.log_time) for p in played] == [
+            ("/chatter", 1000), ("/map", 1500), ("/chatter", 2000), ("/chatter", 3000)]
+        assert types.deserialize(played[-1].data, STRING).data == "message 3"
+        assert [p.log_time for p in recording.messages(2000)] == [2000, 3000]
+        assert [(p.topic, p.log_time) for p in recording.latched_before(2500)] == [("/map", 1500)]
+    finally:
+        recording.close()

@@ -4,7 +4,8 @@
 anyone's with ``cdr`` messages) with :func:`cyborg.record.scan.scan`: every whole chunk is
 found and indexed, so a file cut by ``kill -9`` or a power loss plays up to its last whole
 chunk (:attr:`~cyborg.record.recorded.Recording.cut` says where it was cut). Messages are read
-chunk by chunk and merged across chunks in log-time order; the latched topics' last messages
+chunk by chunk and merged across chunks in log-time order (with those of a file written
+without chunks, read one by one where the scan found them); the latched topics' last messages
 before a time are found through the chunks' message indexes. A channel whose encoding is not
 ``cdr``, or whose type cannot be made known from a ``ros2msg`` schema, is skipped and named.
 """
@@ -43,6 +44,8 @@ class McapRecording(Recording):
 
     _stream: BinaryIO
     _chunks: list[ScannedChunk]
+    _loose: list[tuple[int, int, int]]
+    """(log time, offset, channel id) of the messages outside chunks, in log-time order."""
     _channels: dict[int, str]
     """The topic of each played channel, by channel id."""
 
@@ -62,6 +65,7 @@ class McapRecording(Recording):
             raise RecordingError(f"{path}: holds no messages"
                                  + (f" (cut: {found.stopped})" if not found.finished else ""))
         recording._chunks = sorted(found.chunks, key=lambda c: c.record.message_start_time)
+        recording._loose = sorted(found.loose)
         recording._channels = {}
         for channel_id, channel in sorted(found.channels.items()):
             schema = found.schemas.get(channel.schema_id)
@@ -122,7 +126,15 @@ class McapRecording(Recording):
             position = body + length
 
     def messages(self, start_ns: int = 0) -> Iterator[Played]:
-        """The played topics' messages from ``start_ns`` on, merged across chunks in time."""
+        """The played topics' messages from ``start_ns`` on, merged across chunks in time.
+
+        Messages outside chunks (a file written unchunked) are merged in by their log time.
+        """
+        loose = (self._loose_at(offset) for log_time, offset, channel_id in self._loose
+                 if log_time >= start_ns and channel_id in self._channels)
+        return heapq.merge(self._chunked(start_ns), loose, key=lambda played: played.log_time)
+
+    def _chunked(self, start_ns: int) -> Iterator[Played]:
         pending: list[tuple[int, int, Played]] = []
         order = 0
         chunks = [c for c in self._chunks if c.record.message_end_time >= start_ns]
@@ -141,14 +153,26 @@ class McapRecording(Recording):
         for channel_id, topic in self._channels.items():
             if not self.topics[topic].latched:
                 continue
-            last: tuple[int, ScannedChunk, int] | None = None
+            last: tuple[int, ScannedChunk | None, int] | None = None
             for chunk in self._chunks:
                 for log_time, offset in chunk.message_index.get(channel_id, []):
                     if log_time < start_ns and (last is None or log_time >= last[0]):
                         last = (log_time, chunk, offset)
+            for log_time, offset, loose_channel in self._loose:
+                if (loose_channel == channel_id and log_time < start_ns
+                        and (last is None or log_time >= last[0])):
+                    last = (log_time, None, offset)
             if last is not None:
-                found.append(self._message_at(topic, last[1], last[2]))
+                found.append(self._loose_at(last[2]) if last[1] is None else
+                             self._message_at(topic, last[1], last[2]))
         return sorted(found, key=lambda played: played.log_time)
+
+    def _loose_at(self, offset: int) -> Played:
+        """The message record at ``offset`` of the file, outside any chunk."""
+        _opcode, length = _RECORD.unpack(os.pread(self._stream.fileno(), _RECORD.size, offset))
+        body = os.pread(self._stream.fileno(), length, offset + _RECORD.size)
+        message = Message.read(ReadDataStream(io.BytesIO(body)), length)
+        return Played(self._channels[message.channel_id], message.log_time, bytes(message.data))
 
     def _message_at(self, topic: str, chunk: ScannedChunk, offset: int) -> Played:
         data = self._records(chunk)

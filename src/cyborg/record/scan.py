@@ -90,6 +90,8 @@ class Scan:
     attachments: list[AttachmentIndex] = field(default_factory=list)
     """Where each attachment is, and what it holds."""
     message_counts: dict[int, int] = field(default_factory=dict)
+    loose: list[tuple[int, int, int]] = field(default_factory=list)
+    """(log time, offset, channel id) of each message outside a chunk (an unchunked file)."""
     start_time: int = 0
     end_time: int = 0
     end: int = 0
@@ -200,7 +202,9 @@ def _keep(result: Scan, opcode: int, content: bytes, offset: int, length: int) -
             last.index_offsets[index.channel_id] = offset
             last.index_end = offset + length
     else:
-        _inner(result, opcode, content, len(content))
+        loose = _inner(result, opcode, content, len(content))
+        if loose is not None:
+            result.loose.append((loose.log_time, offset, loose.channel_id))
         if opcode == Opcode.METADATA:
             result.metadata.append(MetadataIndex(offset=offset, length=length,
                                                  name=Metadata.read(data).name))
