@@ -36,6 +36,17 @@ def test_what_is_no_recording_is_refused_in_one_line_naming_the_file(tmp_path: P
     assert said in str(raised.value) and "\n" not in str(raised.value)
 
 
+def test_a_ros1_bag_named_mcap_is_told_to_be_renamed_and_then_plays(tmp_path: Path) -> None:
+    path, _said = refused("ros1 bag named .mcap", tmp_path)
+    with pytest.raises(RecordingError, match=r"rename it to \.bag to read it as one"):
+        open_recording(path, MessageTypes())
+    recording = open_recording(path.rename(path.with_suffix(".bag")), MessageTypes())
+    try:
+        assert [p.topic for p in recording.messages()] == ["/chatter"]
+    finally:
+        recording.close()
+
+
 def test_topics_with_unknown_empty_or_missing_schemas_are_named_and_the_rest_plays(
         tmp_path: Path) -> None:
     recording = open_recording(with_strange_schemas(tmp_path / "run.mcap"), MessageTypes())

@@ -55,7 +55,10 @@ class McapRecording(Recording):
         try:
             found = scan(path)
         except NotRecoverableError as exc:
-            raise RecordingError(str(exc).replace("; nothing to recover", "")) from None
+            said = str(exc).replace("; nothing to recover", "")
+            if "a ROS 1 bag" in said:
+                said += "; rename it to .bag to read it as one"
+            raise RecordingError(said) from None
         except OSError as exc:
             raise RecordingError(f"{path}: cannot be read ({exc.strerror or exc})") from None
         recording = cls(path, start_ns=found.start_time, end_ns=found.end_time)
