@@ -15,7 +15,7 @@ from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.record.mcap_file import McapFile
 from cyborg.record.recover import NotRecoverableError, recover
-from tests.record.bad_recordings import REFUSED, refused
+from tests.record.bad_recordings import REFUSED, refused, sqlite_bag
 from tests.record.readers import raw_messages, read_rosbags
 
 TYPES = MessageTypes()
@@ -182,3 +182,11 @@ def test_recover_refuses_what_play_and_report_refuse_in_one_line(
     error = capsys.readouterr().err
     assert error.startswith(f"cyborg: error: {source}: ") and said in error
     assert error.count("\n") == 1 and not target.exists()
+
+
+def test_recover_refuses_a_ros2_bag_folder_saying_to_recover_its_files_one_by_one(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = sqlite_bag(tmp_path / "bag")
+    assert main(["record", "--recover", str(folder), "-o", str(tmp_path / "fixed.mcap")]) == 1
+    assert capsys.readouterr().err == (f"cyborg: error: {folder}: a folder, not an MCAP file "
+                                       "(recover the .mcap files of a bag folder one by one)\n")
