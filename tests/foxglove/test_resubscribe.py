@@ -12,6 +12,8 @@ from typing import Any
 
 import pytest
 
+from cyborg.bus import Qos
+from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.foxglove.resubscribe import (
     RETRIES,
     Resubscriber,
@@ -19,6 +21,7 @@ from cyborg.foxglove.resubscribe import (
     read_head,
     unmask,
 )
+from tests.foxglove.conftest import Served
 
 
 def server_frame(payload: bytes, opcode: int = 0x1, fin: bool = True) -> bytes:
@@ -123,3 +126,22 @@ def test_a_refused_subscription_is_sent_again_and_the_client_sees_only_the_rest(
     assert json.loads(seen[4]) == {"op": "done"}  # never the refusal
     assert server.subscribes == [{"op": "subscribe",
                                   "subscriptions": [{"id": 1, "channelId": 7}]}] * 2
+
+
+def test_a_client_that_subscribes_the_moment_a_channel_is_advertised_gets_its_messages(
+        served: Served) -> None:
+    """Topics appear while a client is connected, and it subscribes to each as soon as it
+    reads the advertise, as the Foxglove app does: each subscription delivers, and no refusal
+    reaches the client (the race itself is rare on a real server; the fake one above makes it
+    every time)."""
+    latched = Qos.latched()
+    with served.client() as client:
+        assert client.until(lambda: client.server_info is not None)
+        for number in range(12):
+            served.publisher_node.create_publisher(f"appears_{number}", String, latched).publish(
+                String(data=f"hello {number}"))
+            subscription = client.subscribe(f"/cyborg/appears_{number}")
+            payload = client.payloads(subscription)[0]
+            assert served.context.types.deserialize(payload, "std_msgs/msg/String").data == \
+                f"hello {number}"
+        assert not [s for s in client.statuses if "Unknown channel" in str(s.get("message"))]
