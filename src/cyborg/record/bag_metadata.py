@@ -70,6 +70,8 @@ class FileSummary:
     start_ns: int = 0
     end_ns: int = 0
     topics: dict[str, TopicCount] = field(default_factory=dict)
+    counted: int = 0
+    """Messages counted with :meth:`count`."""
 
     @property
     def message_count(self) -> int:
@@ -77,11 +79,15 @@ class FileSummary:
         return sum(topic.count for topic in self.topics.values())
 
     def count(self, topic: TopicCount, log_time: int) -> None:
-        """Counts one message of ``topic`` written at ``log_time``."""
-        first = self.message_count == 0
+        """Counts one message of ``topic`` written at ``log_time`` (once per message written)."""
+        if not self.counted:
+            self.start_ns = self.end_ns = log_time
+        elif log_time < self.start_ns:
+            self.start_ns = log_time
+        elif log_time > self.end_ns:
+            self.end_ns = log_time
         topic.count += 1
-        self.start_ns = log_time if first else min(self.start_ns, log_time)
-        self.end_ns = max(self.end_ns, log_time)
+        self.counted += 1
 
 
 def _span(start_ns: int, end_ns: int) -> dict[str, dict[str, int]]:
