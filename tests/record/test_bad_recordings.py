@@ -118,7 +118,7 @@ def damaged(changes: list[tuple[str, int, int]]) -> bytes:
     return bytes(data)
 
 
-@settings(max_examples=300, deadline=None, derandomize=True,
+@settings(max_examples=200, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(changes=st.lists(damage, min_size=1, max_size=4))
 def test_a_damaged_recording_raises_nothing_but_a_recording_error(
