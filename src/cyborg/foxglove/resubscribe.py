@@ -1,8 +1,8 @@
 """The gate's copy of a connection, frame by frame, closing the SDK's advertise-subscribe race.
 
 foxglove-sdk (0.30) sends a new channel's ``advertise`` to a client *before* it records the
-channel for that client. A client that subscribes at once — the Foxglove app does, for a topic
-its open layout shows, when the topic appears again after a restart — can be quicker than that:
+channel for that client. A client that subscribes at once — as a panel of an open layout may,
+when its topic appears again after a restart — can be quicker than that:
 the server answers ``status`` ``Unknown channel ID: N`` and drops the subscription, and the
 panel stays empty although the channel exists.
 
