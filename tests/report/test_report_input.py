@@ -49,11 +49,17 @@ def test_a_ros2_bag_folder_is_reported_as_a_recording_is(tmp_path: Path) -> None
 
 
 def test_topics_that_cannot_be_read_are_named_under_log_and_the_rest_reported(
-        tmp_path: Path) -> None:
-    text = build_report(with_strange_schemas(tmp_path / "run.mcap"))
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = with_strange_schemas(tmp_path / "run.mcap")
+    text = build_report(path)
     assert "25 on 6 topics" in read_page(text).one("table", "meta").all_text()
     for topic, word in STRANGE_TOPICS.items():
         assert f"{topic}: " in text and html.escape(word) in text
+    assert main(["report", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].startswith(f"cyborg report: not read, {len(STRANGE_TOPICS)} topics: ")
+    assert all(f"{topic} (" in lines[1] and word in lines[1]
+               for topic, word in STRANGE_TOPICS.items())
 
 
 def test_a_cut_file_is_reported_as_far_as_it_is_readable_saying_it_was_cut(

@@ -50,4 +50,8 @@ def report_command(args: argparse.Namespace) -> int:
     cut = f"; the file was cut ({recording.cut})" if recording.cut else ""
     print(f"report of {source} ({recording.message_count:,} messages on "
           f"{len(recording.topics)} topics) written to {output}{cut}")
+    if recording.skipped:
+        listed = "; ".join(f"{topic} ({why})" for topic, why in recording.skipped.items())
+        print(f"cyborg report: not read, {len(recording.skipped)} "
+              f"topic{'s' if len(recording.skipped) > 1 else ''}: {listed}")
     return 0

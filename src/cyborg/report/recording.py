@@ -66,6 +66,8 @@ class Recording:
     """Why the file ends before its summary (a cut file), or "" for a complete one."""
     problems: list[str] = field(default_factory=list)
     """Topics and messages that could not be decoded, said once each."""
+    skipped: dict[str, str] = field(default_factory=dict)
+    """Topics that could not be read at all, with the reason (also among :attr:`problems`)."""
 
     @property
     def message_count(self) -> int:
@@ -101,7 +103,8 @@ def read_recording(path: Path, wanted: Callable[[str, str], bool],
         for topic in sorted([*source.topics.values(), *source.unplayed.values()],
                             key=lambda topic: topic.name):
             result.topics[topic.name] = TopicRecord(topic.name, topic.type_name, topic.count)
-        for name, why in sorted(source.skipped.items()):
+        result.skipped = dict(sorted(source.skipped.items()))
+        for name, why in result.skipped.items():
             result.problems.append(f"{name}: {why}; not read")
         _decode(source, result, wanted, types)
     finally:
