@@ -42,6 +42,18 @@ SET_MODE = Service("mode/set", SetMode)
 SERVICES: tuple[Service, ...] = (SET_MODE,)
 
 
+def machine_namespace(topic: str, type_name: str) -> str | None:
+    """The namespace of the runner whose mode machine publishes ``topic`` of ``type_name``.
+
+    Only a machine's state topic names one (``/cyborg/bt/mode`` → ``/cyborg/bt``); None for
+    any other. ``type_name`` is the topic's type as the bus graph shows it.
+    """
+    suffix = "/" + STATE.name
+    if type_name != STATE.type_name or not topic.endswith(suffix):
+        return None
+    return topic.removesuffix(suffix) or "/"
+
+
 class ModeAction(IntEnum):
     """SetMode's ``action``: what the call asks of the machine."""
 

@@ -33,12 +33,17 @@ player_pause paused                                      pause (true) or resume 
                                                          played recording (player_link.py)
 player_seek  position: s from the start, 0 to duration   go to that time of the recording
 player_step  —                                           play its next message, stay paused
+mode_force   ns, mode, reason                            enter the mode at once (mode_link.py)
+mode_request ns, mode, reason                            ask for the mode as the file allows
+mode_hold    ns, held                                    hold the current mode (true) or
+                                                         release it (false)
 ping         —                                           answered with pong (for latency)
 ===========  ==========================================  =====================================
 
 ``enable``, ``control``, ``step`` and ``resume`` need the control seat; so do the robot
 commands (``go`` … ``tour``) but ``stop``, which any page that may control sends, and the
-player's (``player_pause``, ``player_seek``, ``player_step``). The robot
+player's (``player_pause``, ``player_seek``, ``player_step``) and the mode machine's
+(``mode_force``, ``mode_request``, ``mode_hold``). The robot
 commands, their answers (``result``, ``robot_result``, ``tour``, ``manual_pause``) and why a
 manual goal pauses the tree are in :mod:`cyborg.monitor.robot_commands`.
 
@@ -63,6 +68,7 @@ from typing import Any
 from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import MessageError, check_namespace, decode
+from cyborg.monitor.mode_link import MODE_COMMANDS, ModeCommandError, ModeError
 from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerCommandError, PlayerError
 from cyborg.monitor.robot_commands import ROBOT_COMMANDS
 from cyborg.monitor.robot_fields import RobotCommandError
@@ -140,6 +146,9 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
     if kind in PLAYER_COMMANDS:
         await _player_command(hub, client, kind, command)
         return
+    if kind in MODE_COMMANDS:
+        await _mode_command(hub, client, kind, command)
+        return
     if kind == "hello":
         secret = command.get("seat")
         if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
@@ -209,6 +218,20 @@ async def _player_command(hub: Hub, client: Client, kind: str,
         client.send({**answer, "ok": False, "field": exc.field,
                      "message": located_error(client, command, exc)["message"]})
     except PlayerError as exc:
+        client.send({**answer, "ok": False, "field": None, "message": str(exc)})
+    else:
+        client.send({**answer, "ok": True, "message": message})
+
+
+async def _mode_command(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
+    """A command to a mode machine (:mod:`cyborg.monitor.mode_link`), answered with ``result``."""
+    answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
+    try:
+        message = await hub.modes.handle(client, kind, command)
+    except ModeCommandError as exc:
+        client.send({**answer, "ok": False, "field": exc.field,
+                     "message": located_error(client, command, exc)["message"]})
+    except ModeError as exc:
         client.send({**answer, "ok": False, "field": None, "message": str(exc)})
     else:
         client.send({**answer, "ok": True, "message": message})

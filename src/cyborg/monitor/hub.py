@@ -22,7 +22,8 @@ bus ever waits for a browser.
   it, it is freed with all kept for it. Watching a namespace no runner is in subscribes to
   nothing. Connections are counted per address.
 * **Robots**: their maps in :attr:`Hub.robot_hub`, acting on them in :attr:`Hub.robot_commands`;
-  a played recording's timeline in :attr:`Hub.player` (:mod:`cyborg.monitor.player_link`).
+  a played recording's timeline in :attr:`Hub.player` (:mod:`cyborg.monitor.player_link`);
+  the trees' mode machines in :attr:`Hub.modes` (:mod:`cyborg.monitor.mode_link`).
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from starlette.websockets import WebSocket
 
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import Limits, check_namespace
+from cyborg.monitor.mode_link import ModeLink
 from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_link import PlayerLink
 from cyborg.monitor.robot_commands import RobotCommands
@@ -89,6 +91,7 @@ class Hub:
                                   lambda: self.broadcast(self.robots()))
         self.robot_commands = RobotCommands(self.clients, seat, self.sources, self.robot_hub)
         self.player = PlayerLink(self.clients, seat, self.sources)
+        self.modes = ModeLink(self.clients, seat, self.sources)
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
@@ -231,11 +234,12 @@ class Hub:
     def send_tree(self, client: Client, namespace: str) -> None:
         """Sends ``client`` everything about the tree under ``namespace``.
 
-        That is the runner's state, the structure (unless the client shows this very tree now),
-        a snapshot, the timings and the last blackboard; for a namespace no runner is in, that
-        there is none.
+        That is the runner's state, its mode machine, the structure (unless the client shows
+        this very tree now), a snapshot, the timings and the last blackboard; for a namespace
+        no runner is in, that there is none.
         """
         source = self.sources.get(namespace)
+        self.modes.resend(client, namespace)
         client.send(self._runner_message(source) if source is not None else
                     {"t": "runner", "ns": namespace, "alive": False, "enabled": None,
                      "hooks": [], "paused_at": "", "problem": ""})
@@ -271,6 +275,7 @@ class Hub:
         self._loop = loop
         self.robot_hub.attach(loop)
         self.player.attach(loop)
+        self.modes.attach(loop)
 
     def refusal(self, host: str | None) -> str | None:
         """Why one more connection from ``host`` is refused, or None when it is not."""
@@ -348,6 +353,7 @@ class Hub:
             self.broadcast(self.robots())
         await self.robot_hub.periodic()
         await self.player.periodic()
+        await self.modes.periodic()
         watched = {client.watching for client in self.clients if client.watching}
         for namespace in watched:
             source = self.sources.get(namespace)

@@ -16,7 +16,8 @@ The bus node (``/cyborg/monitor`` by default) subscribes to each runner's topics
 services (:mod:`cyborg.monitor.source`); tree runners that appear on the bus later are found by
 their ``behavior_tree`` topic and offered on the page too; a player of a recording
 (``cyborg play``) is found by its ``player/state`` topic and drives the page's timeline
-(:mod:`cyborg.monitor.player_link`). The web side
+(:mod:`cyborg.monitor.player_link`); a runner of a mode file, by its ``mode`` topic, fills the
+page's Modes panel (:mod:`cyborg.monitor.mode_link`). The web side
 (:mod:`cyborg.monitor.server`) runs on uvicorn in its own thread.
 """
 
@@ -34,10 +35,11 @@ import uvicorn
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
-from cyborg.interfaces import player, robot, tree_runner
+from cyborg.interfaces import modes, player, robot, tree_runner
 from cyborg.monitor.access import TOKEN_VARIABLE, HostPolicy, read_token
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import FRAME_LIMIT, Limits, check_namespace
+from cyborg.monitor.mode_source import ModeSource
 from cyborg.monitor.player_source import PlayerSource
 from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.robot_source import RobotSource
@@ -83,6 +85,7 @@ class Monitor:
         self.hub.robot_hub.use(self._make_robot, self.discover_robots)
         self.hub.robot_commands.use(partial(RobotClients, self.node))
         self.hub.player.use(partial(PlayerSource, self.node), self.discover_players)
+        self.hub.modes.use(partial(ModeSource, self.node), self.discover_modes)
         names = [*allow_hosts, host] if host not in EVERY_INTERFACE else list(allow_hosts)
         self.hosts = HostPolicy(names)
         self.app = create_app(self.hub, hosts=self.hosts)
@@ -111,6 +114,12 @@ class Monitor:
     def discover_players(self) -> list[str]:
         """Namespaces of the players of recordings on the bus (found by their state topic)."""
         found = {player.player_namespace(entity.topic, entity.type_name)
+                 for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
+        return sorted(namespace for namespace in found if namespace is not None)
+
+    def discover_modes(self) -> list[str]:
+        """Namespaces of the tree runners that run a mode file (found by their mode topic)."""
+        found = {modes.machine_namespace(entity.topic, entity.type_name)
                  for entity in self.node.context.graph.entities([EntityKind.PUBLISHER])}
         return sorted(namespace for namespace in found if namespace is not None)
 
@@ -183,6 +192,7 @@ class Monitor:
         self.hub.robot_commands.destroy()
         self.hub.robot_hub.destroy()
         self.hub.player.destroy()
+        self.hub.modes.destroy()
         self.node.destroy()
 
     def __enter__(self) -> Monitor:

@@ -72,6 +72,7 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
                 await periodic
             await hub.robot_hub.detach()
             hub.player.detach()
+            hub.modes.detach()
 
     files = files or page_files()
     exports = asyncio.Semaphore(EXPORTS_AT_ONCE)

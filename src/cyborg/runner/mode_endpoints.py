@@ -2,7 +2,8 @@
 
 When the runner runs a mode file (docs/modes.md) it serves :mod:`cyborg.interfaces.modes`
 through a :class:`ModeEndpoints`: the latched ``mode`` state (published when the mode or the
-hold changes, and after a reload), each transition on ``mode/transitions``, the ``mode/set``
+hold changes, after a reload, and after a reload that failed, with the file's problems), each
+transition on ``mode/transitions``, the ``mode/set``
 service (request, force, hold, release) and the ``mode/events`` topic, whose every message
 fires the event it names.
 
@@ -15,7 +16,7 @@ from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from cyborg.bus import Node
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
@@ -34,6 +35,8 @@ class ModeEndpoints:
 
     def __init__(self, node: Node, current: Callable[[], ModeMachine]) -> None:
         self._current = current
+        self.problems: tuple[str, ...] = ()
+        """Why the latest reload of the mode file failed; empty after a good load."""
         self._state = modes.STATE.publisher(node)
         self._transitions = modes.TRANSITIONS.publisher(node)
         thread = node.callback_thread("mode")
@@ -47,7 +50,21 @@ class ModeEndpoints:
         self._state.publish(ModeState(
             entered=stamp(machine.entered or 0.0), mode=machine.mode, held=machine.held,
             transitions=machine.transition_count,
-            machine=json.dumps(machine.spec.to_json(), separators=(",", ":"))))
+            machine=json.dumps(machine.spec.to_json(), separators=(",", ":")),
+            problems=list(self.problems)))
+
+    def loaded(self) -> None:
+        """A mode file loaded (at start or a reload): its state, with no problems."""
+        self.problems = ()
+        self.publish_state()
+
+    def load_failed(self, problems: Sequence[str]) -> None:
+        """A reload failed: the state again, naming the file's ``problems`` (one a line).
+
+        The machine that loaded before keeps running; monitors show the problems beside it.
+        """
+        self.problems = tuple(problems)
+        self.publish_state()
 
     def publish_transition(self, transition: Transition) -> None:
         """Publishes one transition, then the state it led to."""

@@ -54,8 +54,10 @@ and caps size, nesting and node instances.
 ticks a :class:`~cyborg.modes.ModeMachine` and serves :mod:`cyborg.interfaces.modes` as well
 (:mod:`cyborg.runner.mode_endpoints`). Everything above then concerns the current mode's tree:
 ``behavior_tree`` is published again, and the per-node controls follow, whenever the mode
-changes. A reload reads the mode file again (or another mode file; a runner started on a tree
-file reloads tree files).
+changes (after a condition or time limit, once the status of the tick that led to it is out,
+so watchers never take the tree left's statuses for the tree entered's). A reload reads the
+mode file again (or another mode file; a runner started on a tree file reloads tree files); one
+that fails republishes the ``mode`` state with the file's problems.
 """
 
 from __future__ import annotations
@@ -92,7 +94,7 @@ from cyborg.bus.msgs.std_msgs.msg import Bool
 from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
-from cyborg.modes import ModeMachine, Transition, load_machine
+from cyborg.modes import ModeMachine, Transition, Trigger, load_machine
 from cyborg.robot.interface import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
 from cyborg.runner.mode_endpoints import ModeEndpoints
@@ -105,6 +107,8 @@ RELOAD_TIMEOUT = 30.0
 HALT_WAIT = 0.5
 """Seconds ``enable(false)`` waits for the halt before it answers (see ``set_enabled``)."""
 MODE_FILE_SUFFIX = ".toml"
+AFTER_A_TICK = (Trigger.CONDITION, Trigger.TIMEOUT)
+"""Transitions the machine makes right after a tick, before the tick's listeners run."""
 """A file with this suffix is a mode file (docs/modes.md), any other a tree file."""
 
 
@@ -148,6 +152,7 @@ class TreeRunnerNode:
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
         self.modes: ModeEndpoints | None = None
+        self._structure_after_tick = False
         if isinstance(self.ticked, ModeMachine):
             self.modes = ModeEndpoints(node, self._machine)
             self._follow(self.ticked)
@@ -178,7 +183,7 @@ class TreeRunnerNode:
         """Publishes the machine's transitions and follows its trees with the controls."""
         machine.add_listener(self._on_transition)
         if self.modes is not None:
-            self.modes.publish_state()
+            self.modes.loaded()
 
     def _on_transition(self, transition: Transition) -> None:
         machine = self.ticked
@@ -187,7 +192,10 @@ class TreeRunnerNode:
         self.control.tree_replaced(machine.trees[transition.source],
                                    machine.trees[transition.target])
         self._active = None  # the next tick publishes its path (no lock: this may run in a tick)
-        self._publish_structure()
+        if transition.trigger in AFTER_A_TICK:
+            self._structure_after_tick = True  # the tick's own status goes out first
+        else:
+            self._publish_structure()
         if self.modes is not None:
             self.modes.publish_transition(transition)
 
@@ -216,7 +224,13 @@ class TreeRunnerNode:
             raise TreeLoadError([Problem(f"this runner runs {kind}; it reloads only {kind}s",
                                          str(path), field="file")])
         old = self.tree.blackboard
-        return self._load(path, Blackboard(old.globals, resources=old.resources))
+        try:
+            return self._load(path, Blackboard(old.globals, resources=old.resources))
+        except TreeLoadError as exc:
+            if self.modes is not None:
+                self.modes.load_failed([str(problem) for problem in exc.problems
+                                        if problem.is_error] or [str(exc)])
+            raise
 
     def _install(self, ticked: Tree | ModeMachine, path: Path) -> Tree | ModeMachine:
         # between two ticks: may wait for one, so not under _lock (enable never waits on it)
@@ -322,6 +336,15 @@ class TreeRunnerNode:
         self._updates.publish(BehaviorTreeNodes(ids=list(active)))
 
     def _on_tick(self, snapshot: TickSnapshot) -> None:
+        self._publish_tick(snapshot)
+        if self._structure_after_tick:
+            # the mode changed right after this tick: its path and status (of the tree left)
+            # went out first, so no watcher paints them on the tree entered
+            self._structure_after_tick = False
+            self._active = None
+            self._publish_structure()
+
+    def _publish_tick(self, snapshot: TickSnapshot) -> None:
         active = tuple(snapshot.active)
         if active != self._active:
             self._active = active

@@ -159,6 +159,7 @@ class cyborg_msgs__msg__ModeState:
     held: bool
     transitions: int
     machine: str
+    problems: list[str]
     __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ModeState'
 
 
