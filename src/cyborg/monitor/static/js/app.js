@@ -14,8 +14,10 @@ import { LazyMapPanel } from "./map/lazy_panel.js";
 import { TreeModel } from "./model.js";
 import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
+import { ModesPanel } from "./modes_panel.js";
 import { PlayerBar } from "./player_bar.js";
 import { learnRobots, onRobotSelected, treeOfRobot } from "./robots.js";
+import { TreeFolds } from "./tree_folds.js";
 import { TreeView } from "./tree_view.js";
 
 const $ = (id) => document.getElementById(id);
@@ -75,6 +77,10 @@ new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("t
 const tickHistory = new History({ onShow: () => markDirty("all"), say });
 // A played recording's timeline (js/player_bar.js); a jump of the played time leaves the history.
 const playerBar = new PlayerBar({ send: (body) => command(body), onJump: () => { if (tickHistory.state) tickHistory.live(); } });
+// The mode machine of the shown tree runner, beside the tree (js/modes_panel.js).
+const modesPanel = new ModesPanel({ send: (body) => command(body) });
+// Folded and unfolded nodes of each tree shown (a mode's tree keeps them while another runs).
+const folds = new TreeFolds();
 
 // ------------------------------------------------------------------ messages
 function receive(message) {
@@ -87,12 +93,14 @@ function receive(message) {
       break;
     case "structure":
       stats.structures += 1;
+      folds.switchTree(page, message.ns, message.tree ? message.tree.title : "");
       if (message.ns !== page.ns) {
         page.ns = message.ns;
         treeShown();
       }
       model.reset(message.v, message.tree ? message.tree.root : null);
       page.title = message.tree ? message.tree.title : "";
+      modesPanel.showTreeMode(page.title, Boolean(model.root));
       if (page.selected && !model.byId.has(page.selected)) page.selected = null;
       needsLayout = true;
       schedule();
@@ -127,6 +135,7 @@ function receive(message) {
       page.enabled = message.enabled;
       page.problem = message.problem;
       page.hooks = new Map(message.hooks.map((hook) => [hook.id, hook]));
+      modesPanel.setAlive(message.alive);
       page.pausedAt = message.paused_at;
       if (message.enabled !== false) page.manualPause = null;
       markDirty("all");
@@ -143,6 +152,7 @@ function receive(message) {
       if (message.secret) keepSeatSecret(message.secret);
       if (message.may_control && message.holder === null) connection.post({ t: "claim" });
       playerBar.setSeat(message);
+      modesPanel.setSeat(message);
       toolbar();
       break;
     case "timing":
@@ -159,6 +169,11 @@ function receive(message) {
       break;
     case "history":
       tickHistory.start(message, model.version);
+      break;
+    case "modes":
+      if (message.ns !== page.ns) break;
+      modesPanel.show(message.ns, message.modes);
+      modesPanel.showTreeMode(page.title, Boolean(model.root));
       break;
     case "player":
       playerBar.show(message.player);
