@@ -3,7 +3,8 @@ mode machine is found beside its tree and sent to the pages watching it as ``mod
 transitions are kept; the tree view switches with the mode without the statuses of the tree
 left; the seat's holder forces, requests and holds, every bad field refused by name, pages
 without the seat refused; a mode file that fails to reload and a machine that cannot be drawn
-are shown as problems; the messages are rate-limited."""
+are shown as problems; the messages are rate-limited. (What the monitor makes of a machine's
+JSON: test_mode_source.py.)"""
 
 from __future__ import annotations
 
@@ -19,12 +20,9 @@ import pytest
 
 from cyborg.bt import TreeLoadError
 from cyborg.bus import BusConfig, Context, Node
-from cyborg.bus.msgs.builtin_interfaces.msg import Time
-from cyborg.bus.msgs.cyborg_msgs.msg import ModeState
 from cyborg.modes import ModeMachine
 from cyborg.monitor import Monitor
 from cyborg.monitor.mode_link import MODES_INTERVAL, REASON_LIMIT, ModeLink
-from cyborg.monitor.mode_source import machine_of, view_of
 from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.monitor.mode_runs import NAMESPACE, start_runner
@@ -260,48 +258,6 @@ def test_a_runner_without_modes_is_null_and_a_machine_that_leaves_too(
             runner.destroy()
         assert _modes(socket, lambda m: m is None) is None
         wait_until(lambda: NAMESPACE not in monitor.hub.modes.sources, 20, "the machine let go")
-
-
-def _state(machine: str, problems: list[str] | None = None, mode: str = "a") -> ModeState:
-    return ModeState(entered=Time(sec=2, nanosec=500_000_000), mode=mode, held=False,
-                     transitions=3, machine=machine, problems=problems or [])
-
-
-GOOD = {"schema": "cyborg.modes.machine/1", "initial": "a",
-        "modes": [{"name": "a", "title": "A"}, {"name": "b", "title": "B"}],
-        "transitions": [{"number": 1, "from": ["a"], "to": "b", "trigger": "event",
-                         "event": "go"}]}
-
-
-@pytest.mark.parametrize(("machine", "drawn", "problem"), [
-    ("{not json", False, "not JSON"),
-    (json.dumps({**GOOD, "schema": "other/2"}), False, "schema is 'other/2'"),
-    (json.dumps({**GOOD, "modes": []}), False, "no modes"),
-    (json.dumps({**GOOD, "modes": "ab"}), False, "no modes"),
-    (json.dumps({**GOOD, "modes": [{"name": "a"}, {"name": "a"}, {"title": "x"}]}), True,
-     "mode 2 has no name"),
-    (json.dumps({**GOOD, "transitions": [{"number": 4, "from": ["a"], "to": "nowhere"}]}),
-     True, "transition 4: to 'nowhere' is no mode"),
-    (json.dumps({**GOOD, "transitions": [{"number": 5, "from": ["zz"], "to": "b"}]}),
-     True, "transition 5: from"),
-    (json.dumps({**GOOD, "transitions": [7]}), True, "transition 1 is not an object"),
-    (json.dumps({**GOOD, "initial": "q"}), True, "initial mode 'q'"),
-    (json.dumps({**GOOD, "modes": [{"name": "a", "then": "gone"}]}), True, "then 'gone'"),
-])
-def test_a_machine_that_cannot_be_drawn_whole_is_named_never_blank(
-        machine: str, drawn: bool, problem: str) -> None:
-    view = view_of(_state(machine))
-    assert (view.machine is not None) is drawn
-    assert any(problem in line for line in view.problems), view.problems
-
-
-def test_the_runners_problems_come_first_and_a_sound_machine_has_none() -> None:
-    view = view_of(_state(json.dumps(GOOD), ["m.toml:3: error: mode 'b': no tree"]))
-    assert view.problems == ("m.toml:3: error: mode 'b': no tree",)
-    assert view.entered == 2.5 and view.count == 3 and view.mode_names() == ["a", "b"]
-    assert machine_of(json.dumps(GOOD))[1] == []
-    unknown = view_of(_state(json.dumps(GOOD), mode="zz"))
-    assert unknown.problems == ("the current mode 'zz' is no mode of the machine",)
 
 
 class _Page:

@@ -168,3 +168,61 @@ def test_the_structure_message_names_the_current_modes_tree(bus: Context,
         assert BehaviorTree(tree=text).tree and json.loads(text)["title"] == "demo"
     finally:
         runner.destroy()
+
+
+def test_a_failed_reload_republishes_the_mode_with_the_files_problems(
+        bus: Context, tmp_path: Path) -> None:
+    runner = start_runner(bus, tmp_path, ManualClock())
+    watcher = Watcher(bus)
+    bad = write_modes(tmp_path, MISSION.replace('tree = "charge"', 'tree = "charging"'),
+                      name="bad.modes.toml")
+    try:
+        wait_until(lambda: bool(watcher.states), 10.0, "the latched mode state")
+        assert watcher.states[-1].problems == []
+        with pytest.raises(TreeLoadError):
+            runner.reload(bad)
+        wait_until(lambda: bool(watcher.states[-1].problems), 10.0, "the problems")
+        problems = watcher.states[-1].problems
+        assert problems[0].startswith(f"{bad}:") and "mode 'low'" in problems[0], problems
+        assert watcher.states[-1].mode == "normal", "the machine that loaded runs on"
+        runner.reload()
+        wait_until(lambda: not watcher.states[-1].problems, 10.0, "problems cleared")
+    finally:
+        watcher.node.destroy()
+        runner.destroy()
+
+
+def test_a_condition_s_new_tree_goes_out_after_the_status_of_the_tick_before(
+        bus: Context, tmp_path: Path) -> None:
+    runner = start_runner(bus, tmp_path, ManualClock())
+    node = Node("order", "/test", context=bus)
+    heard: list[tuple[str, Any]] = []
+    tree_runner.STATUS.subscription(node, lambda m: heard.append(("status", m.tick)), NAMESPACE)
+    tree_runner.STRUCTURE.subscription(
+        node, lambda m: heard.append(("structure", json.loads(m.tree)["title"])), NAMESPACE)
+    try:
+        machine = runner.ticked
+        assert isinstance(machine, ModeMachine)
+        wait_until(lambda: ("structure", "patrol") in heard, 10.0, "the first structure")
+        wait_until(lambda: _status_heard(runner, heard), 10.0, "a status heard")
+        machine.globals["battery"] = {"percent": 15}
+        runner.runner.step()  # patrol ticks, then normal -> low
+        wait_until(lambda: ("structure", "charge") in heard, 10.0, "the new structure")
+        switch = heard.index(("structure", "charge"))
+        patrol_ticks = [tick for kind, tick in heard[:switch] if kind == "status"]
+        assert patrol_ticks[-1] == machine.trees["normal"].ticks, \
+            "the tick that led to the change was heard before the tree entered"
+        assert not [entry for entry in heard[switch:] if entry[0] == "status"], \
+            "no status of patrol after charge's structure"
+    finally:
+        node.destroy()
+        runner.destroy()
+
+
+def _status_heard(runner: TreeRunnerNode, heard: list[tuple[str, Any]]) -> bool:
+    """Steps the runner until its status is heard (the subscription matched)."""
+    if any(kind == "status" for kind, _ in heard):
+        return True
+    runner.runner.step()
+    time.sleep(0.05)
+    return False

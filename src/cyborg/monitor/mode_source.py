@@ -137,7 +137,7 @@ def machine_of(text: str) -> tuple[dict[str, Any] | None, list[str]]:
             mode["then"] = None
     transitions = _transitions(data.get("transitions"), names, problems)
     initial = data.get("initial")
-    if initial not in names:
+    if not isinstance(initial, str) or initial not in names:
         problems.append(f"the initial mode {clip(initial)!r} is no mode of the machine")
         initial = None
     return {"initial": initial, "modes": modes, "transitions": transitions}, problems
@@ -154,19 +154,21 @@ def _transitions(found: Any, names: set[str], problems: list[str]) -> list[dict[
             problems.append(f"transition {position + 1} is not an object; left out")
             continue
         number = transition.get("number")
-        label = f"transition {number if isinstance(number, int) else position + 1}"
+        if isinstance(number, bool) or not isinstance(number, int):
+            number = position + 1
+        label = f"transition {number}"
         sources, target = transition.get("from"), transition.get("to")
         if not isinstance(sources, list) or not sources \
-                or not all(s == "*" or s in names for s in sources):
+                or not all(isinstance(s, str) and (s == "*" or s in names) for s in sources):
             problems.append(f"{label}: from {clip(sources)} names no mode of the machine; "
                             "left out")
             continue
-        if target not in names:
+        if not isinstance(target, str) or target not in names:
             problems.append(f"{label}: to {clip(target)!r} is no mode of the machine; left out")
             continue
         trigger = transition.get("trigger")
         transitions.append({
-            "number": number if isinstance(number, int) else position + 1, "from": sources,
+            "number": number, "from": sources,
             "to": target, "trigger": trigger if trigger in ("condition", "event", "request")
             else "request", "when": clip(transition.get("when")),
             "event": clip(transition.get("event")), "guard": clip(transition.get("guard")),
