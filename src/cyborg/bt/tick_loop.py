@@ -19,7 +19,9 @@ ticks one of several trees (a mode machine, :mod:`cyborg.modes`).
 Between two ticks the loop also runs the tree's services (:mod:`cyborg.bt.service_runner`):
 when one is due before the next tick, it sleeps until then on the same clock, runs the due
 services in the ticking thread, and goes back to sleep, so a service's interval holds even
-when it is shorter than the tick period. While paused, services do not run either.
+when it is shorter than the tick period. While paused, services do not run either. Service
+listeners (:meth:`TickLoop.add_service_listener`) hear of each such run, and of a halt that
+stopped services, as tick listeners hear of ticks.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from cyborg.bt.status import RUNNING
 log = logging.getLogger("cyborg.bt")
 
 Listener = Callable[[TickSnapshot], None]
+ServiceListener = Callable[[ServiceRunner], None]
 
 DEFAULT_RATE = 10.0
 """Ticks per second unless told otherwise, as in 2018."""
@@ -93,6 +96,7 @@ class TickLoop(Generic[T]):
         self.rate_hz = rate_hz
         self.clock: Clock = clock or tree.clock
         self._listeners: list[Listener] = []
+        self._service_listeners: list[ServiceListener] = []
         self._tick_lock = threading.RLock()
         self._state = threading.Condition()
         self._wake = threading.Event()
@@ -109,6 +113,18 @@ class TickLoop(Generic[T]):
         """
         self._listeners.append(listener)
         return lambda: self._listeners.remove(listener)
+
+    def add_service_listener(self, listener: ServiceListener) -> Callable[[], None]:
+        """Calls ``listener(services)`` when the loop ran or stopped services outside a tick.
+
+        That is after it ran the due services between two ticks (in the ticking thread), and
+        after :meth:`pause` with ``halt`` stopped the active ones (in the pausing thread); each
+        time under the loop's tick lock, so ``services.states()`` may be read. Services that
+        run within a tick are the tick listeners' news (``snapshot.services``). Returns a
+        function that removes the listener; one that raises is logged and kept.
+        """
+        self._service_listeners.append(listener)
+        return lambda: self._service_listeners.remove(listener)
 
     @property
     def paused(self) -> bool:
@@ -133,6 +149,9 @@ class TickLoop(Generic[T]):
         if halt:
             with self._tick_lock:
                 self.tree.halt()
+                services = self.tree.services
+                if services is not None:
+                    self._services_changed(services)
 
     def resume(self) -> None:
         """Ticks again at the set rate."""
@@ -243,7 +262,15 @@ class TickLoop(Generic[T]):
             with self._tick_lock:
                 if self.tree.services is services and services is not None:
                     services.run_due(clock.now())
+                    self._services_changed(services)
         clock.sleep_until(due, wake)
+
+    def _services_changed(self, services: ServiceRunner) -> None:
+        for listener in list(self._service_listeners):
+            try:
+                listener(services)
+            except Exception:
+                log.exception("service listener %r raised", listener)
 
     def _tick(self) -> TickSnapshot:
         with self._tick_lock:

@@ -14,6 +14,10 @@ name                        type                                what
 ``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: what ran, how it ended
 ``hooks``                   cyborg_msgs/BehaviorTreeHooks       latched: hooks set, where a tick
                                                                 waits (:class:`HookAction`)
+``services``                cyborg_msgs/ServiceStates           latched: the services on the
+                                                                composites (docs/services.md):
+                                                                whether each runs, when it last
+                                                                ran, what it wrote, its error
 ``enable``                  std_srvs/SetBool                    run or pause the tree
 ``reload``                  cyborg_msgs/ReloadTree              load the file again
 ``control``                 cyborg_msgs/ControlNode             set or clear a hook on one node
@@ -22,6 +26,14 @@ name                        type                                what
 ==========================  ==================================  ==================================
 
 A runner is recognised on the bus by its :data:`STRUCTURE` topic (:func:`runner_namespace`).
+``services`` (:data:`SERVICE_STATES`) carries the state of every service attached to a
+composite of the tree that ticks (of a mode file: the current mode's tree), one
+``cyborg_msgs/ServiceState`` each, in tree order. It is published when any of them started,
+stopped, ran, wrote or failed, at most :data:`SERVICE_STATES_PER_SECOND` times a second (the
+newest states go out when the interval has passed), and latched, so a monitor that comes late
+gets the last. A tree without services publishes nothing on it; when a reload or a mode switch
+leaves a tree without services after one with them, one message with no services says so.
+
 Hook codes and statuses come from ControlNode.srv; the statuses equal the engine's
 (:class:`cyborg.bt.Status`), which the tests check.
 """
@@ -35,6 +47,7 @@ from cyborg.bus.msgs.cyborg_msgs.msg import (
     BehaviorTreeHooks,
     BehaviorTreeNodes,
     BehaviorTreeStatus,
+    ServiceStates,
 )
 from cyborg.bus.msgs.cyborg_msgs.srv import (
     ControlNode,
@@ -55,7 +68,11 @@ ACTIVE_PATH = Topic("behavior_tree_updates", BehaviorTreeNodes, latched=True)
 ENABLED = Topic("enabled", Bool, latched=True)
 STATUS = Topic("status", BehaviorTreeStatus)
 HOOKS = Topic("hooks", BehaviorTreeHooks, latched=True)
-TOPICS: tuple[Topic, ...] = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS)
+SERVICE_STATES = Topic("services", ServiceStates, latched=True)
+TOPICS: tuple[Topic, ...] = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS, SERVICE_STATES)
+
+SERVICE_STATES_PER_SECOND = 4.0
+"""Most ``services`` messages a runner publishes a second (wall time)."""
 
 # ---------------------------------------------------------------------- services
 ENABLE = Service("enable", SetBool)

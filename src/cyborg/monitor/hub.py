@@ -23,7 +23,8 @@ bus ever waits for a browser.
   nothing. Connections are counted per address.
 * **Robots**: their maps in :attr:`Hub.robot_hub`, acting on them in :attr:`Hub.robot_commands`;
   a played recording's timeline in :attr:`Hub.player` (:mod:`cyborg.monitor.player_link`);
-  the trees' mode machines in :attr:`Hub.modes` (:mod:`cyborg.monitor.mode_link`).
+  the trees' mode machines in :attr:`Hub.modes` (:mod:`cyborg.monitor.mode_link`) and the
+  services on their composites in :attr:`Hub.services` (:mod:`cyborg.monitor.service_link`).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from cyborg.monitor.player_link import PlayerLink
 from cyborg.monitor.robot_commands import RobotCommands
 from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
+from cyborg.monitor.service_link import ServiceLink
 from cyborg.monitor.source import ControlError, TreeSource
 
 log = logging.getLogger("cyborg.monitor")
@@ -92,6 +94,7 @@ class Hub:
         self.robot_commands = RobotCommands(self.clients, seat, self.sources, self.robot_hub)
         self.player = PlayerLink(self.clients, seat, self.sources)
         self.modes = ModeLink(self.clients, seat, self.sources)
+        self.services = ServiceLink(self.clients, self.sources)
 
     # ------------------------------------------------------------------ sources
     def follow(self, namespace: str, *, pinned: bool = False) -> TreeSource:
@@ -120,6 +123,7 @@ class Hub:
         self.sources.pop(namespace, None)
         for kept in (self._last_frame, self._blackboards):
             kept.pop(namespace, None)
+        self.services.forget(namespace)
         self._scheduled.discard(namespace)
         if source is None:
             return False
@@ -167,7 +171,9 @@ class Hub:
         loop = self._loop
         if loop is None or loop.is_closed():
             return
-        if what == "tick":
+        if what == "services":
+            self.services.notify(namespace)
+        elif what == "tick":
             if namespace in self._scheduled:
                 return
             self._scheduled.add(namespace)
@@ -261,6 +267,7 @@ class Hub:
         blackboard = self._blackboards.get(namespace)
         if blackboard is not None:
             client.send(blackboard)
+        self.services.send_to(client, namespace)
 
     def resync(self, client: Client) -> None:
         """Send a client that fell behind everything again."""
@@ -276,18 +283,11 @@ class Hub:
         self.robot_hub.attach(loop)
         self.player.attach(loop)
         self.modes.attach(loop)
+        self.services.attach(loop)
 
     def refusal(self, host: str | None) -> str | None:
         """Why one more connection from ``host`` is refused, or None when it is not."""
-        limits = self.limits
-        if len(self.clients) >= limits.connections:
-            return (f"the monitor has {limits.connections} connections already; close "
-                    "monitor pages you do not use")
-        same = sum(1 for client in self.clients if client.host == host)
-        if same >= limits.connections_per_address:
-            return (f"{limits.connections_per_address} connections from {host} already; "
-                    "close monitor pages you do not use")
-        return None
+        return self.limits.refusal([client.host for client in self.clients], host)
 
     def connect(self, websocket: WebSocket, *, may_control: bool) -> Client:
         """A new client for an accepted ``websocket``, numbered and registered in one step.

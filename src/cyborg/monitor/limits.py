@@ -58,6 +58,16 @@ class Limits:
     burst: int = 200
     """Messages a connection may send at once before :attr:`rate` applies."""
 
+    def refusal(self, hosts: list[str | None], host: str | None) -> str | None:
+        """Why one more connection from ``host`` is refused beside ``hosts``' ones, or None."""
+        if len(hosts) >= self.connections:
+            return (f"the monitor has {self.connections} connections already; close "
+                    "monitor pages you do not use")
+        if hosts.count(host) >= self.connections_per_address:
+            return (f"{self.connections_per_address} connections from {host} already; "
+                    "close monitor pages you do not use")
+        return None
+
 
 class MessageError(ValueError):
     """A message the monitor will not read; ``pos`` is the character where it went wrong."""

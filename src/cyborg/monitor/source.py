@@ -3,8 +3,10 @@
 A :class:`TreeSource` subscribes to a runner's namespace (``/cyborg/bt`` by default; the topics
 and services are those of :mod:`cyborg.interfaces.tree_runner`) and keeps a
 :class:`~cyborg.monitor.tree_state.TreeState` up to date. It tells its listener what changed
-(``"structure"``, ``"tick"``, ``"enabled"``, ``"hooks"``, ``"alive"``) from the bus threads; the
-listener hands that to the web side.
+(``"structure"``, ``"tick"``, ``"enabled"``, ``"hooks"``, ``"alive"``, ``"services"``) from the
+bus threads; the listener hands that to the web side. The runner's ``services`` message (the
+services on its composites) is kept as it came and read for the page against the structure
+(:meth:`TreeSource.services_message`, :mod:`cyborg.monitor.service_wire`).
 
 It also follows the runner's liveliness: when the runner's process goes away the source says
 ``alive = False`` (the page shows it), and when a runner comes back its latched structure
@@ -28,6 +30,7 @@ from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import tree_runner
 from cyborg.interfaces.contract import Service
 from cyborg.interfaces.tree_runner import HookAction, HookStatus
+from cyborg.monitor.service_wire import page_services
 from cyborg.monitor.tree_state import TreeState, status_name
 
 log = logging.getLogger("cyborg.monitor")
@@ -62,6 +65,8 @@ class TreeSource:
         self.alive = False
         self.problem = ""
         """Why the last structure could not be used, if it could not."""
+        self.service_states: Any = None
+        """The runner's last ``services`` message (cyborg_msgs/ServiceStates), as it came."""
         ns = self.namespace
         self._subscriptions: list[Subscription] = [
             tree_runner.STRUCTURE.subscription(node, self._on_structure, ns),
@@ -69,6 +74,7 @@ class TreeSource:
             tree_runner.ENABLED.subscription(node, self._on_enabled, ns),
             tree_runner.HOOKS.subscription(node, self._on_hooks, ns),
             tree_runner.STATUS.subscription(node, self._on_status, ns, qos=Qos(depth=50)),
+            tree_runner.SERVICE_STATES.subscription(node, self._on_services, ns),
         ]
         self._clients = {service.name: service.client(node, ns) for service in (
             tree_runner.ENABLE, tree_runner.CONTROL, tree_runner.STEP, tree_runner.RESUME,
@@ -118,6 +124,21 @@ class TreeSource:
                          list(message.active_ids))
         self._tell("tick")
 
+    def _on_services(self, message: Any) -> None:
+        self.service_states = message
+        self._tell("services")
+
+    def services_message(self) -> dict[str, Any] | None:
+        """The page's ``services`` message for the tree as it is now; None without one.
+
+        None before a structure or a ``services`` message came, and for a tree whose runner
+        never published services.
+        """
+        state, message = self.state, self.service_states
+        if state is None or message is None:
+            return None
+        return page_services(self.namespace, message, state)
+
     def _on_enabled(self, message: Any) -> None:
         self.enabled = bool(message.data)
         self._tell("enabled")
@@ -140,6 +161,7 @@ class TreeSource:
             self.alive = alive
             if not alive:
                 self.paused_at = ""
+                self.service_states = None  # a runner that comes back publishes its own
             self._tell("alive")
 
     def _tell(self, what: str) -> None:

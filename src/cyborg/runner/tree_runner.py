@@ -16,6 +16,10 @@ name                        type                                what
                                                                 their status and wall time
                                                                 (timed while someone listens),
                                                                 tick, duration
+``services``                cyborg_msgs/ServiceStates           latched: the services on the
+                                                                composites, when they change (at
+                                                                most 4 a second;
+                                                                :mod:`cyborg.runner.service_states`)
 ``enable``                  std_srvs/SetBool                    service: run or pause the tree
 ``reload``                  cyborg_msgs/ReloadTree              service: load the file again
 ==========================  ==================================  ==================================
@@ -74,6 +78,7 @@ from cyborg.bt import (
     Blackboard,
     Clock,
     NodeRegistry,
+    ServiceRegistry,
     TickLoop,
     Tree,
     default_registry,
@@ -98,6 +103,7 @@ from cyborg.modes import ModeMachine, Transition, Trigger, load_machine
 from cyborg.robot.interface import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
 from cyborg.runner.mode_endpoints import ModeEndpoints
+from cyborg.runner.service_states import ServiceStatesPublisher
 from cyborg.runner.tree_control import TreeControl
 
 log = logging.getLogger("cyborg.runner")
@@ -119,14 +125,18 @@ class TreeRunnerNode:
                  rate_hz: float = DEFAULT_RATE, clock: Clock | None = None,
                  robot: Robot | None = None,
                  registry: NodeRegistry | None = None, enabled: bool = True,
-                 reload_timeout: float = RELOAD_TIMEOUT) -> None:
+                 reload_timeout: float = RELOAD_TIMEOUT,
+                 services: ServiceRegistry | None = None) -> None:
         """Load the tree (raises :class:`~cyborg.bt.TreeLoadError`), set up topics and services.
 
-        :meth:`start` begins ticking. ``reload_timeout`` is the default of the node parameter of
-        that name (a value given to the node at start-up wins).
+        :meth:`start` begins ticking. ``reload_timeout`` is the default of the node parameter
+        of that name (a value given to the node at start-up wins). ``services`` are the
+        services its composites may carry (default: the registered ones,
+        :func:`~cyborg.bt.default_service_registry`).
         """
         self.node, self.path, self.tree_choice = node, Path(path), tree
         self.registry = registry if registry is not None else default_registry()
+        self.services = services
         self.clock = clock
         self.resources: dict[str, Any] = {ROBOT: robot} if robot is not None else {}
         self.ticked = self._load(self.path, Blackboard(resources=self.resources))
@@ -146,11 +156,13 @@ class TreeRunnerNode:
         self._updates = tree_runner.ACTIVE_PATH.publisher(node)
         self._enabled_pub = tree_runner.ENABLED.publisher(node)
         self._status = tree_runner.STATUS.publisher(node)
+        self._service_states = ServiceStatesPublisher(node)
         tree_runner.ENABLE.server(node, self._on_enable, callbacks=node.callback_thread("enable"))
         tree_runner.RELOAD.server(node, self._on_reload, deferred=True)
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
+        self.runner.add_service_listener(lambda _services: self._offer_services())
         self.modes: ModeEndpoints | None = None
         self._structure_after_tick = False
         if isinstance(self.ticked, ModeMachine):
@@ -170,9 +182,9 @@ class TreeRunnerNode:
     def _load(self, path: Path, blackboard: Blackboard) -> Tree | ModeMachine:
         if path.suffix == MODE_FILE_SUFFIX:
             return load_machine(path, registry=self.registry, clock=self.clock,
-                                blackboard=blackboard)
+                                blackboard=blackboard, services=self.services)
         return load_tree(path, tree=self.tree_choice, registry=self.registry, clock=self.clock,
-                         blackboard=blackboard)
+                         blackboard=blackboard, services=self.services)
 
     def _machine(self) -> ModeMachine:
         ticked = self.ticked
@@ -243,6 +255,8 @@ class TreeRunnerNode:
         if isinstance(ticked, ModeMachine):
             self._follow(ticked)
         self._publish_structure()
+        if not self._enabled:  # no tick comes to tell of the new tree's services
+            self._offer_services()
         log.info("reloaded %s: %s", path, describe(ticked))
         return ticked
 
@@ -321,6 +335,7 @@ class TreeRunnerNode:
         """Answer a pending reload, stop ticking (the tree halts) and destroy the node."""
         self._reloads.close()
         self.stop()
+        self._service_states.close()
         self.control.destroy()
         self.node.destroy()
 
@@ -335,7 +350,12 @@ class TreeRunnerNode:
     def _publish_active(self, active: tuple[str, ...]) -> None:
         self._updates.publish(BehaviorTreeNodes(ids=list(active)))
 
+    def _offer_services(self) -> None:
+        """The services of the tree that ticks now to ``services`` (when they changed)."""
+        self._service_states.offer(self.tree)
+
     def _on_tick(self, snapshot: TickSnapshot) -> None:
+        self._offer_services()
         self._publish_tick(snapshot)
         if self._structure_after_tick:
             # the mode changed right after this tick: its path and status (of the tree left)

@@ -14,6 +14,7 @@ if TYPE_CHECKING:
     import numpy as np
     from rosbags.typesys.stores.ros2_jazzy import (
         builtin_interfaces__msg__Time,
+        diagnostic_msgs__msg__KeyValue,
         geometry_msgs__msg__Polygon,
         geometry_msgs__msg__Pose2D,
         std_msgs__msg__Header,
@@ -211,6 +212,30 @@ class cyborg_msgs__msg__Predictions:
     __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/Predictions'
 
 
+@dataclass
+class cyborg_msgs__msg__ServiceState:
+    """Class for cyborg_msgs/msg/ServiceState."""
+
+    composite: str
+    service: str
+    active: bool
+    runs: int
+    last_run: builtin_interfaces__msg__Time
+    wrote: list[diagnostic_msgs__msg__KeyValue]
+    error: str
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ServiceState'
+
+
+@dataclass
+class cyborg_msgs__msg__ServiceStates:
+    """Class for cyborg_msgs/msg/ServiceStates."""
+
+    stamp: builtin_interfaces__msg__Time
+    tree_id: str
+    services: list[cyborg_msgs__msg__ServiceState]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ServiceStates'
+
+
 BatteryStatus = cyborg_msgs__msg__BatteryStatus
 BehaviorTree = cyborg_msgs__msg__BehaviorTree
 BehaviorTreeHooks = cyborg_msgs__msg__BehaviorTreeHooks
@@ -225,3 +250,5 @@ ModeTransition = cyborg_msgs__msg__ModeTransition
 PlayerState = cyborg_msgs__msg__PlayerState
 Prediction = cyborg_msgs__msg__Prediction
 Predictions = cyborg_msgs__msg__Predictions
+ServiceState = cyborg_msgs__msg__ServiceState
+ServiceStates = cyborg_msgs__msg__ServiceStates
