@@ -6,7 +6,8 @@ one in the browser test), published by a :class:`~tests.monitor.robot_messages.F
 
 Values come from :data:`NUMBERS`: NaN, the infinities, huge and tiny numbers, and ordinary ones;
 lengths from lists that straddle the monitor's limits (8,192 beams, 3 to 256 corners, 200
-objects); texts with quotes, markup, line breaks and 500 characters."""
+objects); texts with quotes, markup, line breaks and 500 characters. And a tree runner's
+``services`` message gone wrong (:func:`hostile_service_states`)."""
 
 from __future__ import annotations
 
@@ -17,6 +18,9 @@ from typing import Any
 import numpy as np
 
 from cyborg.bus import Publisher
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.cyborg_msgs.msg import ServiceState, ServiceStates
+from cyborg.bus.msgs.diagnostic_msgs.msg import KeyValue
 from cyborg.bus.msgs.std_msgs.msg import String
 from tests.monitor.robot_messages import (
     FakeMapRobot,
@@ -118,3 +122,27 @@ def certainly_bad() -> list[tuple[str, Any]]:
         ("map", map_geometry(points=np.array([1.0, math.nan], np.float32))),
         ("detections", detections(("person", 0.9, math.inf))),
     ]
+
+
+def hostile_service_states(rng: random.Random, composites: list[str]) -> ServiceStates:
+    """A tree runner's ``services`` message gone wrong: composites the tree has and has not,
+    names, keys, values and errors from :data:`TEXTS` and 2,000 characters long, nanosecond
+    counts past a second, runs from 0 to the most a uint32 holds, up to 2,000 services (and
+    up to 200 written keys each of a few)."""
+    def text() -> str:
+        return "k" * 2_000 if rng.random() < 0.1 else _text(rng)
+
+    def stamp() -> Time:
+        return Time(sec=rng.choice((0, 1, -1, 2**31 - 1, -(2**31))),
+                    nanosec=rng.choice((0, 5, 999_999_999, 1_000_000_000, 2**32 - 1)))
+
+    ids = [*composites, "", "nope", "x" * 500]
+    count = rng.choice((0, 1, 4, 2000))
+    keys = (0, 1, 3, 200) if count < 10 else (0, 1)
+    return ServiceStates(stamp=stamp(), tree_id=text(), services=[
+        ServiceState(composite=rng.choice(ids), service=text(), active=rng.random() < 0.5,
+                     runs=rng.choice((0, 1, 7, 2**32 - 1)), last_run=stamp(),
+                     wrote=[KeyValue(key=text(), value=text())
+                            for _ in range(rng.choice(keys))],
+                     error=text())
+        for _ in range(count)])

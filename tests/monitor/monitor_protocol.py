@@ -148,6 +148,9 @@ class FakeSource:
     def blackboard(self) -> dict[str, Any]:
         return {"global": {}, "tree": {}, "node": {}}
 
+    def services_message(self) -> dict[str, Any] | None:
+        return None  # a tree without services
+
     def destroy(self) -> None:
         FakeSource.destroyed.append(self.namespace)
 

@@ -14,47 +14,14 @@ from typing import Any
 
 import pytest
 
-from cyborg.bt import Service, ServiceBoard, ServiceRegistry
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.bus.msgs.cyborg_msgs.msg import ServiceStates
 from cyborg.interfaces import tree_runner
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.running_system import wait_until, write_tree
+from tests.service_trees import registry, sequence_of, sequence_with
 
 NAMESPACE = "/cyborg/bt"
-
-
-class Counter(Service):
-    """Writes how many times it ran under ``key``."""
-
-    interval = 0.05
-
-    def __init__(self, key: str = "count") -> None:
-        self.key = key
-
-    def run(self, blackboard: ServiceBoard) -> None:
-        blackboard[self.key] = blackboard.get(self.key, 0) + 1
-
-
-class Broken(Service):
-    """Raises on its first run."""
-
-    interval = 0.05
-
-    def run(self, blackboard: ServiceBoard) -> None:
-        raise RuntimeError("the sensor is unplugged")
-
-
-def registry() -> ServiceRegistry:
-    services = ServiceRegistry()
-    services.add(Counter)
-    services.add(Broken)
-    return services
-
-
-def sequence_with(services: str) -> dict[str, Any]:
-    """A Sequence carrying ``services`` over a leaf that runs for ever: they stay active."""
-    return {"name": "Sequence", "props": {"services": services}, "children": [{"name": "Runner"}]}
 
 
 @pytest.fixture
@@ -95,11 +62,6 @@ def runner_on(bus: Context, tree: Path, **options: Any) -> Iterator[TreeRunnerNo
         yield runner
     finally:
         runner.destroy()
-
-
-def sequence_of(runner: TreeRunnerNode) -> str:
-    """The id of the tree's Sequence, the composite that carries the services."""
-    return next(node.uid for node in runner.tree.nodes if node.name == "Sequence")
 
 
 def seconds(stamp: Any) -> float:

@@ -45,9 +45,12 @@ def clip(text: Any, limit: int) -> str:
 
 
 def seconds_of(stamp: Any) -> float:
-    """A ``builtin_interfaces/Time`` in seconds; an out-of-range nanosecond count clamped."""
+    """A ``builtin_interfaces/Time`` in seconds, to the microsecond below.
+
+    A nanosecond count past the second is clamped to the second's last nanosecond.
+    """
     nanoseconds = min(max(int(stamp.nanosec), 0), _NANOSECONDS - 1)
-    return round(int(stamp.sec) + nanoseconds / _NANOSECONDS, 6)
+    return int(stamp.sec) + (nanoseconds // 1000) / 1e6
 
 
 def page_services(namespace: str, message: Any, state: TreeState) -> dict[str, Any]:
