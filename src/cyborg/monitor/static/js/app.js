@@ -16,6 +16,7 @@ import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { ModesPanel } from "./modes_panel.js";
 import { PlayerBar } from "./player_bar.js";
+import { badgeMarkup } from "./services.js";
 import { learnRobots, onRobotSelected, treeOfRobot } from "./robots.js";
 import { TreeFolds } from "./tree_folds.js";
 import { TreeView } from "./tree_view.js";
@@ -55,6 +56,7 @@ const view = new TreeView($("tree"), {
   onSelect: (id) => select(id),
   onToggle: (id) => toggle(id),
   onUserZoom: () => { $("autofit").checked = false; },
+  badge: (node, width) => badgeMarkup(node, width, model.servicesOn.has(node.id)),
 });
 
 const connection = new Connection({
@@ -167,6 +169,12 @@ function receive(message) {
         showBlackboard(message.data, $("bb-filter").value, nodeName);
       }
       break;
+    case "services": { // the services on composites: badges and the details panel
+      const changed = message.ns === page.ns ? model.applyServices(message) : null;
+      if (changed) view.markServices(model.servicesOn, changed);
+      if (changed && page.selected) showNode(model, page.selected, page.hooks);
+      break;
+    }
     case "history":
       tickHistory.start(message, model.version);
       break;

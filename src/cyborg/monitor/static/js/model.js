@@ -36,6 +36,9 @@ export class TreeModel {
     this.duration = 0;
     this.rootStatus = 0;
     this.timing = new Map();
+    this.services = new Map(); // composite id -> its services' states, from `services` messages
+    this.servicesOn = new Set(); // composites with a service running
+    this.servicesTime = 0; // the tree's clock when the runner took the states
   }
 
   code(id) {
@@ -95,6 +98,26 @@ export class TreeModel {
         this.timing.set(id, { calls: row[1], last: row[2], mean: row[3], min: row[4], max: row[5], changes: row[6], since: row[7] });
       }
     }
+  }
+
+  // A `services` message (the states of the services on composites); returns the composites
+  // whose badge changed (running or not), or null when the message is for another tree.
+  applyServices(message) {
+    if (message.v !== this.version) return null;
+    const services = new Map();
+    const on = new Set();
+    for (const state of message.s) {
+      if (!this.byId.has(state.id)) continue;
+      if (!services.has(state.id)) services.set(state.id, []);
+      services.get(state.id).push(state);
+      if (state.active) on.add(state.id);
+    }
+    const changed = new Set([...on].filter((id) => !this.servicesOn.has(id)));
+    for (const id of this.servicesOn) if (!on.has(id)) changed.add(id);
+    this.services = services;
+    this.servicesOn = on;
+    this.servicesTime = message.time;
+    return changed;
   }
 
   ancestors(id) {

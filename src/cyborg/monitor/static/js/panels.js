@@ -1,6 +1,7 @@
-// The side panels: the selected node (facts, timing, hook, control buttons) and the live
-// blackboard table.
+// The side panels: the selected node (facts, its services, timing, hook, control buttons) and
+// the live blackboard table.
 
+import { showServices } from "./services.js";
 import { countBelow, escapeHtml } from "./tree_view.js";
 
 const STATUS_NAMES = ["never ran", "success", "failure", "running", "error"];
@@ -24,6 +25,7 @@ export function showNode(model, id, hooks) {
   ];
   for (const [key, value] of Object.entries(node.properties || {})) facts.push([key, JSON.stringify(value)]);
   document.getElementById("node-facts").innerHTML = rows(facts);
+  showServices(node, model);
   const timing = model.timing.get(id);
   document.getElementById("node-timing").innerHTML = timing
     ? rows([

@@ -18,7 +18,8 @@ const FAR_SCALE = 0.35;
 const STATE_CLASSES = / (s\d|fresh|never|active|inside-active|hooked|paused)\b/g;
 
 export class TreeView {
-  constructor(svg, { onSelect, onToggle, onUserZoom }) {
+  // `badge(node, width)`: extra markup drawn in a node's box (the services' badge), or "".
+  constructor(svg, { onSelect, onToggle, onUserZoom, badge = () => "" }) {
     this.svg = svg;
     this.viewport = svg.querySelector("#viewport");
     this.edgeLayer = svg.querySelector("#edges");
@@ -26,6 +27,8 @@ export class TreeView {
     this.onSelect = onSelect;
     this.onToggle = onToggle;
     this.onUserZoom = onUserZoom;
+    this.badge = badge;
+    this.badges = new Map(); // id -> the <g> of its badge
     this.transform = { k: 1, x: 0, y: 0 };
     this.bounds = { x0: 0, y0: 0, x1: 1, y1: 1 };
     this.elements = new Map(); // id -> <g>
@@ -72,7 +75,7 @@ export class TreeView {
         `<g class="${stateClass(`node c-${d.data.category}${folded ? " folded" : ""}`, id, look)}" data-id="${escapeHtml(id)}" ` +
           `transform="translate(${d.x - d.width / 2},${d.y})">` +
           `<rect width="${d.width}" height="${BOX_HEIGHT}"></rect>` +
-          `<text x="${d.width / 2}" y="${BOX_HEIGHT / 2 + 1}">${escapeHtml(d.label)}</text></g>`,
+          `<text x="${d.width / 2}" y="${BOX_HEIGHT / 2 + 1}">${escapeHtml(d.label)}</text>${this.badge(d.data, d.width)}</g>`,
       );
       if (d.parent) {
         const px = d.parent.x, py = d.parent.y + BOX_HEIGHT, my = (py + d.y) / 2;
@@ -87,6 +90,8 @@ export class TreeView {
     this.nodeLayer.innerHTML = nodes.join("");
     this.elements = new Map();
     for (const g of this.nodeLayer.children) this.elements.set(g.dataset.id, g);
+    this.badges = new Map();
+    for (const g of this.nodeLayer.querySelectorAll("g.svc")) this.badges.set(g.parentNode.dataset.id, g);
     this.edges = new Map();
     for (const path of this.edgeLayer.children) this.edges.set(path.dataset.child, path);
     this.bounds = { x0: x0 - 20, y0: -20, x1: x1 + 20, y1: y1 + 20 };
@@ -99,6 +104,7 @@ export class TreeView {
     this.nodeLayer.innerHTML = "";
     this.elements = new Map();
     this.edges = new Map();
+    this.badges = new Map();
     this.layoutRoot = null;
     return 0;
   }
@@ -116,6 +122,11 @@ export class TreeView {
       const path = this.edges.get(id);
       if (path) path.classList.toggle("active", look.active.has(id) && look.active.has(path.dataset.parent));
     }
+  }
+
+  // Badges of the composites `ids` marked running (`on`), the others not.
+  markServices(on, ids) {
+    for (const id of ids) this.badges.get(id)?.classList.toggle("on", on.has(id));
   }
 
   markClass(name, ids) {
