@@ -135,3 +135,28 @@ def test_decimal_clock_steps_do_not_cost_an_extra_tick() -> None:
     assert tree.tick().status is Status.RUNNING
     clock.set(0.35)
     assert tree.tick().status is Status.FAILURE
+
+
+def test_service_listeners_hear_of_runs_between_ticks_and_of_a_halt_that_stops_them() -> None:
+    from tests.bt.service_helpers import probe_tree
+
+    tree = probe_tree(N("Sequence", N("Runner"), id="seq", services="Probe(interval=0.02)"))
+    tree.clock = MonotonicClock()
+    loop = TickLoop(tree, rate_hz=0.2)  # one tick, then service runs only
+    heard: list[tuple[int, bool, str]] = []
+    remove = loop.add_service_listener(lambda services: heard.append(
+        (tree.ticks, services.states()[0].active, threading.current_thread().name)))
+    loop.start()
+    deadline = time.monotonic() + 30.0
+    while len(heard) < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert len(heard) >= 3 and {ticks for ticks, _, _ in heard} == {1}, heard
+    assert all(active and thread == "bt:Main" for _, active, thread in heard), heard
+    heard.clear()
+    loop.pause(halt=True)
+    assert heard and heard[-1][1] is False, "the halt stopped the service, and said so"
+    remove()
+    loop.stop(timeout=30.0)
+    count = len(heard)
+    loop.step()
+    assert len(heard) == count, "a removed listener hears nothing more"

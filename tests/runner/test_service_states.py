@@ -16,8 +16,10 @@ import pytest
 
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.bus.msgs.cyborg_msgs.msg import ServiceStates
-from cyborg.interfaces import tree_runner
+from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.interfaces import modes, tree_runner
 from cyborg.runner.tree_runner import TreeRunnerNode
+from tests.builders import N, project_json, tree_json
 from tests.running_system import wait_until, write_tree
 from tests.service_trees import registry, sequence_of, sequence_with
 
@@ -189,3 +191,45 @@ def test_a_disabled_runner_reloading_a_tree_with_services_shows_them_idle(
         assert (state.service, state.active, state.runs, list(state.wrote)) == \
             ("Counter", False, 0, [])
         assert state.composite == sequence_of(runner)
+
+
+MODES = """\
+project = "mission.b3.json"
+initial = "normal"
+[modes.normal]
+tree = "patrol"
+[modes.demo]
+tree = "demo"
+
+[[transitions]]
+from = "normal"
+to = "demo"
+event = "show"
+"""
+
+
+def test_a_mode_file_publishes_the_current_modes_services_and_none_in_a_mode_without(
+        bus: Context, tmp_path: Path) -> None:
+    patrol = tree_json(N("Sequence", N("Runner"), services="Counter(interval=0.05)"),
+                       tree_id="patrol", title="patrol")
+    demo = tree_json(N("Sequence", N("Runner")), tree_id="demo", title="demo")
+    (tmp_path / "mission.b3.json").write_text(project_json([patrol, demo]))
+    modes_file = tmp_path / "mission.modes.toml"
+    modes_file.write_text(MODES)
+    listener = Listener(bus)
+    events = modes.EVENTS.publisher(listener.node, NAMESPACE)
+    with runner_on(bus, modes_file) as runner:
+        wait_until(lambda: counted(listener.last()) >= 3, timeout=15,
+                   what="the normal mode's Counter published")
+        last = listener.last()
+        assert last is not None and last.tree_id == "patrol"
+        assert last.services[0].composite == sequence_of(runner)
+
+        def in_demo() -> bool:  # the event again until the runner's subscription has it
+            if runner.tree.title != "demo":
+                events.publish(String(data="show"))
+            return runner.tree.title == "demo"
+        wait_until(in_demo, timeout=15, what="the demo mode")
+        wait_until(lambda: (message := listener.last()) is not None and not message.services,
+                   timeout=15, what="an empty message in the mode without services")
+        assert listener.last().tree_id == "demo"  # type: ignore[union-attr]
