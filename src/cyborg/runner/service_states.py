@@ -1,11 +1,11 @@
 """The tree runner's ``services`` topic: the states of the services on its composites.
 
-A :class:`ServiceStatesPublisher` is offered the tree that ticks after every tick and every
-run (or halt) of services outside a tick, and reads its service states
-(:meth:`ServiceRunner.states <cyborg.bt.service_runner.ServiceRunner.states>`; none for a tree
-without services). ``states()`` hands back the very same tuple while nothing changed, so an offer
-of unchanged states costs one identity test; a changed one is published on
-:data:`~cyborg.interfaces.tree_runner.SERVICE_STATES` (latched), at most
+A :class:`ServiceStatesPublisher` is offered the service states of the tree that ticks
+(:meth:`ServiceRunner.states <cyborg.bt.service_runner.ServiceRunner.states>`, ``None`` for a
+tree without services) after every tick (the snapshot's) and every run or halt of services
+outside a tick (read under the tick loop's lock). ``states()`` hands back the very same tuple
+while nothing changed, so an offer of unchanged states costs one identity test; a changed one
+is published on :data:`~cyborg.interfaces.tree_runner.SERVICE_STATES` (latched), at most
 :data:`~cyborg.interfaces.tree_runner.SERVICE_STATES_PER_SECOND` times a second of wall time:
 states offered sooner wait, and the newest of them goes out when the interval has passed (from
 a timer thread), so the last change is never lost.
@@ -21,6 +21,7 @@ import time
 from collections.abc import Sequence
 
 from cyborg.bt.service_runner import ServiceState
+from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.tree import Tree
 from cyborg.bus import Node
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
@@ -48,6 +49,12 @@ def states_message(tree_id: str, states: Sequence[ServiceState], now: float) -> 
         for state in states])
 
 
+def states_of(tree: Tree) -> tuple[ServiceState, ...] | None:
+    """The states of ``tree``'s services now; ``None`` for a tree without services."""
+    services = tree.services
+    return None if services is None else services.states()
+
+
 class ServiceStatesPublisher:
     """Publishes the service states offered to it; see the module docstring."""
 
@@ -64,28 +71,42 @@ class ServiceStatesPublisher:
         self._showing = False
         """Whether the last message queued listed services."""
         self._closed = False
+        self._looked: tuple[Tree | None, int] = (None, 0)
+        """The tree last looked at outside a tick, and its tick count then."""
         self.published = 0
         """How many messages it has published."""
 
-    def offer(self, tree: Tree) -> None:
-        """The service states of ``tree``, the tree that ticks now.
+    def tick_ended(self, tree: Tree, snapshot: TickSnapshot) -> None:
+        """After a tick: the states its snapshot took, unless it switched to ``tree`` (a mode).
 
-        Called where ``tree.services.states()`` may be read: on the ticking thread, or under
-        the tick loop's lock. Cheap when nothing changed since the last offer.
+        A snapshot older than a :meth:`look` at the same tree is passed over: a halt on another
+        thread (a disable) may have stopped the services after the tick and before this.
         """
-        services = tree.services
-        states = None if services is None else services.states()
+        if tree is self._looked[0] and snapshot.tick <= self._looked[1]:
+            return
+        self.offer(tree, snapshot.services if tree.last is snapshot else states_of(tree))
+
+    def look(self, tree: Tree) -> None:
+        """The states of ``tree`` read now: under the tick loop's lock, or while no tick runs."""
+        self._looked = (tree, tree.ticks)
+        self.offer(tree, states_of(tree))
+
+    def offer(self, tree: Tree, states: tuple[ServiceState, ...] | None) -> None:
+        """The service ``states`` of ``tree``, the tree that ticks now (``None``: it has none).
+
+        Cheap when they are the very states offered last (nothing changed); may be called
+        from the ticking thread and from a thread that halted the tree.
+        """
         if states is self._offered:
             return
-        self._offered = states
-        if not states and not self._showing:
-            return  # a tree without services, and none shown before it
-        self._showing = bool(states)
-        message = states_message(tree.tree_id, states or (), tree.clock.now())
         with self._lock:
-            if self._closed:
+            if self._closed or states is self._offered:
                 return
-            self._pending = message
+            self._offered = states
+            if not states and not self._showing:
+                return  # a tree without services, and none shown before it
+            self._showing = bool(states)
+            self._pending = states_message(tree.tree_id, states or (), tree.clock.now())
             wait = self._sent_at + self.interval - time.monotonic()
             if wait <= 0:
                 self._send_pending()

@@ -162,7 +162,7 @@ class TreeRunnerNode:
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
-        self.runner.add_service_listener(lambda _services: self._offer_services())
+        self.runner.add_service_listener(lambda _ran: self._service_states.look(self.tree))
         self.modes: ModeEndpoints | None = None
         self._structure_after_tick = False
         if isinstance(self.ticked, ModeMachine):
@@ -256,7 +256,7 @@ class TreeRunnerNode:
             self._follow(ticked)
         self._publish_structure()
         if not self._enabled:  # no tick comes to tell of the new tree's services
-            self._offer_services()
+            self._service_states.look(tree)
         log.info("reloaded %s: %s", path, describe(ticked))
         return ticked
 
@@ -350,12 +350,8 @@ class TreeRunnerNode:
     def _publish_active(self, active: tuple[str, ...]) -> None:
         self._updates.publish(BehaviorTreeNodes(ids=list(active)))
 
-    def _offer_services(self) -> None:
-        """The services of the tree that ticks now to ``services`` (when they changed)."""
-        self._service_states.offer(self.tree)
-
     def _on_tick(self, snapshot: TickSnapshot) -> None:
-        self._offer_services()
+        self._service_states.tick_ended(self.tree, snapshot)
         self._publish_tick(snapshot)
         if self._structure_after_tick:
             # the mode changed right after this tick: its path and status (of the tree left)
