@@ -127,10 +127,11 @@ def test_cdr_round_trip_and_numpy_views(types: MessageTypes) -> None:
                          visited_ids=["a", "b/c"],
                          visited_statuses=np.array([1, 3], dtype=np.uint8),
                          visited_durations=np.array([1e-5, 2e-6], dtype=np.float32),
-                         active_ids=["b/c"], halted_ids=[])
+                         active_ids=["b/c"], halted_ids=[], mode="normal")
     raw = bytes(types.serialize(message, "cyborg_msgs/msg/BehaviorTreeStatus"))
     back = types.deserialize(raw, "cyborg_msgs/msg/BehaviorTreeStatus")
-    assert (back.tick, back.visited_ids, back.stamp.sec) == (42, ["a", "b/c"], 12)
+    assert (back.tick, back.visited_ids, back.stamp.sec, back.mode) == (42, ["a", "b/c"], 12,
+                                                                          "normal")
     assert back.visited_statuses.tolist() == [1, 3]
     image_cls = types.message_class("sensor_msgs/msg/Image")
     header_cls = types.message_class("std_msgs/msg/Header")

@@ -123,7 +123,7 @@ def test_the_tree_ticks_as_json_naming_its_nodes(served: Served) -> None:
             status=3, visited_ids=["check", "drive", "seq"],
             visited_statuses=np.array([1, 3, 3], np.uint8),
             visited_durations=np.array([0.001, 0.001, 0.002], np.float32),
-            active_ids=["seq", "drive"], halted_ids=[])
+            active_ids=["seq", "drive"], halted_ids=[], mode="")
     stream = Repeating(status, tick)
     try:
         with served.client() as client:

@@ -75,6 +75,6 @@ def write_played_run(path: Path) -> None:
             visited_durations=np.full(len(visited), 0.001, np.float32),
             active_ids=[uid for uid in ("root", "work", "rest")
                         if visited.get(uid) == RUNNING],
-            halted_ids=[]), seconds, [])
+            halted_ids=[], mode=""), seconds, [])
         add(f"{ROBOT}/pose", Pose2D(x=seconds, y=1.0, theta=0.0), seconds, [])
     file.close()

@@ -38,7 +38,8 @@ def status(i: int) -> BehaviorTreeStatus:
                               status=3, visited_ids=["a", f"n{i}"],
                               visited_statuses=np.array([1, 3], dtype=np.uint8),
                               visited_durations=np.array([0.25, 0.5], dtype=np.float32),
-                              active_ids=["root", f"n{i}"], halted_ids=[])
+                              active_ids=["root", f"n{i}"], halted_ids=[],
+                              mode="")
 
 
 MESSAGES: dict[str, tuple[type, Any]] = {

@@ -99,7 +99,7 @@ def tick(number: int, seconds: float, root: int, visited: list[tuple[str, int]],
         visited_statuses=np.array([status for _, status in visited], np.uint8),
         visited_durations=np.array(durations if durations is not None
                                    else [0.002] * len(visited), np.float32),
-        active_ids=[], halted_ids=[])
+        active_ids=[], halted_ids=[], mode="")
 
 
 def battery(charge: float, *, charging: bool = False, dock: str = "UNDOCKED") -> BatteryStatus:

@@ -14,7 +14,12 @@ import pytest
 
 from cyborg.bt import Blackboard, ManualClock, TreeLoadError
 from cyborg.bus import BusConfig, Context, Node
-from cyborg.bus.msgs.cyborg_msgs.msg import BehaviorTree, ModeState, ModeTransition
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BehaviorTree,
+    BehaviorTreeStatus,
+    ModeState,
+    ModeTransition,
+)
 from cyborg.bus.msgs.cyborg_msgs.srv import SetMode
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.interfaces import modes, tree_runner
@@ -226,3 +231,24 @@ def _status_heard(runner: TreeRunnerNode, heard: list[tuple[str, Any]]) -> bool:
     runner.runner.step()
     time.sleep(0.05)
     return False
+
+
+def test_each_status_names_the_mode_whose_tree_ticked(bus: Context, tmp_path: Path) -> None:
+    runner = start_runner(bus, tmp_path, ManualClock())
+    watcher = Node("status_watcher", "/test", context=bus)
+    statuses: list[BehaviorTreeStatus] = []
+    tree_runner.STATUS.subscription(watcher, statuses.append, NAMESPACE)
+    try:
+        machine = runner.ticked
+        assert isinstance(machine, ModeMachine)
+        wait_until(lambda: runner._status.subscription_count() > 0, 10.0, "the subscription")
+        runner.runner.step()
+        machine.globals["battery"] = {"percent": 15}
+        runner.runner.step()  # the normal tree ticks, then the machine goes to low
+        runner.runner.step()
+        wait_until(lambda: len(statuses) == 3, 10.0, "three statuses")
+        assert [status.mode for status in statuses] == ["normal", "normal", "low"]
+        assert [status.tick for status in statuses] == [1, 2, 1], "each mode's tree counts"
+    finally:
+        watcher.destroy()
+        runner.destroy()

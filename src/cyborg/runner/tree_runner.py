@@ -15,7 +15,8 @@ name                        type                                what
 ``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: nodes visited with
                                                                 their status and wall time
                                                                 (timed while someone listens),
-                                                                tick, duration
+                                                                tick, duration, and the mode
+                                                                that ticked (of a mode file)
 ``services``                cyborg_msgs/ServiceStates           latched: the services on the
                                                                 composites, when they change (at
                                                                 most 4 a second;
@@ -378,7 +379,15 @@ class TreeRunnerNode:
             status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
             visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
             visited_durations=np.array(snapshot.visit_durations, np.float32),
-            active_ids=list(active), halted_ids=snapshot.halted))
+            active_ids=list(active), halted_ids=snapshot.halted, mode=self._mode_of(snapshot)))
+
+    def _mode_of(self, snapshot: TickSnapshot) -> str:
+        """The mode whose tree made ``snapshot``; empty for a plain tree."""
+        machine = self.ticked
+        if not isinstance(machine, ModeMachine):
+            return ""
+        last = machine.last  # set by the tick that made the snapshot, before the listeners
+        return last.mode if last is not None and last.snapshot is snapshot else machine.mode
 
     # ------------------------------------------------------------------ services
     def _on_enable(self, request: SetBool_Request) -> SetBool_Response:

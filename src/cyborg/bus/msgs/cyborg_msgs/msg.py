@@ -88,6 +88,7 @@ class cyborg_msgs__msg__BehaviorTreeStatus:
     visited_durations: np.ndarray[tuple[int, ...], np.dtype[np.float32]]
     active_ids: list[str]
     halted_ids: list[str]
+    mode: str
     SUCCESS: ClassVar[int] = 1
     FAILURE: ClassVar[int] = 2
     RUNNING: ClassVar[int] = 3
