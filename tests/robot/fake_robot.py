@@ -54,6 +54,8 @@ class FakeRobot:
     """False: the robot's services and action server are gone (the simulator was killed)."""
     send_attempts: int = 0
     """Calls of move_to, sent or not."""
+    help_calls: list[tuple[str, float]] = field(default_factory=list)
+    """Each call_for_help: ``(reason, time)``."""
 
     def goals(self, refresh: bool = False) -> dict[str, Goal]:
         if refresh and not self.reachable:
@@ -74,6 +76,9 @@ class FakeRobot:
     def dock(self) -> tuple[bool, str]:
         self.dock_requests += 1
         return (True, "docking") if self.can_dock else (False, "the map has no Dock")
+
+    def call_for_help(self, reason: str, time: float) -> None:
+        self.help_calls.append((reason, time))
 
     def undock(self) -> tuple[bool, str]:
         self.undock_requests += 1

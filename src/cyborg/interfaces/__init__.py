@@ -19,6 +19,8 @@ that every client endpoint finds its server.
   (`cyborg play` ↔ a timeline).
 * :mod:`~cyborg.interfaces.modes` — a mode machine's state, transitions, events and its
   request/force/hold service (tree runner of a mode file ↔ ``cyborg bt mode``, monitors).
+* :mod:`~cyborg.interfaces.help` — a robot's call for help (its tree's robot ↔ whoever
+  comes: ``cyborg topic echo /cyborg/help``, monitors).
 
 **Adding to a contract.** Declare the endpoint in the module of the program that serves it,
 e.g. ``BUMPERS = Topic("bumper_state", BumperState, latched=True)`` with ``BumperState``

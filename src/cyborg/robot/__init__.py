@@ -12,6 +12,10 @@ ClosestGoal{key}          action      closest goal by path length into the black
 DistanceToGoal{location}  condition   path length to a goal into the blackboard
 BlackboardCompare{key,    decorator   tick the child when a blackboard entry matches
 value,equal}
+ReadBattery{key}          action      the battery reading into the global blackboard
+StopSafely                action      ask the robot to stop (it waits where it is)
+CallForHelp{reason,       action      call for help on the robot's ``help`` topic, again
+every}                                every ``every`` s; RUNNING
 ========================  ==========  =====================================================
 
 Two services (:mod:`cyborg.robot.watch_services`) keep the robot's state in the blackboard while
@@ -26,8 +30,17 @@ point of the groups ``cyborg.nodes`` and ``cyborg.services``, so every registry 
 way (see the README).
 """
 
-from cyborg.robot import battery, blackboard_compare, docking, goals, move_to, watch_services
+from cyborg.robot import (
+    battery,
+    battery_board,
+    blackboard_compare,
+    docking,
+    goals,
+    move_to,
+    safety,
+    watch_services,
+)
 from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
 
-__all__ = ["ROBOT", "Robot", "RobotError", "battery", "blackboard_compare", "docking", "goals",
-           "move_to", "robot_of", "watch_services"]
+__all__ = ["ROBOT", "Robot", "RobotError", "battery", "battery_board", "blackboard_compare",
+           "docking", "goals", "move_to", "robot_of", "safety", "watch_services"]

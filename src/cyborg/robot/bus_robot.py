@@ -2,7 +2,8 @@
 
 Under the robot's namespace (``/cyborg`` by default) it uses the topics ``pose`` and
 ``battery_status``, the services ``nav/get_available_goals``, ``nav/get_distance_to_goal``,
-``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action
+``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action,
+and publishes its calls for help on ``help`` (:mod:`cyborg.interfaces.help`)
 (see :mod:`cyborg.interfaces.robot` for the full interface, which the simulator serves)::
 
     robot = BusRobot(Node("bt", "/cyborg"), "/cyborg")
@@ -21,6 +22,7 @@ from typing import Any
 
 from cyborg.bus import ActionError, ClientGoal, Node, ServiceError, new_message
 from cyborg.interfaces import robot
+from cyborg.interfaces.help import HELP, HelpCall, help_text
 from cyborg.nav.geometry import Pose2D
 from cyborg.robot.interface import BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from cyborg.robot.rate_limited_log import RateLimitedLog
@@ -116,6 +118,7 @@ class BusRobot:
             robot.AVAILABLE_GOALS, robot.DISTANCE_TO_GOAL, robot.CLOSEST_GOAL, robot.DOCK,
             robot.UNDOCK, robot.STOP)}
         self._action = robot.MOVE_TO_GOAL.client(node, namespace)
+        self._help = HELP.publisher(node, namespace)
 
     # ------------------------------------------------------------------ state
     def _on_pose(self, message: Any) -> None:
@@ -205,6 +208,16 @@ class BusRobot:
                            "orientation": {"z": pose.orientation.z, "w": pose.orientation.w}}}
         return self.node.context.calls.submit(
             lambda: float(self._call(robot.DISTANCE_TO_GOAL.name, **fields).distance))
+
+    def call_for_help(self, reason: str, time: float) -> None:
+        """Publishes a call for help on ``help`` (:mod:`cyborg.interfaces.help`).
+
+        The call names the robot's namespace, ``reason``, its last pose and charge, and ``time``.
+        """
+        pose, battery = self._pose, self._battery
+        self._help.publish(help_text(HelpCall(
+            self.namespace, reason, None if pose is None else (pose.x, pose.y, pose.theta),
+            None if battery is None else battery.charge_percent, time)))
 
     def closest_goal(self) -> Future[tuple[str, float]]:
         """A future of the closest goal and its path length in m, asked on the call pool."""

@@ -107,6 +107,9 @@ class Robot(Protocol):
     def closest_goal(self) -> Future[tuple[str, float]]:
         """The goal with the shortest planned path, and its length."""
         ...
+    def call_for_help(self, reason: str, time: float) -> None:
+        """Say on the bus that the robot needs help, why, and where it is (never blocks)."""
+        ...
 
 
 class RobotError(RuntimeError):
