@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from cyborg.bt import RUNNING, SUCCESS, ManualClock, TreeLoadError
@@ -58,7 +60,7 @@ def test_stop_safely_asks_again_while_the_robot_does_not_answer() -> None:
 @pytest.mark.parametrize(("props", "field"), [({"reason": " "}, "reason"),
                                               ({"every": 0}, "every"),
                                               ({"every": -5}, "every")])
-def test_bad_call_for_help_properties_are_load_errors(props: dict[str, object],
+def test_bad_call_for_help_properties_are_load_errors(props: dict[str, Any],
                                                       field: str) -> None:
     with pytest.raises(TreeLoadError, match=field):
         robot_tree(N("CallForHelp", **props), FakeRobot())
