@@ -13,11 +13,14 @@ from tests.robot.fake_robot import FakeRobot, robot_tree
 
 
 class UnreachableRobot(FakeRobot):
-    """Its stop service is gone: every stop raises."""
+    """While ``gone``, its stop service does not answer: every stop raises."""
+
+    gone = True
 
     def stop(self) -> None:
         self.stops += 1
-        raise RobotError("service /cyborg/stop is not available")
+        if self.gone:
+            raise RobotError("service /cyborg/stop is not available")
 
 
 def test_stop_safely_stops_the_robot_then_the_call_for_help_repeats_while_it_waits() -> None:
@@ -53,7 +56,7 @@ def test_stop_safely_asks_again_while_the_robot_does_not_answer() -> None:
     tree = robot_tree(N("StopSafely"), robot, clock)
     assert tree.tick().status is RUNNING and tree.tick().status is RUNNING
     assert robot.stops == 2
-    robot.__class__ = FakeRobot  # the service is back
+    robot.gone = False  # the service is back
     assert tree.tick().status is SUCCESS
 
 
