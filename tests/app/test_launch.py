@@ -238,16 +238,16 @@ def test_cyborg_up_runs_the_bundled_system() -> None:
         if robots["robots"] and robots["robots"][0]["alive"] and robots["robots"][0]["tick"]:
             break
         time.sleep(0.2)
-    assert robots["robots"][0]["title"] == "Campus mission", robots
+    assert robots["robots"][0]["title"] == "Patrol", robots  # the tree of the mode `normal`
     page = urllib.request.urlopen(url, timeout=5).read().decode()
     assert "<title>cyborg monitor</title>" in page
     rest = process.stdout.read()  # what the text wrapper has read ahead stays in it
     assert process.wait(timeout=120) == 0, rest + (process.stderr.read() if process.stderr else "")
     out = "".join(lines) + rest
     assert "simulator    /cyborg/arnl: campus.map at 20x real time" in out
-    assert "tree runner  /cyborg/bt/tree_runner: 'Campus mission' (22 nodes)" in out
-    assert "Campus mission > Priority > Patrol > Repeat -1x > MemSequence > MoveTo Lecture hall" \
-        in out
+    assert ("tree runner  /cyborg/bt/tree_runner: 4 modes, in 'normal' ('Patrol', 17 nodes) "
+            "from campus.modes.toml") in out
+    assert "Patrol > Sequence > Repeat -1x > MemSequence > MoveTo Lecture hall" in out
     assert "MoveTo Library" in out, "the robot got to the lecture hall and went on"
 
 

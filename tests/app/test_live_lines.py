@@ -12,7 +12,9 @@ from hypothesis import strategies as st
 
 from cyborg.app.progress import ProgressBar, Unit
 from cyborg.app.status_line import StatusLine, fit_status
-from cyborg.bt import Status, load_tree
+from cyborg.bt import Status, Tree, load_tree, loads_tree
+from cyborg.bt.snapshot import TickSnapshot
+from tests.builders import N, project_json, registry, tree_json
 from tests.running_system import write_tree
 
 CAMPUS = ["Campus mission", "Priority", "Patrol", "Repeat -1x", "MemSequence",
@@ -36,6 +38,29 @@ def test_a_short_status_line_is_written_in_full() -> None:
     assert fit_status(42, Status.RUNNING, ["Root", "MoveTo room1"], 80) == \
         "tick     42  RUNNING  Root > MoveTo room1"
     assert fit_status(3, Status.SUCCESS, [], 80) == "tick      3  SUCCESS  -"
+
+
+def test_the_status_line_of_a_mode_machine_names_the_mode_and_its_trees_nodes() -> None:
+    patrol = loads_tree(project_json([tree_json(N("Sequence", N("Runner"), title="Go"),
+                                                title="Patrol")]), registry=registry())
+    charge = loads_tree(project_json([tree_json(N("Runner", title="Charge"), title="Go charge",
+                                                tree_id="charge")]), registry=registry())
+    modes = {id(patrol): "normal", id(charge): "low_battery"}
+    made_by: dict[int, Tree] = {}
+
+    def tick(tree: Tree) -> TickSnapshot:
+        snapshot = tree.tick()
+        made_by[id(snapshot)] = tree
+        return snapshot
+
+    stream = io.StringIO()
+    line = StatusLine(patrol, stream, tree_of=lambda snapshot: made_by[id(snapshot)],
+                      mode_of=lambda snapshot: modes[id(made_by[id(snapshot)])])
+    line.update(tick(patrol))
+    line.update(tick(charge))
+    assert stream.getvalue().splitlines() == [
+        "tick      1  RUNNING  [normal] Patrol > Go > Runner",
+        "tick      1  RUNNING  [low_battery] Go charge > Charge"]
 
 
 @pytest.mark.parametrize("width", [80, 40])

@@ -129,5 +129,5 @@ def test_cyborg_up_record_records_the_run_with_its_map_and_tree(tmp_path: Path) 
                   "/clock"):
         assert counts.get(topic, 0) > 0, topic
     assert metadata["cyborg"]["map"].endswith("campus.map")
-    assert metadata["cyborg"]["tree"].endswith("campus_patrol.b3.json")
+    assert metadata["cyborg"]["tree"].endswith("campus.modes.toml")
     assert metadata["cyborg.map"]["source"] == "campus.map"

@@ -242,6 +242,8 @@ def test_each_status_names_the_mode_whose_tree_ticked(bus: Context, tmp_path: Pa
         machine = runner.ticked
         assert isinstance(machine, ModeMachine)
         wait_until(lambda: runner._status.subscription_count() > 0, 10.0, "the subscription")
+        titles: list[str] = []
+        runner.runner.add_listener(lambda snapshot: titles.append(runner.tree_of(snapshot).title))
         runner.runner.step()
         machine.globals["battery"] = {"percent": 15}
         runner.runner.step()  # the normal tree ticks, then the machine goes to low
@@ -249,6 +251,7 @@ def test_each_status_names_the_mode_whose_tree_ticked(bus: Context, tmp_path: Pa
         wait_until(lambda: len(statuses) == 3, 10.0, "three statuses")
         assert [status.mode for status in statuses] == ["normal", "normal", "low"]
         assert [status.tick for status in statuses] == [1, 2, 1], "each mode's tree counts"
+        assert titles == ["patrol", "patrol", "charge"], "the tree that ticked, not the next"
     finally:
         watcher.destroy()
         runner.destroy()

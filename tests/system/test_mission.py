@@ -16,11 +16,20 @@ import pytest
 
 from cyborg.app.cli import build_parser
 from cyborg.app.launch import Launch
-from cyborg.app.up import CAMPUS_TREE, DATA, up_description, up_notes
-from cyborg.bt import SUCCESS, load_tree
+from cyborg.app.up import (
+    CAMPUS_CHARGED,
+    CAMPUS_DEMO_TIME,
+    CAMPUS_MODES,
+    CAMPUS_THRESHOLD,
+    DATA,
+    up_description,
+    up_notes,
+)
+from cyborg.bt import SUCCESS
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import BusConfig, Context
 from cyborg.bus.actions import ActionServer, GoalStatus
+from cyborg.modes import ModeMachine, read_mode_file
 from cyborg.runner.component import RunningTree
 from cyborg.sim.component import RunningSimulator
 from cyborg.sim.simulator import Simulator
@@ -109,36 +118,55 @@ def test_patrol_and_recharge_over_a_full_battery_cycle(shared: Path) -> None:
 
 
 # ---------------------------------------------------------------------------------- cyborg up
-RECHARGE_WITHIN = 120.0
-"""Wall-clock seconds in which `cyborg up`, on its defaults, shows the recharge (README)."""
+CYCLE_WITHIN = 180.0
+"""Wall-clock seconds in which `cyborg up`, on its defaults, shows normal -> low_battery ->
+normal (README, docs/modes.md)."""
 
 
-def _bundled_threshold() -> float:
-    tree = load_tree(Path(str(DATA.joinpath(CAMPUS_TREE))))
-    (guard,) = [node for node in tree if node.name == "CheckBattery"]
-    return float(guard.threshold)  # type: ignore[attr-defined]
+def _bundled_condition(source: str, target: str) -> str:
+    """The `when` of the bundled mode file's transition from ``source`` to ``target``."""
+    spec = read_mode_file(Path(str(DATA.joinpath(CAMPUS_MODES))))
+    (when,) = [t.when.source for t in spec.transitions
+               if t.when is not None and source in t.sources and t.target == target]
+    return when
 
 
-def test_cyborg_up_starts_just_above_the_recharge_threshold_and_says_so() -> None:
+def test_cyborg_up_runs_the_mission_on_modes_just_above_low_battery_and_says_so() -> None:
     args = build_parser().parse_args(["up", "--no-detector"])
-    sim = next(spec for spec in up_description(args).nodes if spec.kind == "simulator")
-    threshold = _bundled_threshold()
-    assert threshold < sim.parameters["battery"] <= threshold + 5, "a recharge soon"
+    description = up_description(args)
+    sim = next(spec for spec in description.nodes if spec.kind == "simulator")
+    runner = next(spec for spec in description.nodes if spec.kind == "tree_runner")
+    assert runner.parameters["tree_file"].endswith(CAMPUS_MODES)
+    assert _bundled_condition("normal", "low_battery") == \
+        f"battery.percent < {CAMPUS_THRESHOLD:g}"
+    assert _bundled_condition("low_battery", "normal") == \
+        f"battery.percent >= {CAMPUS_CHARGED:g}"
+    spec = read_mode_file(Path(str(DATA.joinpath(CAMPUS_MODES))))
+    assert spec.modes["demo"].max_time == CAMPUS_DEMO_TIME
+    assert {"emergency", "help_arrived"} <= {t.event for t in spec.transitions}
+    assert CAMPUS_THRESHOLD < sim.parameters["battery"] <= CAMPUS_THRESHOLD + 5, "low soon"
     assert sim.parameters["speed"] > 1, "faster than real time"
     notes = "\n".join(up_notes(args))
     assert f"{sim.parameters['speed']:g}x real time (--speed)" in notes
     assert f"battery at {sim.parameters['battery']:g} % (--battery)" in notes
-    assert f"below {threshold:g} %" in notes
+    assert f"below {CAMPUS_THRESHOLD:g} %" in notes and f"to {CAMPUS_CHARGED:g} %" in notes
+    assert "/cyborg/help" in notes and "`help_arrived`" in notes
+    assert f"demo for {CAMPUS_DEMO_TIME / sim.parameters['speed']:g} s" in notes
     assert all(len(f"  {line}") < 80 for line in notes.splitlines()), "as printed"
     own = build_parser().parse_args(["up", "--speed", "1", "--battery", "100"])
-    assert "recharge" not in "\n".join(up_notes(own)), "no promise the user's choice breaks"
+    assert "low_battery" not in "\n".join(up_notes(own)), "no promise the user's choice breaks"
+    plain = up_description(build_parser().parse_args(["up", "--tree", "x.b3.json"]))
+    assert next(spec for spec in plain.nodes if spec.kind == "tree_runner").parameters[
+        "tree_file"] == "x.b3.json", "--tree still runs a plain tree"
 
 
 @pytest.mark.heavy
-def test_cyborg_up_on_its_defaults_shows_a_recharge_within_two_minutes() -> None:
+def test_cyborg_up_on_its_defaults_goes_to_charge_and_back_to_patrol_within_three_minutes(
+) -> None:
     """What `cyborg up` starts, at its default pace and charge (the monitor and camera left
-    out): the patrol runs, the battery falls below the threshold, the robot docks and charges,
-    all within the wall-clock time the README promises."""
+    out): the patrol runs, the battery falls below the threshold, the mode machine sends the
+    robot to charge, and once charged back to patrol, within the wall-clock time the README
+    promises."""
     args = build_parser().parse_args(["up", "--no-monitor", "--no-detector"])
     seen: list[str] = []
     with Context(BusConfig.isolated()) as context:
@@ -149,18 +177,21 @@ def test_cyborg_up_on_its_defaults_shows_a_recharge_within_two_minutes() -> None
             sim = next(item for item in launch.running
                        if isinstance(item, RunningSimulator)).loop.simulator
             runner = next(item for item in launch.running if isinstance(item, RunningTree))
-            labels = {node.uid: node.label for node in runner.runner.tree}
+            machine = runner.runner.ticked
+            assert isinstance(machine, ModeMachine)
+            labels = {node.uid: node.label for tree in machine.trees.values() for node in tree}
             runner.runner.runner.add_listener(lambda snapshot: seen.extend(
                 labels[uid] for uid in snapshot.active[-1:]))
-            wait_until(lambda: "Charge to 90%" in seen,
-                       timeout=RECHARGE_WITHIN - (time.monotonic() - started),
-                       what="the recharge to start")
-            low = sim.battery.charge_percent
-            wait_until(lambda: sim.battery.charging and sim.battery.charge_percent > low + 0.1,
-                       timeout=max(RECHARGE_WITHIN - (time.monotonic() - started), 1.0),
-                       what="the battery to charge")
+            wait_until(lambda: machine.transition_count >= 2,
+                       timeout=CYCLE_WITHIN - (time.monotonic() - started),
+                       what="low_battery and back to normal")
+            charged = sim.battery.charge_percent
         finally:
             launch.stop()
-    assert low < _bundled_threshold()
+    first, second = machine.history[0], machine.history[1]
+    assert (first.source, first.target, second.source, second.target) == (
+        "normal", "low_battery", "low_battery", "normal")
+    assert charged >= CAMPUS_CHARGED
     patrol = seen[:seen.index("MoveTo Charger")]
     assert {"MoveTo Lecture hall", "MoveTo Library"} <= set(patrol), "the patrol came first"
+    assert "Charge to 100%" in seen

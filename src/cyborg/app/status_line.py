@@ -9,7 +9,7 @@ in full, is written only when the root status or the active path changes, so log
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TextIO
 
 from cyborg.app.progress import terminal_width
@@ -59,8 +59,17 @@ class StatusLine:
     the status or the active path changes.
     """
 
-    def __init__(self, tree: Tree, stream: TextIO, *, redraw_hz: float = 10.0) -> None:
+    def __init__(self, tree: Tree, stream: TextIO, *, redraw_hz: float = 10.0,
+                 tree_of: Callable[[TickSnapshot], Tree] | None = None,
+                 mode_of: Callable[[TickSnapshot], str] | None = None) -> None:
+        """Follows ``tree``, or for a mode machine the tree and mode of each tick.
+
+        ``tree_of`` gives the tree that made a snapshot and ``mode_of`` its mode, which the
+        line shows first (``[normal] Patrol > ...``).
+        """
         self.tree = tree
+        self._tree_of = tree_of
+        self._mode_of = mode_of
         self.stream = stream
         self.live = stream.isatty()
         self._interval = 1.0 / redraw_hz
@@ -73,7 +82,10 @@ class StatusLine:
 
         With ``width``, fitted into that many columns (:func:`fit_status`).
         """
-        labels = [self.tree.by_uid[uid].label for uid in snapshot.active]
+        tree = self._tree_of(snapshot) if self._tree_of is not None else self.tree
+        labels = [tree.by_uid[uid].label for uid in snapshot.active if uid in tree.by_uid]
+        if self._mode_of is not None and labels:
+            labels[0] = f"[{self._mode_of(snapshot)}] {labels[0]}"
         if width is not None:
             return fit_status(snapshot.tick, snapshot.status, labels, width)
         path = SEPARATOR.join(labels) if labels else "-"

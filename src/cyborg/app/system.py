@@ -16,6 +16,7 @@ from cyborg.app.errors import CommandError
 from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck
 from cyborg.app.status_line import StatusLine
 from cyborg.bus.component import LaunchError
+from cyborg.modes import ModeMachine
 from cyborg.runner.component import RunningTree
 
 
@@ -58,10 +59,16 @@ def run_system(description: LaunchDescription, args: argparse.Namespace, *, titl
 
 
 def _follow_tree(launch: Launch) -> StatusLine | None:
-    """Prints a live status line for the first tree runner of this process."""
+    """Prints a live status line for the first tree runner of this process.
+
+    Of a mode file, the line follows the tree of the mode that ticked and names the mode first.
+    """
     for item in launch.running:
         if isinstance(item, RunningTree):
-            line = StatusLine(item.runner.tree, sys.stdout)
+            runner = item.runner
+            modes = isinstance(runner.ticked, ModeMachine)
+            line = StatusLine(runner.tree, sys.stdout, tree_of=runner.tree_of,
+                              mode_of=runner.mode_of if modes else None)
             item.runner.runner.add_listener(line.update)
             return line
     return None

@@ -2,15 +2,16 @@
 
 ``cyborg up`` with no arguments runs the whole system on built-in defaults, in one process:
 the simulated Pioneer LX on the bundled campus map (``data/campus.map``, drawn by the project in
-ARNL format) with its navigation services, the tree runner with the bundled
-patrol-and-recharge tree (``data/campus_patrol.b3.json``, behavior3editor format) on simulated
+ARNL format) with its navigation services, the tree runner with the bundled mission on modes
+(``data/campus.modes.toml``: patrol, go charge, stop and call for help, demo — one tree each in
+``data/campus_mission.b3.json``, behavior3editor format; docs/modes.md) on simulated
 time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``; this machine only unless
 ``--monitor-host 0.0.0.0``, see docs/security.md), with ``--foxglove`` a Foxglove server
 (ws://127.0.0.1:8765, :mod:`cyborg.app.foxglove_commands`), and a camera playing
 sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
 ``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. ``--robots N`` simulates
 N robots on the map (:mod:`cyborg.sim.fleet`), ``/robot1`` … ``/robotN``, each with its own
-tree runner (``/robot1/bt`` …) on the same tree; one monitor shows them all, and the camera and
+tree runner (``/robot1/bt`` …) on the same mission; one monitor shows them all, and the camera and
 detector serve the first. Each next robot's battery starts :data:`FLEET_BATTERY_STEP` % fuller
 (``--battery`` is the first's), so that they take turns at the map's one charger. It prints
 what runs and where, then a live line of what the tree does; Ctrl-C stops everything cleanly.
@@ -18,9 +19,12 @@ what runs and where, then a live line of what the tree does; Ctrl-C stops everyt
 The defaults are chosen to *show* the mission, not to mimic a day of it: the battery drains
 about 9 % an hour and charging to 90 % takes two hours, so at real time from a full battery the
 first recharge would come after seven hours. ``cyborg up`` therefore simulates at 30x real time
-from a 33 % charge, just above the bundled tree's 30 % threshold: the robot patrols for about
-forty seconds, drives to the charger, charges for about four minutes and patrols again. Its
-first lines say so, and how to choose otherwise (``--speed 1 --battery 100``).
+from a 33 % charge, just above the bundled mission's 30 % low-battery threshold: the robot
+patrols (mode ``normal``) for about forty seconds, goes to charge (``low_battery``), charges
+to 60 % in about a minute and a half and patrols again — the whole cycle within three minutes.
+Its first lines say so, how to see the other modes (``cyborg bt mode demo``; ``critical``, which
+only a failed charge reaches by itself, by an ``emergency`` event), and how to choose otherwise
+(``--speed 1 --battery 100``). ``--tree FILE`` runs a plain tree (or another mode file).
 
 ``cyborg launch FILE`` starts what a launch description lists (see :mod:`cyborg.app.launch`).
 """
@@ -50,13 +54,21 @@ from cyborg.sim import component as sim
 from cyborg.sim.fleet import MAX_ROBOTS
 
 DATA = files("cyborg.app").joinpath("data")
-"""The bundled data: the campus map and its patrol tree."""
+"""The bundled data: the campus map, its mission on modes and the plain patrol tree."""
 CAMPUS_MAP = "campus.map"
 """The bundled map, in ARNL format, in :data:`DATA`."""
+CAMPUS_MODES = "campus.modes.toml"
+"""The bundled mission, a mode file (docs/modes.md) over ``campus_mission.b3.json``, in
+:data:`DATA`: what ``cyborg up`` runs unless ``--tree`` says otherwise."""
 CAMPUS_TREE = "campus_patrol.b3.json"
-"""The bundled patrol-and-recharge tree, a behavior3editor export, in :data:`DATA`."""
+"""The bundled patrol-and-recharge tree in one tree (CheckBattery), a behavior3editor export,
+in :data:`DATA`: the plain-tree example, ``cyborg up --tree``."""
 CAMPUS_THRESHOLD = 30.0
-"""The bundled tree's CheckBattery threshold, percent: below it the robot goes to recharge."""
+"""The bundled mission's low-battery threshold, percent: below it the robot goes to charge."""
+CAMPUS_CHARGED = 60.0
+"""The bundled mission's charged threshold, percent: from it the robot patrols again."""
+CAMPUS_DEMO_TIME = 600.0
+"""Seconds (tree clock) the bundled mission's demo lasts before it patrols again."""
 DEFAULT_SPEED = 30.0
 """Simulated seconds per wall-clock second: a patrol round in ~6 s, a full charge in ~4 min."""
 DEFAULT_BATTERY = 33.0
@@ -71,11 +83,13 @@ def add_parser(commands: Any) -> None:
     up = commands.add_parser("up", help="run the robot's system on built-in defaults",
                              description="Start the simulated robot on the bundled campus map, "
                                          "its navigation services and the tree runner with the "
-                                         "bundled patrol-and-recharge tree.")
+                                         "bundled mission on modes (patrol, go charge, stop "
+                                         "and call for help, demo).")
     up.add_argument("--map", type=Path, default=None, metavar="FILE",
                     help="ARNL .map file (default: the bundled campus)")
     up.add_argument("--tree", type=Path, default=None, metavar="FILE",
-                    help="behavior3editor export to run (default: the bundled patrol)")
+                    help="behavior3editor export or mode file (*.toml) to run (default: the "
+                         "bundled mission on modes)")
     up.add_argument("--speed", type=float, default=DEFAULT_SPEED, metavar="X",
                     help=f"simulated seconds per wall-clock second (default {DEFAULT_SPEED:g}, "
                          f"so a recharge shows within a minute; {sim.SPEED:g}: real time; 0: as "
@@ -84,7 +98,8 @@ def add_parser(commands: Any) -> None:
                     help="goal or dock to start at (default: the map's home, else its dock)")
     up.add_argument("--battery", type=float, default=DEFAULT_BATTERY, metavar="PERCENT",
                     help=f"battery charge at the start (default {DEFAULT_BATTERY:g}, just "
-                         f"above the bundled tree's {CAMPUS_THRESHOLD:g} %% recharge threshold)")
+                         f"above the bundled mission's {CAMPUS_THRESHOLD:g} %% low-battery "
+                         "threshold)")
     up.add_argument("--namespace", default=sim.NAMESPACE,
                     help=f"the robot's namespace (default {sim.NAMESPACE})")
     up.add_argument("--robots", type=int, default=sim.ROBOTS, metavar="N",
@@ -126,7 +141,7 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
         raise CommandError(f"--namespace names one robot; with --robots {args.robots} the "
                            f"robots are /robot1 ... /robot{args.robots}")
     map_path = args.map or Path(str(DATA.joinpath(CAMPUS_MAP)))
-    tree_path = args.tree or Path(str(DATA.joinpath(CAMPUS_TREE)))
+    tree_path = args.tree or Path(str(DATA.joinpath(CAMPUS_MODES)))
     fleet = "/" if args.robots > 1 else under_robot(args.namespace, sim.NAMESPACE)
     namespaces = fleet_namespaces(fleet, args.robots)
     trees = [under_robot(namespace, runner.NAMESPACE) for namespace in namespaces]
@@ -161,8 +176,9 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
 def up_notes(args: argparse.Namespace) -> list[str]:
     """The lines ``cyborg up`` prints first, under the bus: the pace and the charge it runs at.
 
-    On the bundled mission at the defaults they say too when the recharge comes and how to
-    choose otherwise (a recharge is seven hours away at real time on a full battery).
+    On the bundled mission at the defaults they say too when its modes change, how to see
+    the demo and critical modes, and how to choose otherwise (a recharge is seven hours away
+    at real time on a full battery).
     """
     pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
     lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
@@ -173,10 +189,17 @@ def up_notes(args: argparse.Namespace) -> list[str]:
                      f"{charges} %, so they take turns at the charger")
     if (args.map, args.tree, args.speed, args.battery) == (None, None, DEFAULT_SPEED,
                                                            DEFAULT_BATTERY):
-        lines += [f"             the patrol goes to recharge below {CAMPUS_THRESHOLD:g} % "
-                  "within a minute and",
-                  f"             charges for about 4 minutes; --speed {sim.SPEED:g} --battery "
-                  f"{sim.BATTERY:g}: real time"]
+        robot = args.namespace if args.robots == 1 else "/robotN"
+        lines += [f"modes        normal: patrol; low_battery below {CAMPUS_THRESHOLD:g} % within "
+                  "a minute, charging",
+                  f"             to {CAMPUS_CHARGED:g} %, then normal again, within 3 minutes; "
+                  "`cyborg bt mode",
+                  f"             demo`: the demo for {CAMPUS_DEMO_TIME / args.speed:g} s; "
+                  "critical (stops, calls for help",
+                  f"             on {robot.rstrip('/')}/help): `emergency` on .../bt/mode/events, "
+                  "ended by",
+                  "             `help_arrived` (docs/modes.md)",
+                  f"             --speed {sim.SPEED:g} --battery {sim.BATTERY:g}: real time"]
     return lines
 
 

@@ -38,7 +38,7 @@ from cyborg.bus.clock import JUMP_LIMIT, STALL_TIMEOUT
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces import robot, tree_runner
 from cyborg.robot.interface import Robot
-from cyborg.runner.tree_runner import TreeRunnerNode
+from cyborg.runner.tree_runner import TreeRunnerNode, describe
 
 NAME = "tree_runner"
 """The runner's node name unless told otherwise."""
@@ -70,11 +70,14 @@ class RunningTree:
         self.runner, self.robot_node, self.robot = runner, robot_node, robot
 
     def describe(self) -> str:
-        """The tree, its file, rate and clock, and where its topics and enable service are."""
-        tree, node = self.runner.tree, self.runner.node
+        """One line: the tree, its file, rate and clock, and where its topics are.
+
+        Of a mode file it names the modes and the current one with its tree.
+        """
+        node = self.runner.node
         clock = "simulated time (/clock)" if isinstance(self.runner.clock, SimClock) \
             else "wall-clock time"
-        return (f"tree runner  {node.fq_name}: {tree.title!r} ({len(tree)} nodes) from "
+        return (f"tree runner  {node.fq_name}: {describe(self.runner.ticked)} from "
                 f"{self.runner.path.name} at {self.runner.runner.rate_hz:g} Hz on {clock}; "
                 f"topics {node.namespace}/behavior_tree, .../status; enable: "
                 f"{node.namespace}/enable")

@@ -379,15 +379,25 @@ class TreeRunnerNode:
             status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
             visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
             visited_durations=np.array(snapshot.visit_durations, np.float32),
-            active_ids=list(active), halted_ids=snapshot.halted, mode=self._mode_of(snapshot)))
+            active_ids=list(active), halted_ids=snapshot.halted, mode=self.mode_of(snapshot)))
 
-    def _mode_of(self, snapshot: TickSnapshot) -> str:
-        """The mode whose tree made ``snapshot``; empty for a plain tree."""
+    def mode_of(self, snapshot: TickSnapshot) -> str:
+        """The mode whose tree made ``snapshot`` (a tick listener's); empty for a plain tree."""
         machine = self.ticked
         if not isinstance(machine, ModeMachine):
             return ""
         last = machine.last  # set by the tick that made the snapshot, before the listeners
         return last.mode if last is not None and last.snapshot is snapshot else machine.mode
+
+    def tree_of(self, snapshot: TickSnapshot) -> Tree:
+        """The tree that made ``snapshot`` (a tick listener's).
+
+        After a transition that tick led to, :attr:`tree` is already the next mode's.
+        """
+        machine = self.ticked
+        if not isinstance(machine, ModeMachine):
+            return machine
+        return machine.trees.get(self.mode_of(snapshot), machine.tree)
 
     # ------------------------------------------------------------------ services
     def _on_enable(self, request: SetBool_Request) -> SetBool_Response:
