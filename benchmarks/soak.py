@@ -3,7 +3,7 @@
     python3 benchmarks/soak.py [--minutes 60] [--markdown] [--detector]
 
 Starts what `cyborg up` starts — the simulated Pioneer LX on the bundled campus map, the tree
-runner with the patrol-and-recharge tree on simulated time, the web monitor (on a free
+runner with the bundled mission on modes on simulated time, the web monitor (on a free
 loopback port) and, with ``--detector``, the camera and the detector — in this process, with
 the simulation at full speed (``--speed 0``), and reports:
 
@@ -32,6 +32,7 @@ from cyborg.app.up import up_description
 from cyborg.bt import SUCCESS
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bus import BusConfig, Context
+from cyborg.modes import ModeMachine
 from cyborg.runner.component import RunningTree
 from cyborg.sim.component import RunningSimulator
 
@@ -73,8 +74,9 @@ def soak(minutes: float, detector: bool) -> dict[str, float]:
             sim = next(item for item in launch.running
                        if isinstance(item, RunningSimulator)).loop.simulator
             runner = next(item for item in launch.running if isinstance(item, RunningTree))
-            tree = runner.runner.tree
-            tally = Tally({node.uid: node.label for node in tree})
+            ticked = runner.runner.ticked  # the mission's mode machine, or a plain tree
+            trees = ticked.trees.values() if isinstance(ticked, ModeMachine) else [ticked]
+            tally = Tally({node.uid: node.label for tree in trees for node in tree})
             runner.runner.runner.add_listener(tally.tick)
             started = time.monotonic()
             total = minutes * 60
