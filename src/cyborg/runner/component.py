@@ -38,7 +38,8 @@ from cyborg.bus.clock import JUMP_LIMIT, STALL_TIMEOUT
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces import robot, tree_runner
 from cyborg.robot.interface import Robot
-from cyborg.runner.tree_runner import TreeRunnerNode, describe
+from cyborg.runner.ticked import describe
+from cyborg.runner.tree_runner import TreeRunnerNode
 
 NAME = "tree_runner"
 """The runner's node name unless told otherwise."""

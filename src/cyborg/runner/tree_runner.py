@@ -105,6 +105,7 @@ from cyborg.robot.interface import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
 from cyborg.runner.mode_endpoints import ModeEndpoints
 from cyborg.runner.service_states import ServiceStatesPublisher
+from cyborg.runner.ticked import describe, mode_of, tree_of
 from cyborg.runner.tree_control import TreeControl
 
 log = logging.getLogger("cyborg.runner")
@@ -383,23 +384,12 @@ class TreeRunnerNode:
 
     def mode_of(self, snapshot: TickSnapshot) -> str:
         """The mode whose tree made ``snapshot`` (a tick listener's); empty for a plain tree."""
-        machine = self.ticked
-        if not isinstance(machine, ModeMachine):
-            return ""
-        last = machine.last  # set by the tick that made the snapshot, before the listeners
-        return last.mode if last is not None and last.snapshot is snapshot else machine.mode
+        return mode_of(self.ticked, snapshot)
 
     def tree_of(self, snapshot: TickSnapshot) -> Tree:
-        """The tree that made ``snapshot`` (a tick listener's).
+        """The tree that made ``snapshot`` (a tick listener's); see :func:`ticked.tree_of`."""
+        return tree_of(self.ticked, snapshot)
 
-        After a transition that tick led to, :attr:`tree` is already the next mode's.
-        """
-        machine = self.ticked
-        if not isinstance(machine, ModeMachine):
-            return machine
-        return machine.trees.get(self.mode_of(snapshot), machine.tree)
-
-    # ------------------------------------------------------------------ services
     def _on_enable(self, request: SetBool_Request) -> SetBool_Response:
         on = bool(request.data)
         done = self.set_enabled(on, wait=HALT_WAIT)
@@ -424,11 +414,3 @@ class TreeRunnerNode:
                        message: str) -> None:
         responder.reply(ReloadTree.Response(success=success, message=message))
 
-
-def describe(ticked: Tree | ModeMachine) -> str:
-    """``'Root tree' (18 nodes)``, or ``4 modes, in 'normal' ('Patrol', 12 nodes)``."""
-    if isinstance(ticked, ModeMachine):
-        tree = ticked.tree
-        return (f"{len(ticked.trees)} modes, in {ticked.mode!r} ({tree.title!r}, "
-                f"{len(tree)} nodes)")
-    return f"{ticked.title!r} ({len(ticked)} nodes)"
