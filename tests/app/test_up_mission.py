@@ -10,7 +10,6 @@ from pathlib import Path
 from cyborg.app.up import CAMPUS_MODES, DATA
 from cyborg.bt import Blackboard, ManualClock
 from cyborg.modes import load_machine, read_mode_file
-from cyborg.robot.battery_board import ReadBattery
 from cyborg.robot.interface import ROBOT
 from tests.robot.fake_robot import FakeRobot
 
@@ -28,7 +27,7 @@ def test_one_tree_per_mode_from_one_editor_project() -> None:
     assert [tree["title"] for tree in project["trees"]] == [
         "Patrol", "Go charge", "Stop and call", "Demo"]
     custom = {node["name"] for node in project["custom_nodes"]}
-    assert {"MoveTo", "Charge", "ReadBattery", "StopSafely", "CallForHelp"} <= custom
+    assert {"MoveTo", "Charge", "StopSafely", "CallForHelp"} <= custom
 
 
 def test_every_tree_reads_the_battery_into_the_key_the_conditions_read() -> None:
@@ -42,6 +41,8 @@ def test_every_tree_reads_the_battery_into_the_key_the_conditions_read() -> None
                            blackboard=Blackboard(resources={ROBOT: FakeRobot()}))
     for mode, tree in machine.trees.items():
         first = tree.root.children[0]  # the tree's Subtree wraps the root Sequence
-        readers = [node for node in tree if isinstance(node, ReadBattery)]
-        assert [node.key for node in readers] == ["battery"], mode
-        assert first.name == "Sequence" and first.children[0] is readers[0], mode
+        services = tree.services
+        assert first.name == "Sequence" and services is not None, mode
+        watches = [scheduled.service for scheduled in services.of(first)
+                   if scheduled.service.name == "BatteryWatch"]
+        assert [getattr(service, "key", None) for service in watches] == ["battery"], mode

@@ -51,6 +51,21 @@ def test_a_halted_call_for_help_calls_at_once_when_it_starts_again() -> None:
     assert robot.help_calls[0][0] == "the robot needs help", "the default reason"
 
 
+def test_the_call_says_which_goal_the_robot_is_near_when_the_blackboard_knows() -> None:
+    robot, clock = FakeRobot(), ManualClock()
+    tree = robot_tree(N("CallForHelp", reason="stopped", every=10.0, near="closest_goal"),
+                      robot, clock)
+    tree.tick()
+    tree.blackboard["closest_goal"] = "Library"
+    clock.advance(10.0)
+    tree.tick()
+    tree.blackboard["closest_goal"] = None  # no goal reachable
+    clock.advance(10.0)
+    tree.tick()
+    assert [reason for reason, _ in robot.help_calls] == [
+        "stopped", "stopped; near Library", "stopped"]
+
+
 def test_stop_safely_asks_again_while_the_robot_does_not_answer() -> None:
     robot, clock = UnreachableRobot(), ManualClock()
     tree = robot_tree(N("StopSafely"), robot, clock)

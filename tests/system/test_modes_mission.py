@@ -168,4 +168,5 @@ def test_the_bundled_mission_goes_through_every_mode() -> None:
     call = calls[0]
     assert call.robot == "/cyborg" and call.pose is not None and call.battery is not None
     assert call.reason.startswith("critical: stopped")
+    assert "; near " in call.reason, "ClosestGoal, a service of the patrol, said where it is"
     assert call.battery > 30.0, "an emergency, not the battery"
