@@ -21,6 +21,8 @@ that every client endpoint finds its server.
   request/force/hold service (tree runner of a mode file ↔ ``cyborg bt mode``, monitors).
 * :mod:`~cyborg.interfaces.help` — a robot's call for help (its tree's robot ↔ whoever
   comes: ``cyborg topic echo /cyborg/help``, monitors).
+* :mod:`~cyborg.interfaces.perception` — tracked objects on the map, the ``say`` topic, the
+  camera's model and mount and the tracker's defaults (tracker ↔ tree nodes, simulated camera).
 
 **Adding to a contract.** Declare the endpoint in the module of the program that serves it,
 e.g. ``BUMPERS = Topic("bumper_state", BumperState, latched=True)`` with ``BumperState``

@@ -15,8 +15,10 @@ if TYPE_CHECKING:
     from rosbags.typesys.stores.ros2_jazzy import (
         builtin_interfaces__msg__Time,
         diagnostic_msgs__msg__KeyValue,
+        geometry_msgs__msg__Point,
         geometry_msgs__msg__Polygon,
         geometry_msgs__msg__Pose2D,
+        geometry_msgs__msg__Vector3,
         std_msgs__msg__Header,
     )
 
@@ -237,6 +239,31 @@ class cyborg_msgs__msg__ServiceStates:
     __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/ServiceStates'
 
 
+@dataclass
+class cyborg_msgs__msg__TrackedObject:
+    """Class for cyborg_msgs/msg/TrackedObject."""
+
+    id: int
+    label: str
+    confidence: float
+    position: geometry_msgs__msg__Point
+    velocity: geometry_msgs__msg__Vector3
+    last_seen: builtin_interfaces__msg__Time
+    times_seen: int
+    distance: float
+    bearing: float
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/TrackedObject'
+
+
+@dataclass
+class cyborg_msgs__msg__TrackedObjects:
+    """Class for cyborg_msgs/msg/TrackedObjects."""
+
+    header: std_msgs__msg__Header
+    objects: list[cyborg_msgs__msg__TrackedObject]
+    __msgtype__: ClassVar[str] = 'cyborg_msgs/msg/TrackedObjects'
+
+
 BatteryStatus = cyborg_msgs__msg__BatteryStatus
 BehaviorTree = cyborg_msgs__msg__BehaviorTree
 BehaviorTreeHooks = cyborg_msgs__msg__BehaviorTreeHooks
@@ -253,3 +280,5 @@ Prediction = cyborg_msgs__msg__Prediction
 Predictions = cyborg_msgs__msg__Predictions
 ServiceState = cyborg_msgs__msg__ServiceState
 ServiceStates = cyborg_msgs__msg__ServiceStates
+TrackedObject = cyborg_msgs__msg__TrackedObject
+TrackedObjects = cyborg_msgs__msg__TrackedObjects
