@@ -60,7 +60,8 @@ ALLOWED = {"interfaces": ("cyborg.interfaces", "cyborg.bus"),
                         "cyborg.bt.status", "cyborg.access"),
            "report": ("cyborg.report", "cyborg.record", "cyborg.bus", "cyborg.interfaces",
                       "cyborg.bt.status", "cyborg.bt.outline"),
-           "modes": ("cyborg.modes", "cyborg.bt")}
+           "modes": ("cyborg.modes", "cyborg.bt"),
+           "perception": ("cyborg.perception", "cyborg.bus", "cyborg.interfaces")}
 """The contracts (topic, service and action names, types, constants) build only on the bus, so
 that both sides of each can import them; navigation may use the bus (its services); the
 simulator builds on navigation and the bus; the robot's nodes glue the engine to the bus, with
@@ -71,7 +72,9 @@ from the bus and names the contracts' topics only to describe the run; the run r
 recordings (the recorder's scan and metadata names), decodes them with the bus's types, finds
 the robots by the contracts and borrows only the engine's statuses and structure outline; the
 Foxglove server relays the bus, drawing robots' maps with navigation's grid and naming tick
-statuses as the engine does; the mode machine builds one engine tree per mode and needs
+statuses as the engine does; the tracker places the detector's predictions on the map and
+follows them (the contracts of the detector, the robot and the objects, on the bus, nothing of
+trees or navigation); the mode machine builds one engine tree per mode and needs
 nothing but the engine (no bus: the tree runner, which may run a mode file instead of a tree
 file, puts it on the bus). The monitor and the Foxglove
 server share the access rules of ``cyborg.access``, which imports nothing else of cyborg. All

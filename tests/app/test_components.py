@@ -22,6 +22,7 @@ from cyborg.bus.component import NodeSpec
 from cyborg.interfaces import detector, robot, tree_runner
 from cyborg.monitor import component as monitor
 from cyborg.monitor.monitor import Monitor
+from cyborg.perception import component as perception
 from cyborg.robot.settling_robot import SettlingBusRobot
 from cyborg.runner import component as runner
 from cyborg.runner.tree_runner import TreeRunnerNode
@@ -39,7 +40,8 @@ COMPONENT_MODULES = {"simulator": "cyborg.sim.component",
                      "foxglove": "cyborg.foxglove.component",
                      "camera": "cyborg.vision.component",
                      "detector": "cyborg.vision.component",
-                     "recorder": "cyborg.record.component"}
+                     "recorder": "cyborg.record.component",
+                     "tracker": "cyborg.perception.component"}
 
 
 def _default(function: Callable[..., Any], name: str) -> Any:
@@ -91,13 +93,16 @@ def test_cyborg_up_wires_the_camera_to_the_detector_by_the_contract(
     args = build_parser().parse_args(["up"])
     assert args.model == vision.MODEL
     monkeypatch.setattr(up_vision, "model_for_up", lambda name: Path(f"/models/{name}.onnx"))
-    camera, found = up_vision.vision_nodes(args, robot.NAMESPACE)
+    camera, found, tracker = up_vision.vision_nodes(args, robot.NAMESPACE)
     assert (camera.name, camera.namespace) == (vision.CAMERA_NAME, detector.CAMERA_NAMESPACE)
     assert (found.name, found.namespace) == (vision.DETECTOR_NAME, detector.DETECTOR_NAMESPACE)
     assert found.parameters["image_topic"] == detector.DEFAULT_IMAGE_TOPIC
     assert found.parameters["depth_topic"] == detector.DEFAULT_DEPTH_TOPIC
+    assert (tracker.kind, tracker.name, tracker.namespace) == (
+        "tracker", perception.TRACKER_NAME, robot.NAMESPACE)
     moved = up_vision.vision_nodes(args, "/robot1")
-    assert [spec.namespace for spec in moved] == ["/robot1/camera", "/robot1/detector"]
+    assert [spec.namespace for spec in moved] == ["/robot1/camera", "/robot1/detector",
+                                                  "/robot1"]
     assert moved[1].parameters["image_topic"] == "/robot1/camera/left/image_raw"
 
 

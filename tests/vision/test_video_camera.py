@@ -94,7 +94,7 @@ def test_a_video_camera_advertises_no_depth_and_the_detector_finds_the_person_wi
     video = write_video(tmp_path / "walk.avi")
     args = argparse.Namespace(no_detector=False, model="yolox_nano", camera=str(video))
     specs = vision_nodes(args, "/cyborg")  # what `cyborg up --camera walk.avi` starts
-    assert [spec.kind for spec in specs] == ["camera", "detector"]
+    assert [spec.kind for spec in specs] == ["camera", "detector", "tracker"]
     predictions = listen(bus, "/cyborg/detector/predictions")
     running = [starter_for(spec)(bus, spec) for spec in specs]
     try:

@@ -14,6 +14,7 @@ kind             start function (and its parameters)
 ``camera``       :func:`cyborg.vision.component.start_camera`
 ``detector``     :func:`cyborg.vision.component.start_detector`
 ``recorder``     :func:`cyborg.record.component.start`
+``tracker``      :func:`cyborg.perception.component.start`
 ===============  ====================================================================
 
 Any other kind is given as ``"package.module:function"``: a start function
@@ -28,6 +29,7 @@ from functools import partial
 from cyborg.bus.component import NodeSpec, Starter
 from cyborg.foxglove import component as foxglove
 from cyborg.monitor import component as monitor
+from cyborg.perception import component as perception
 from cyborg.record import component as recorder
 from cyborg.robot.settling_robot import SettlingBusRobot
 from cyborg.runner import component as runner
@@ -42,6 +44,7 @@ KINDS: dict[str, Starter] = {
     "camera": vision.start_camera,
     "detector": vision.start_detector,
     "recorder": recorder.start,
+    "tracker": perception.start,
 }
 """The start function of each kind a launch file may name."""
 

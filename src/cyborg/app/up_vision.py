@@ -1,11 +1,13 @@
-"""The camera and detector ``cyborg up`` starts beside the simulated robot.
+"""The camera, detector and tracker ``cyborg up`` starts beside the simulated robot.
 
 The simulated robot has no rendered camera, so the camera node plays recorded frames: by
 default scikit-image's Middlebury "Motorcycle" stereo sample (left, right and depth, looped at
 a few frames per second), or any source given with ``--camera``. The detector finds its model
 by name (``--model``, default ``yolox_nano``); when no copy is on this machine it is downloaded
 once into the cache with its SHA-256 checked. Without a model — offline and never fetched — the
-robot runs without the detector and says why.
+robot runs without the detector and says why. The tracker
+(:mod:`cyborg.perception.component`) places the detector's predictions on the map and
+publishes the robot's ``objects``; it stamps as the camera does (the wall clock).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from pathlib import Path
 from cyborg.app.launch import under_robot
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces.detector import DEPTH, IMAGE
+from cyborg.perception import component as perception
 from cyborg.vision import VisionError
 from cyborg.vision import component as vision
 from cyborg.vision.models import CATALOGUE, fetch, find_model
@@ -63,7 +66,7 @@ def model_for_up(name: str) -> Path | None:
 
 
 def vision_nodes(args: argparse.Namespace, namespace: str) -> list[NodeSpec]:
-    """The camera and the detector for the robot ``namespace``; none without a model."""
+    """The camera, detector and tracker of the robot ``namespace``; none without a model."""
     if args.no_detector:
         return []
     model = model_for_up(args.model)
@@ -80,4 +83,5 @@ def vision_nodes(args: argparse.Namespace, namespace: str) -> list[NodeSpec]:
                   "image_topic": IMAGE.full_name(camera_ns),
                   "depth_topic": DEPTH.full_name(camera_ns)},
                  where="detector (--model)"),
+        NodeSpec("tracker", perception.TRACKER_NAME, namespace, where="tracker"),
     ]
