@@ -27,7 +27,7 @@ import math
 import time
 from collections.abc import Callable, Iterable
 
-from cyborg.bus import Node
+from cyborg.bus import Node, Qos
 from cyborg.bus.msgs.cyborg_msgs.msg import Predictions
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.interfaces import detector, perception, robot
@@ -40,6 +40,8 @@ log = logging.getLogger("cyborg.perception")
 
 REFRESH = 0.5
 """Wall-clock seconds between two publications when no predictions come."""
+QUEUE = 5
+"""Predictions messages the subscription holds while the node is busy (the topic keeps 1)."""
 REPORT_EVERY = 10.0
 """Wall-clock seconds between two warnings about dropped predictions."""
 NO_POSE = "no pose yet"
@@ -74,7 +76,8 @@ class TrackerNode:
         self._tracked_at = 0.0  # the node's clock when the last frame was tracked
         self._publisher = perception.OBJECTS.publisher(node, robot_namespace)
         robot.POSE.subscription(node, self._on_pose, robot_namespace)
-        detector.PREDICTIONS.subscription(node, self._on_predictions, self.detector_namespace)
+        detector.PREDICTIONS.subscription(node, self._on_predictions, self.detector_namespace,
+                                          qos=Qos.latched(QUEUE))
         self._timer = node.create_timer(REFRESH, self._refresh)
 
     def _on_pose(self, message: Pose2D) -> None:
