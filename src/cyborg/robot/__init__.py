@@ -16,7 +16,22 @@ ReadBattery{key}          action      the battery reading into the global blackb
 StopSafely                action      ask the robot to stop (it waits where it is)
 CallForHelp{reason,       action      call for help on the robot's ``help`` topic, again
 every}                                every ``every`` s; RUNNING
+ObjectDetected{label,     condition   an object of ``label`` near, sure and fresh enough
+maxDistance,minConfidence,
+maxAge}
+ClosestObject{label,key}  action      the nearest object (bearing, distance, map position)
+                                      into the blackboard
+FaceObject{label,         action      turn toward the nearest object of ``label``
+tolerance}
+ApproachObject{label,     action      drive up to it, stop ``stopDistance`` m away
+stopDistance}
+Say{text}                 action      speak a sentence; ``{closest.label}`` fills in
+                                      blackboard values
 ========================  ==========  =====================================================
+
+The perception nodes (:mod:`~cyborg.robot.object_nodes`, :mod:`~cyborg.robot.object_motion`,
+:mod:`~cyborg.robot.say`) read what the robot's tracker follows on the map and speak through
+:class:`~cyborg.robot.perceiving.PerceivingRobot` (see docs/perception.md).
 
 Two services (:mod:`cyborg.robot.watch_services`) keep the robot's state in the blackboard while
 the composite they are attached to runs: ``BatteryWatch{key,low}`` (the battery reading) and
@@ -38,9 +53,13 @@ from cyborg.robot import (
     goals,
     move_to,
     safety,
+    object_motion,
+    object_nodes,
+    say,
     watch_services,
 )
 from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
 
 __all__ = ["ROBOT", "Robot", "RobotError", "battery", "battery_board", "blackboard_compare",
-           "docking", "goals", "move_to", "robot_of", "safety", "watch_services"]
+           "docking", "goals", "move_to", "object_motion", "object_nodes", "robot_of", "safety",
+           "say", "watch_services"]

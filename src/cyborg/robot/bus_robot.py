@@ -2,9 +2,11 @@
 
 Under the robot's namespace (``/cyborg`` by default) it uses the topics ``pose`` and
 ``battery_status``, the services ``nav/get_available_goals``, ``nav/get_distance_to_goal``,
-``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action,
-and publishes its calls for help on ``help`` (:mod:`cyborg.interfaces.help`)
-(see :mod:`cyborg.interfaces.robot` for the full interface, which the simulator serves)::
+``nav/get_closest_goal``, ``dock``, ``undock`` and ``stop``, and the ``move_to_goal`` action
+(see :mod:`cyborg.interfaces.robot` for the full interface, which the simulator serves); it
+publishes its calls for help on ``help`` (:mod:`cyborg.interfaces.help`); and for the
+perception nodes it uses the tracker's ``objects``, ``say`` and ``cmd_vel``
+(:class:`~cyborg.robot.bus_perception.BusPerception`)::
 
     robot = BusRobot(Node("bt", "/cyborg"), "/cyborg")
     move = robot.move_to("room1")
@@ -24,7 +26,9 @@ from cyborg.bus import ActionError, ClientGoal, Node, ServiceError, new_message
 from cyborg.interfaces import robot
 from cyborg.interfaces.help import HELP, HelpCall, help_text
 from cyborg.nav.geometry import Pose2D
+from cyborg.robot.bus_perception import BusPerception
 from cyborg.robot.interface import BatteryReading, DockState, Goal, MoveOutcome, RobotError
+from cyborg.robot.perceiving import SeenObject
 from cyborg.robot.rate_limited_log import RateLimitedLog
 
 log = logging.getLogger("cyborg.robot")
@@ -119,6 +123,7 @@ class BusRobot:
             robot.UNDOCK, robot.STOP)}
         self._action = robot.MOVE_TO_GOAL.client(node, namespace)
         self._help = HELP.publisher(node, namespace)
+        self.perception = BusPerception(node, namespace)
 
     # ------------------------------------------------------------------ state
     def _on_pose(self, message: Any) -> None:
@@ -225,3 +230,16 @@ class BusRobot:
             reply = self._call(robot.CLOSEST_GOAL.name)
             return str(reply.name), float(reply.distance)
         return self.node.context.calls.submit(ask)
+
+    # ------------------------------------------------------------------ perception
+    def objects(self) -> list[SeenObject]:
+        """The objects the robot's tracker follows (see :class:`BusPerception`)."""
+        return self.perception.objects()
+
+    def say(self, text: str) -> None:
+        """Publishes ``text`` for the robot's speech node."""
+        self.perception.say(text)
+
+    def drive(self, linear: float, angular: float) -> None:
+        """Sends one ``cmd_vel`` command: m/s ahead, rad/s to the left."""
+        self.perception.drive(linear, angular)
