@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from cyborg.bt import Blackboard, ManualClock, Tree, loads_tree
 from cyborg.nav.geometry import Pose2D
 from cyborg.robot.interface import ROBOT, BatteryReading, DockState, Goal, MoveOutcome, RobotError
+from cyborg.robot.perceiving import SeenObject
 from tests.builders import N, registry, tree_json
 
 
@@ -56,6 +57,11 @@ class FakeRobot:
     """Calls of move_to, sent or not."""
     help_calls: list[tuple[str, float]] = field(default_factory=list)
     """Each call_for_help: ``(reason, time)``."""
+    seen: list[SeenObject] = field(default_factory=list)
+    """What the tracker follows (objects())."""
+    said: list[str] = field(default_factory=list)
+    drives: list[tuple[float, float]] = field(default_factory=list)
+    """Every speed command, (m/s, rad/s)."""
 
     def goals(self, refresh: bool = False) -> dict[str, Goal]:
         if refresh and not self.reachable:
@@ -86,6 +92,15 @@ class FakeRobot:
 
     def stop(self) -> None:
         self.stops += 1
+
+    def objects(self) -> list[SeenObject]:
+        return list(self.seen)
+
+    def say(self, text: str) -> None:
+        self.said.append(text)
+
+    def drive(self, linear: float, angular: float) -> None:
+        self.drives.append((linear, angular))
 
     def set_battery(self, percent: float, state: DockState = DockState.UNDOCKED) -> None:
         self.battery = BatteryReading(percent, state is DockState.DOCKED, state)

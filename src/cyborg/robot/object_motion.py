@@ -70,7 +70,7 @@ class _Follow(Action):
 
     def __init__(self, label: str, min_confidence: float, max_age: float) -> None:
         check_limits(minConfidence=min_confidence, maxAge=max_age)
-        self.label, self.min_confidence, self.max_age = label, min_confidence, max_age
+        self.object_label, self.min_confidence, self.max_age = label, min_confidence, max_age
         self.target: int | None = None
         self.moving = False
         self.reason = ""
@@ -80,11 +80,11 @@ class _Follow(Action):
         self.target, self.moving, self.reason = None, False, ""
 
     def _object(self, robot: PerceivingRobot) -> SeenObject | None:
-        found = choose(robot.objects(), self.label, robot.pose,
+        found = choose(robot.objects(), self.object_label, robot.pose,
                        min_confidence=self.min_confidence, max_age=self.max_age,
                        object_id=self.target)
         if found is None:
-            what = f"{self.label or 'object'}" + (f" {self.target}" if self.target else "")
+            what = f"{self.object_label or 'object'}" + (f" {self.target}" if self.target else "")
             self.reason = (f"lost the {what}" if self.target is not None
                            else f"no {what} in sight")
         else:

@@ -41,13 +41,13 @@ class ObjectDetected(Condition):
     def __init__(self, label: str = "", max_distance: float = math.inf,
                  min_confidence: float = MIN_CONFIDENCE, max_age: float = MAX_AGE) -> None:
         check_limits(maxDistance=max_distance, minConfidence=min_confidence, maxAge=max_age)
-        self.label, self.max_distance = label, max_distance
+        self.object_label, self.max_distance = label, max_distance
         self.min_confidence, self.max_age = min_confidence, max_age
 
     @override
     def tick(self) -> Status:
         robot = perceiving_robot_of(self)
-        found = choose(robot.objects(), self.label, robot.pose,
+        found = choose(robot.objects(), self.object_label, robot.pose,
                        min_confidence=self.min_confidence, max_age=self.max_age,
                        max_distance=self.max_distance)
         return SUCCESS if found is not None else FAILURE
@@ -64,14 +64,14 @@ class ClosestObject(Action):
         if not key:
             raise ValueError("key is empty: name the blackboard entry to write")
         check_limits(minConfidence=min_confidence, maxAge=max_age)
-        self.label, self.key = label, key
+        self.object_label, self.key = label, key
         self.min_confidence, self.max_age = min_confidence, max_age
 
     @override
     def tick(self) -> Status:
         robot = perceiving_robot_of(self)
         pose = robot.pose
-        found = choose(robot.objects(), self.label, pose, min_confidence=self.min_confidence,
+        found = choose(robot.objects(), self.object_label, pose, min_confidence=self.min_confidence,
                        max_age=self.max_age)
         self.blackboard[self.key] = None if found is None else found.as_entry(pose)
         return SUCCESS if found is not None else FAILURE
