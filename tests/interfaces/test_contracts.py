@@ -13,15 +13,17 @@ import pytest
 
 from cyborg.bt import HookMode, Status
 from cyborg.bus import BusConfig, Context, MessageTypes, Node, Qos
+from cyborg.bus.component import NodeSpec
 from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.wire import Durability, EntityKind
-from cyborg.interfaces import detector, modes, player, robot, tree_runner
+from cyborg.interfaces import detector, modes, perception, player, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.monitor.monitor import Monitor
 from cyborg.monitor.player_source import PlayerSource
 from cyborg.monitor.robot_clients import RobotClients
 from cyborg.monitor.source import TreeSource
 from cyborg.nav.arnl_map import read_map
+from cyborg.perception import component as tracker_component
 from cyborg.record.mcap_file import McapFile
 from cyborg.record.playback_source import open_recording
 from cyborg.record.player import Player
@@ -388,3 +390,25 @@ def test_constants_change_neither_the_type_hash_nor_the_fields() -> None:
         "RIHS01_c761dc027c3b333c5284bf32a4cbc239864cae975cdf375675eb53fbf4ea2d8b"
     assert [name for name, _type in TYPES.fields(battery)] == [
         "header", "charging_state", "charge_percent", "voltage", "charging", "dock_state"]
+
+
+# ---------------------------------------------------------------------- perception
+def test_the_tracker_and_the_robot_client_agree_on_objects_say_and_speeds(bus: Context) -> None:
+    tracker = tracker_component.start(bus, NodeSpec("tracker", "tracker", "/robot3"))
+    client = BusRobot(Node("bt", "/elsewhere", context=bus), "/robot3")
+    graph = bus.graph
+    try:
+        assert client.objects() == []  # the first look subscribes
+        settle(graph, lambda: len(endpoints(graph, "/elsewhere/bt",
+                                            [EntityKind.SUBSCRIPTION])) >= 3
+               and len(endpoints(graph, "/robot3/tracker", [EntityKind.SUBSCRIPTION])) >= 2)
+        assert_serves(graph, "/robot3/tracker", "/robot3", [perception.OBJECTS])
+        assert_subscribes(graph, "/robot3/tracker", "/robot3", [robot.POSE])
+        assert_subscribes(graph, "/robot3/tracker", "/robot3/detector", [detector.PREDICTIONS])
+        assert_subscribes(graph, "/elsewhere/bt", "/robot3", [perception.OBJECTS])
+        published = {(entity.topic, entity.type_name) for entity in endpoints(
+            graph, "/elsewhere/bt", [EntityKind.PUBLISHER])}
+        assert published == {(topic.full_name("/robot3"), topic.type_name)
+                             for topic in (perception.SAY, robot.CMD_VEL)}
+    finally:
+        tracker.stop()
