@@ -64,7 +64,8 @@ def test_the_robot_nodes_are_known(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["bt", "nodes"]) == 0
     out = capsys.readouterr().out
     for name in ("MoveTo", "CheckBattery", "Charge", "Dock", "Undock", "ClosestGoal",
-                 "DistanceToGoal", "BlackboardCompare"):
+                 "DistanceToGoal", "BlackboardCompare", "ObjectDetected", "ClosestObject",
+                 "FaceObject", "ApproachObject", "Say"):
         assert f"\n{name} " in out or f"{name}  " in out, name
     assert "entry point cyborg" in out or "cyborg.robot" in out
 

@@ -118,3 +118,17 @@ def test_a_tracker_with_a_bad_gate_is_refused_naming_the_entry(bus: Context) -> 
     with pytest.raises(LaunchError, match=r"up.json: node 4: .*gate"):
         component.start(bus, NodeSpec("tracker", "tracker", ROBOT, {"gate": -1.0},
                                       where="up.json: node 4"))
+
+
+def test_the_labels_tracked_are_a_string_array_and_text_is_refused(bus: Context) -> None:
+    running = component.start(bus, NodeSpec("tracker", "tracker", ROBOT,
+                                            {"labels": ["person", "dog"]}))
+    try:
+        assert running.tracker.labels == ("person", "dog")
+    finally:
+        running.stop()
+    every = component.start(bus, NodeSpec("tracker", "t2", ROBOT))
+    assert every.tracker.labels == ()
+    every.stop()
+    with pytest.raises(ValueError, match=r"labels.*string array"):
+        component.start(bus, NodeSpec("tracker", "t3", ROBOT, {"labels": "person"}))

@@ -10,7 +10,8 @@ parameter           meaning (default)
 ``robot``           the robot's namespace, whose ``pose`` it reads and under which it
                     publishes ``objects`` (the node's namespace)
 ``detector``        the detector's namespace (the robot's detector: ``<robot>/detector``)
-``labels``          labels to track, separated by commas (empty: every label)
+``labels``          labels to track, a string array as the detector's ``classes``
+                    (empty: every label)
 ``gate``            metres a sighting may lie from an object to join it (1.0)
 ``forget_after``    seconds unseen after which an object is forgotten (5.0)
 ``use_sim_time``    the node's clock from ``/clock`` (false: the wall clock)
@@ -64,7 +65,7 @@ def start(context: Context, spec: NodeSpec) -> RunningTracker:
         robot_ns = str(fixed("robot", "", "robot namespace (default: the node's)")) \
             or node.namespace
         detector_ns = str(fixed("detector", "", "detector namespace (default: the robot's)"))
-        labels = str(fixed("labels", "", "labels to track, comma-separated (empty: all)"))
+        labels = fixed("labels", [""], "labels to track (empty: every label)")
         gate = fixed("gate", perception.ASSOCIATION_GATE, "association gate, m")
         forget_after = fixed("forget_after", perception.FORGET_AFTER, "forget after, s")
         sim_time = bool(fixed("use_sim_time", False, "time from /clock"))
@@ -75,8 +76,8 @@ def start(context: Context, spec: NodeSpec) -> RunningTracker:
             raise spec.error(str(exc)) from exc
         now = SimClock(node).now if sim_time else time.time
         tracker = TrackerNode(node, robot_ns, detector_ns or None, settings=settings,
-                              labels=[label.strip() for label in labels.split(",")
-                                      if label.strip()], now=now)
+                              labels=[str(label) for label in labels  # type: ignore[attr-defined]
+                                      if label], now=now)
     except BaseException:
         node.destroy()
         raise
