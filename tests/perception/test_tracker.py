@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -123,3 +124,32 @@ def test_track_frames_follows_a_person_seen_by_a_turning_robot() -> None:
     *_, last = track_frames(frames)
     (person,) = last
     assert (person.x, person.y) == pytest.approx((3.0, 1.0), abs=0.05)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.floats(-20, 20), st.floats(-20, 20), st.integers(0, 2**32 - 1))
+def test_a_person_standing_still_seen_with_noise_is_one_object_near_where_they_stand(
+        x: float, y: float, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    tracker = Tracker()
+    for step in range(30):
+        noise = rng.normal(0.0, 0.1, 2)
+        tracker.update(step / 15, [seen("person", x + noise[0], y + noise[1])])
+    (person,) = tracker.objects()
+    assert math.hypot(person.x - x, person.y - y) < 0.3
+    assert math.hypot(person.vx, person.vy) < 0.5
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.lists(st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6),
+                                   st.floats(0, 1)), max_size=40), max_size=6),
+       st.integers(1, 20))
+def test_any_sightings_keep_the_tracker_bounded(frames: list[list[tuple[float, float, float]]],
+                                                max_objects: int) -> None:
+    tracker = Tracker(TrackerSettings(max_objects=max_objects))
+    for step, frame in enumerate(frames):
+        tracker.update(step * 0.05, [seen("person", x, y, c) for x, y, c in frame])
+        assert len(tracker) <= max_objects
+        for item in tracker.objects():
+            assert 0.0 <= item.confidence <= 1.0
+            assert math.hypot(item.vx, item.vy) <= tracker.settings.max_speed + 1e-9
