@@ -7,8 +7,9 @@ to its detector's ``predictions`` (:mod:`cyborg.interfaces.detector`), and publi
 * each predictions message is screened (:mod:`~cyborg.perception.screening`), placed on the
   map from the robot's latest pose (:mod:`~cyborg.perception.sighting`; ``pose`` carries no
   stamp, so the pose is the one known when the predictions arrive) and tracked
-  (:mod:`~cyborg.perception.tracker`) at the predictions' stamp — the detector's clock, which
-  is ``/clock`` under ``use_sim_time`` — and the objects are published at once;
+  (:mod:`~cyborg.perception.tracker`) at the stamp of the image they were found in (else of
+  the message, else the time it came) — the camera's clock, which is ``/clock`` under
+  ``use_sim_time`` — and the objects are published at once;
 * every :data:`REFRESH` s (wall time) the objects are forgotten and published again, so a list
   whose detector went quiet empties in time: the time then is the newest stamp plus what the
   node's clock counted since that frame came (so a detector stamping on another clock than
@@ -93,8 +94,9 @@ class TrackerNode:
                 rejected.counts[NO_POSE] += len(detections)
             self._count(rejected)
             return
-        stamp = seconds_of(message.header.stamp)
-        if stamp <= 0:  # a publisher that does not stamp: take the time it arrived
+        # when the frame was taken (the image's stamp), else when it was detected, else now
+        stamp = seconds_of(message.image_header.stamp) or seconds_of(message.header.stamp)
+        if not (math.isfinite(stamp) and stamp > 0):
             stamp = self.now()
         self._count(rejected)
         self.tracker.update(stamp, locate(detections, pose))
