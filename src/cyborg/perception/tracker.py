@@ -7,7 +7,8 @@ through :meth:`Tracker.update`:
 * **prediction** — each object is moved along its velocity to the frame's stamp (at most
   :attr:`TrackerSettings.horizon` seconds ahead, so an old guess does not wander off);
 * **gating and association**, per label — a sighting may only join an object of its own label
-  whose predicted position lies within :attr:`TrackerSettings.gate` metres; the pairs within
+  whose predicted position, or the position where it was last seen (someone who stopped or
+  turned back while unseen), lies within :attr:`TrackerSettings.gate` metres; the pairs within
   the gate are taken greedily, nearest first, each object and sighting at most once (a greedy
   assignment: with objects further apart than the gate, as people are, it gives what an optimal
   one would);
@@ -150,9 +151,12 @@ class Tracker:
         if candidates:
             settings = self.settings
             predicted = np.array([item.predicted(stamp, settings.horizon) for item in candidates])
+            last = np.array([(item.x, item.y) for item in candidates])
             seen = np.array([(sighting.x, sighting.y) for sighting in sightings])
-            gaps = np.hypot(seen[:, None, 0] - predicted[None, :, 0],
-                            seen[:, None, 1] - predicted[None, :, 1])
+            gaps = np.minimum(  # to the prediction, or to where it was (it stopped, turned)
+                np.hypot(seen[:, None, 0] - predicted[None, :, 0],
+                         seen[:, None, 1] - predicted[None, :, 1]),
+                np.hypot(seen[:, None, 0] - last[None, :, 0], seen[:, None, 1] - last[None, :, 1]))
             rows, cols = np.nonzero(gaps <= settings.gate)
             used: set[int] = set()
             for index in np.argsort(gaps[rows, cols], kind="stable"):
