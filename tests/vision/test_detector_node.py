@@ -119,6 +119,42 @@ def test_the_node_runs_the_network_only_while_someone_listens(bus: Context,
         detector.classes, detector.confidence = frozenset(), 0.5
 
 
+class _SlowPipeline(DetectionPipeline):
+    """A pipeline that, in the middle of a frame, waits until its node is being destroyed."""
+
+    node: Node
+    started: threading.Event
+
+    def process(self, frame: Any, *, draw: bool = False) -> Any:
+        result = super().process(frame, draw=draw)
+        self.started.set()
+        wait_for(lambda: self.node.destroyed, 10.0)
+        return result
+
+
+def test_a_node_destroyed_while_it_processes_a_frame_ends_it_quietly(
+        bus: Context, detector: Detector, caplog: pytest.LogCaptureFixture) -> None:
+    camera_node = Node("camera", "/cyborg/camera", context=bus)
+    camera = CameraNode(camera_node, lambda: SampleSource("motorcycle"), rate=20.0)
+    node = Node("detector", "/cyborg/detector", context=bus)
+    pipeline = _SlowPipeline(detector)
+    pipeline.node, pipeline.started = node, threading.Event()
+    detector_node = DetectorNode(node, pipeline, CameraTopics(
+        "/cyborg/camera/left/image_raw", "/cyborg/camera/depth/depth_registered"))
+    listener = Node("listener", context=bus)
+    listener.create_subscription("/cyborg/detector/predictions", "cyborg_msgs/msg/Predictions",
+                                 lambda _message: None, Qos.latched())
+    camera.start()
+    try:
+        assert pipeline.started.wait(30), "no frame reached the network"
+        node.destroy()  # what a stopping launch does while the frame is in the network
+        assert wait_for(lambda: detector_node.processed >= 1)
+        time.sleep(0.2)  # the callback's publishing, had it failed, would be logged by now
+        assert not [record for record in caplog.records if record.levelname == "ERROR"]
+    finally:
+        camera.stop()
+
+
 def test_distance_is_nan_without_depth_and_frames_pair_by_exact_stamp(bus: Context,
                                                                        detector: Detector
                                                                        ) -> None:

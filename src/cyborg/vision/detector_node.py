@@ -142,10 +142,16 @@ class DetectorNode:
             return
         self.processed += 1
         self.last = result
-        self.predictions.publish(predictions_message(result.detections,
-                                                     image_message.header, self.now_ns()))
-        self.detections.publish(detection_array_message(result.detections,
-                                                        image_message.header))
-        if result.annotated is not None:
-            self.image.publish(bgr_to_image(result.annotated, frame.stamp_ns,
-                                            frame.frame_id))
+        try:
+            self.predictions.publish(predictions_message(result.detections,
+                                                         image_message.header, self.now_ns()))
+            self.detections.publish(detection_array_message(result.detections,
+                                                            image_message.header))
+            if result.annotated is not None:
+                self.image.publish(bgr_to_image(result.annotated, frame.stamp_ns,
+                                                frame.frame_id))
+        except RuntimeError:
+            if not self.node.destroyed:
+                raise
+            # the node was destroyed while the frame was processed (a stopping launch): the
+            # frame's results go nowhere, quietly
