@@ -18,6 +18,7 @@ from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.wire import Durability, EntityKind
 from cyborg.interfaces import detector, modes, perception, player, robot, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
+from cyborg.interfaces.help import HELP
 from cyborg.monitor.monitor import Monitor
 from cyborg.monitor.player_source import PlayerSource
 from cyborg.monitor.robot_clients import RobotClients
@@ -409,6 +410,6 @@ def test_the_tracker_and_the_robot_client_agree_on_objects_say_and_speeds(bus: C
         published = {(entity.topic, entity.type_name) for entity in endpoints(
             graph, "/elsewhere/bt", [EntityKind.PUBLISHER])}
         assert published == {(topic.full_name("/robot3"), topic.type_name)
-                             for topic in (perception.SAY, robot.CMD_VEL)}
+                             for topic in (perception.SAY, robot.CMD_VEL, HELP)}
     finally:
         tracker.stop()

@@ -52,9 +52,9 @@ from cyborg.robot import (
     docking,
     goals,
     move_to,
-    safety,
     object_motion,
     object_nodes,
+    safety,
     say,
     watch_services,
 )
