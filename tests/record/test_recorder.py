@@ -1,8 +1,9 @@
 """The recorder on the bus: late topics, latched values, selection, pause, skipped types,
-the one-second flush."""
+the one-second flush, the messages a full queue dropped."""
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -14,6 +15,7 @@ from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.msgs.std_srvs.srv import SetBool
 from cyborg.bus.wire import EntityKind
 from cyborg.record import mcap_file
+from cyborg.record import recorder as recorder_module
 from cyborg.record.recorder import Recorder
 from cyborg.record.scan import scan
 from cyborg.record.selection import TopicSelection
@@ -132,3 +134,32 @@ def test_an_open_chunk_reaches_the_file_within_the_flush_interval(
     publisher.publish(String(data="soon on disk"))
     assert wait_for(lambda: scan(tmp_path / "run.mcap").message_count == 1, 10)
     rec.close()
+
+
+def test_messages_the_full_queue_dropped_are_counted_and_the_rest_written(
+        bus: Context, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(recorder_module, "QUEUE_DEPTH", 3)
+    talker = Node("talker", context=bus)
+    publisher = talker.create_publisher("/log", String)
+    rec = recorder(bus, tmp_path / "run.mcap")
+    assert wait_for(lambda: "/log" in rec.stats.topics, 10)
+    publisher.publish(String(data="first"))  # the publisher's sequence starts here
+    assert wait_for(lambda: rec.stats.messages == 1, 10)
+    busy, release = threading.Event(), threading.Event()
+
+    def writer_busy() -> None:
+        busy.set()
+        release.wait(30)
+    rec.node.callbacks.submit(writer_busy)
+    assert busy.wait(10)
+    for i in range(10):
+        publisher.publish(String(data=str(i)))
+    release.set()
+    assert wait_for(lambda: rec.stats.messages == 4, 10)
+    publisher.publish(String(data="after"))
+    assert wait_for(lambda: rec.stats.messages == 5, 10)
+    rec.close()
+    assert rec.stats.dropped == 7
+    assert rec.backlog_peak == 3
+    assert read_mcap(tmp_path / "run.mcap") == {
+        "/log": [{"data": "first"}, {"data": "7"}, {"data": "8"}, {"data": "9"}, {"data": "after"}]}

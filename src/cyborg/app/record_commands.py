@@ -162,8 +162,9 @@ class RecordLine(LiveLine):
         files = ", ".join(str(path) for path in recorder.files.paths)
         if recorder.files.folder is not None:
             files = f"{recorder.files.folder} ({len(recorder.files.paths)} files)"
+        dropped = f", {stats.dropped:,} dropped (the writer fell behind)" if stats.dropped else ""
         print(f"{files}: {stats.messages:,} messages on {len(stats.topics)} topics, "
-              f"{size(stats.bytes)} of messages", file=self.stream)
+              f"{size(stats.bytes)} of messages{dropped}", file=self.stream)
         for topic, why in sorted(stats.skipped.items()):
             print(f"  not recorded: {topic} ({why})", file=self.stream)
         self.stream.flush()

@@ -15,7 +15,9 @@ callback a :class:`RawMessage`:
 ``received_ns`` is the wall-clock time (ns since the epoch) at which the bus received the
 message, before it waited in the queue; ``info`` is the sample's attachment (publisher GID,
 sequence number and the publisher's own timestamp), or None for a sample sent without one.
-Create one with :meth:`cyborg.bus.node.Node.create_raw_subscription`.
+:attr:`RawSubscription.backlog_peak` is the most messages that ever waited in its queue at
+once, so a recorder can tell how close its writer came to dropping (a full keep-last queue
+drops the oldest). Create one with :meth:`cyborg.bus.node.Node.create_raw_subscription`.
 
 A player wants the reverse: to send what a recording holds as it was recorded. A
 :class:`RawPublisher` is a :class:`~cyborg.bus.topics.Publisher` (same keys, token, QoS,
@@ -60,6 +62,9 @@ class RawSubscription(Subscription[RawMessage]):
     the bytes are. The type name must be known to the bus (it makes the key and the token).
     """
 
+    backlog_peak = 0
+    """The most messages that waited in this subscription's queue at once."""
+
     def deliver_local(self, message: Any, type_name: str, attachment: Attachment) -> None:
         """A message of this process: queue it as it is, to be serialised when delivered."""
         if type_name != self.type_name:
@@ -68,6 +73,12 @@ class RawSubscription(Subscription[RawMessage]):
         if not self._last_sequence.record(attachment.gid, attachment.sequence):
             return
         self._enqueue(_Local(message, time.time_ns()), attachment)
+
+    def _enqueue(self, message: Any, info: Attachment | None) -> None:
+        super()._enqueue(message, info)
+        backlog = len(self._queue)  # a deque's length is read atomically
+        if backlog > self.backlog_peak:
+            self.backlog_peak = backlog
 
     def _decode(self, data: bytes | memoryview) -> Any:
         """The payload itself (copied out of a shared-memory slot), stamped on arrival."""

@@ -51,7 +51,8 @@ class RunningRecorder:
         stats, files = self.recorder.stats, self.recorder.files.paths
         where = ", ".join(str(path) for path in files)
         failure = f"; {self.recorder.failure}" if self.recorder.failure else ""
-        print(f"recorded {stats.messages} messages on {len(stats.topics)} topics into "
+        dropped = f" ({stats.dropped} dropped)" if stats.dropped else ""
+        print(f"recorded {stats.messages} messages{dropped} on {len(stats.topics)} topics into "
               f"{where}{failure}", file=sys.stderr, flush=True)
 
 

@@ -11,6 +11,11 @@ A :class:`Recorder` is one bus node (``recorder`` by default) that
   the tree's structure, the battery) is recorded even when it was published before the start;
 * writes each message with the time it was received as its log time and the sender's
   timestamp (from the sample's attachment) as its publish time, on the node's one thread;
+* counts what it could not write: each topic's queue holds :data:`QUEUE_DEPTH` messages
+  (:data:`IMAGE_QUEUE_DEPTH` for images) while the writer is busy, and drops the oldest beyond
+  that; a gap in a publisher's sequence numbers after the first message received from it is
+  a message sent and never written, counted in :attr:`RecordingStats.dropped` (also when the
+  bus lost it on the way);
 * closes the open chunk at least every second (:mod:`cyborg.record.mcap_file`);
 * pauses and resumes: :meth:`Recorder.set_paused`, and the service ``<node>/pause``
   (``std_srvs/srv/SetBool``: true pauses, false resumes), so ``cyborg service call
@@ -35,7 +40,7 @@ from importlib.metadata import PackageNotFoundError, version
 
 from cyborg.bus import Durability, Node, Qos
 from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
-from cyborg.bus.raw import RawMessage
+from cyborg.bus.raw import RawMessage, RawSubscription
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import robot
 from cyborg.record import layout
@@ -82,6 +87,9 @@ class RecordingStats:
     """Topics not recorded, with the reason (an unknown type)."""
     paused_drops: int = 0
     """Messages that arrived while paused."""
+    dropped: int = 0
+    """Messages sent and never written: gaps in a publisher's sequence numbers (the queue was
+    full while the writer was busy, or the bus lost them on the way)."""
 
 
 class Recorder:
@@ -103,6 +111,9 @@ class Recorder:
         self._discovering = threading.Lock()
         self._types: dict[str, str] = {}
         self._maps: dict[str, str] = {}
+        self._sequences: dict[tuple[str, bytes], int] = {}  # (topic, publisher) -> last seen
+        self.subscriptions: dict[str, RawSubscription] = {}
+        """The raw subscription of each topic recorded."""
         self._closed = False
         files.add_metadata(RUN_METADATA, {
             "cyborg_version": cyborg_version(),
@@ -147,18 +158,30 @@ class Recorder:
             self.files.add_topic(topic, type_name, offered)
             self._types[topic] = type_name
         try:
-            self.node.create_raw_subscription(
+            self.subscriptions[topic] = self.node.create_raw_subscription(
                 topic, type_name, lambda raw: self._on_message(topic, raw), qos)
         except RuntimeError:  # the recorder is being closed
             return
         self.stats.topics.setdefault(topic, 0)  # listed once messages can arrive
 
+    @property
+    def backlog_peak(self) -> int:
+        """The most messages that waited for the writer at once in any topic's queue."""
+        return max((sub.backlog_peak for sub in list(self.subscriptions.values())), default=0)
+
     # ------------------------------------------------------------------ messages
     def _on_message(self, topic: str, raw: RawMessage) -> None:
+        info = raw.info
+        if info is not None:
+            key = (topic, info.gid)
+            last = self._sequences.get(key)
+            self._sequences[key] = info.sequence
+            if last is not None and info.sequence > last + 1:
+                self.stats.dropped += info.sequence - last - 1
         if self.paused:
             self.stats.paused_drops += 1
             return
-        sent = raw.info.timestamp_ns if raw.info is not None else raw.received_ns
+        sent = info.timestamp_ns if info is not None else raw.received_ns
         if sent < 0:  # a sender's clock is not checked by the bus; MCAP times are unsigned
             sent = raw.received_ns
         with self._lock:
