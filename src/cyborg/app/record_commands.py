@@ -28,6 +28,7 @@ from typing import Any, TextIO
 from cyborg.app.bus_options import open_context
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
+from cyborg.app.memory import keep_large_buffers
 from cyborg.app.progress import LiveLine, duration, size
 from cyborg.bus import Node
 from cyborg.bus.config import DEFAULT_ROUTER
@@ -92,6 +93,7 @@ def record_command(args: argparse.Namespace) -> int:
             raise ValueError("--duration must be more than 0 seconds")
     except ValueError as exc:
         raise CommandError(str(exc)) from None
+    keep_large_buffers()  # large messages (images, maps) without a page fault per 4 KiB
     context = open_context(args)
     try:
         try:

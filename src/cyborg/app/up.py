@@ -42,6 +42,7 @@ from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
 from cyborg.app.errors import CommandError
 from cyborg.app.foxglove_commands import foxglove_parameters
 from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_robot
+from cyborg.app.memory import keep_large_buffers
 from cyborg.app.system import run_system
 from cyborg.app.up_record import add_record_options, record_nodes
 from cyborg.app.up_vision import add_vision_options, vision_nodes
@@ -205,6 +206,8 @@ def up_notes(args: argparse.Namespace) -> list[str]:
 
 def up_command(args: argparse.Namespace) -> int:
     """``cyborg up``: the robot's system on built-in defaults, until Ctrl-C."""
+    if args.record is not None and args.record_images:
+        keep_large_buffers()  # camera frames without a page fault per 4 KiB (app.memory)
     return run_system(up_description(args), args, title="cyborg up", notes=up_notes(args))
 
 
