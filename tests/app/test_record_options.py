@@ -67,6 +67,7 @@ def test_the_live_line_shows_messages_megabytes_rate_topics_and_pause(tmp_path: 
         recorder.stats.messages, recorder.stats.bytes = 12345, 4_100_000
         recorder.stats.topics.update({"/a": 1, "/b": 2})
         recorder.stats.skipped["/odd"] = "unknown type their_msgs/msg/Odd"
+        recorder.stats.dropped = 3
         stream = io.StringIO()
         line = RecordLine(recorder, stream)
         assert not line.live
@@ -79,5 +80,36 @@ def test_the_live_line_shows_messages_megabytes_rate_topics_and_pause(tmp_path: 
     assert first.startswith("recording  12,345 msgs  4.1 MB  ")
     assert "/s  2 topics  0:00" in first
     assert paused.startswith("PAUSED")
-    assert "12,345 messages on 2 topics" in stream.getvalue()
+    assert "12,345 messages on 2 topics, 4.1 MB of messages, 3 dropped" in stream.getvalue()
     assert "not recorded: /odd (unknown type their_msgs/msg/Odd)" in stream.getvalue()
+
+
+@pytest.mark.parametrize(("images", "compression"), [(False, "zstd"), (True, "")])
+def test_a_recording_with_images_is_not_compressed_unless_asked(
+        images: bool, compression: str, tmp_path: Path) -> None:
+    from mcap.reader import make_reader
+
+    from cyborg.bus import Node, new_message
+    from cyborg.record.component import RunningRecorder
+    from tests.bus.bus_peer import wait_for
+
+    spec = NodeSpec("recorder", "recorder", "/", {"output": "run.mcap", "images": images},
+                    base=tmp_path, where="launch.toml: node 1")
+    with Context(BusConfig.isolated()) as context:
+        camera = Node("camera", context=context)
+        publisher = camera.create_publisher("/camera/image", "sensor_msgs/msg/Image")
+        log = camera.create_publisher("/log", "std_msgs/msg/String")
+        running = starter_for(spec)(context, spec)
+        assert isinstance(running, RunningRecorder)
+        stats = running.recorder.stats
+        assert wait_for(lambda: "/log" in stats.topics, 10)
+        publisher.publish(new_message(context.types, "sensor_msgs/msg/Image",
+                                      {"height": 1, "width": 1, "encoding": "mono8",
+                                       "step": 1}))
+        log.publish(new_message(context.types, "std_msgs/msg/String", {"data": "x"}))
+        assert wait_for(lambda: stats.messages == (2 if images else 1), 10)
+        running.stop()
+    with open(tmp_path / "run.mcap", "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    assert {index.compression for index in summary.chunk_indexes} == {compression}

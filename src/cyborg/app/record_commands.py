@@ -59,8 +59,9 @@ def add_parser(commands: Any) -> None:
     record.add_argument("--images", action="store_true",
                         help="record image topics too when recording all topics")
     record.add_argument("--compression", choices=sorted(COMPRESSIONS),
-                        default=component.COMPRESSION,
-                        help=f"chunk compression (default {component.COMPRESSION})")
+                        default=None,
+                        help=f"chunk compression (default {component.COMPRESSION}; "
+                             f"{component.IMAGE_COMPRESSION} with --images)")
     record.add_argument("--split-size", default=None, metavar="SIZE",
                         help="start a new file past this size, e.g. 1GiB (a bag folder: "
                              "run/run_0.mcap, run/run_1.mcap, ..., run/metadata.yaml)")
@@ -97,7 +98,8 @@ def record_command(args: argparse.Namespace) -> int:
     context = open_context(args)
     try:
         try:
-            files = RecordingFiles(output, context.types, args.compression, policy)
+            compression = args.compression or component.default_compression(args.images)
+            files = RecordingFiles(output, context.types, compression, policy)
         except (FileExistsError, OSError) as exc:
             raise CommandError(str(exc)) from None
         recorder = Recorder(Node(NAME, context=context), files, selection,

@@ -11,7 +11,7 @@ parameter           meaning (default)
 ``topics``          topics to record ([]: all but hidden topics and images)
 ``exclude``         glob patterns of topics left out ([])
 ``images``          record image topics too, when recording all (false)
-``compression``     ``none``, ``lz4`` or ``zstd`` (:data:`COMPRESSION`)
+``compression``     ``none``, ``lz4`` or ``zstd`` (:func:`default_compression`)
 ``split_size``      start a new file past this size, e.g. ``1GiB`` ("": never)
 ``split_duration``  start a new file after this long, e.g. ``10m`` ("": never)
 ``map``, ``tree``   the map and tree files of the run, named in the metadata ("")
@@ -30,7 +30,17 @@ from cyborg.record.selection import TopicSelection
 from cyborg.record.split import RecordingFiles, SplitPolicy, parse_duration, parse_size
 
 COMPRESSION = "zstd"
-"""Compression of a recording unless told otherwise; docs/recording.md says why."""
+"""Compression of a recording without images unless told otherwise; docs/recording.md says
+why."""
+IMAGE_COMPRESSION = "none"
+"""Compression of a recording that takes images unless told otherwise: zstd cannot keep up
+with a camera's hundreds of MB a second on one core, lz4 takes about half a core and saves
+little on pixels (docs/recording.md, "Compression")."""
+
+
+def default_compression(images: bool) -> str:
+    """The compression a recording uses unless one is named: none with images, else zstd."""
+    return IMAGE_COMPRESSION if images else COMPRESSION
 
 
 class RunningRecorder:
@@ -66,8 +76,9 @@ def start(context: Context, spec: NodeSpec) -> RunningRecorder:
         exclude = params.declare("exclude", [""], "glob patterns of topics left out",
                                  read_only=True)
         images = bool(params.declare("images", False, "record images too", read_only=True))
-        compression = str(params.declare("compression", COMPRESSION,
-                                         "none, lz4 or zstd", read_only=True))
+        compression = str(params.declare(
+            "compression", "", "none, lz4 or zstd (default: zstd; none with images)",
+            read_only=True)) or default_compression(images)
         split_size = str(params.declare("split_size", "", "new file past this size",
                                         read_only=True))
         split_duration = str(params.declare("split_duration", "", "new file after this long",
@@ -93,4 +104,5 @@ def start(context: Context, spec: NodeSpec) -> RunningRecorder:
     return RunningRecorder(recorder)
 
 
-__all__ = ["COMPRESSION", "RunningRecorder", "start"]
+__all__ = ["COMPRESSION", "IMAGE_COMPRESSION", "RunningRecorder", "default_compression",
+           "start"]
