@@ -1,5 +1,6 @@
 """Raw subscriptions get each message's CDR as it travelled: in-process, through Zenoh, through
-shared memory, latched; stamped on arrival, with the sender's attachment."""
+shared memory, latched; stamped on arrival, with the sender's attachment; batched until the
+node drains them."""
 
 from __future__ import annotations
 
@@ -90,3 +91,22 @@ def test_a_raw_publisher_sends_the_bytes_as_they_are_remote_local_large_and_latc
         chatter.destroy()
         with pytest.raises(RuntimeError, match="destroyed"):
             chatter.publish_raw(text)
+
+
+def test_a_batched_subscription_waits_for_drain_and_keeps_the_newest_depth() -> None:
+    with Context(BusConfig.isolated()) as context:
+        talker, recorder = Node("talker", context=context), Node("recorder", context=context)
+        got: list[RawMessage] = []
+        subscription = recorder.create_raw_subscription(
+            "/chatter", "std_msgs/msg/String", got.append, Qos(depth=3), batched=True)
+        publisher = talker.create_publisher("/chatter", String)
+        for i in range(5):
+            publisher.publish(String(data=str(i)))
+        assert recorder.callbacks.flush(10)
+        assert got == []  # nothing was handed over on the node's thread
+        assert subscription.backlog_peak == 3
+        assert subscription.drain() == 3
+        assert [context.types.deserialize(raw.data, "std_msgs/msg/String").data
+                for raw in got] == ["2", "3", "4"]
+        assert [raw.info.sequence for raw in got if raw.info is not None] == [3, 4, 5]
+        assert subscription.drain() == 0

@@ -168,13 +168,16 @@ class Node:
 
     def create_raw_subscription(self, topic: str, type_name: str,
                                 callback: Callable[[RawMessage], object],
-                                qos: Qos | None = None) -> RawSubscription:
+                                qos: Qos | None = None, *,
+                                batched: bool = False) -> RawSubscription:
         """Call ``callback(RawMessage)`` with each message's CDR bytes, never decoded.
 
         For recorders: the bytes are the message as it travelled (see :mod:`cyborg.bus.raw`);
         ``type_name`` (a known type) makes the key, ``qos`` as for :meth:`create_subscription`.
+        ``batched``: messages wait until the node calls the subscription's ``drain()``.
         """
-        return self._keep(RawSubscription, topic, type_name, callback, qos or Qos(depth=10))
+        return self._keep(RawSubscription, topic, type_name, callback, qos or Qos(depth=10),
+                          batched=batched)
 
     def create_raw_publisher(self, topic: str, type_name: str,
                              qos: Qos | None = None) -> RawPublisher:

@@ -19,6 +19,13 @@ sequence number and the publisher's own timestamp), or None for a sample sent wi
 once, so a recorder can tell how close its writer came to dropping (a full keep-last queue
 drops the oldest). Create one with :meth:`cyborg.bus.node.Node.create_raw_subscription`.
 
+A *batched* raw subscription (``batched=True``) does not wake its node for each message:
+messages wait in its queue (keep-last, ``qos.depth``) until the node calls
+:meth:`RawSubscription.drain`, which hands every waiting message to the callback at once. A
+recorder drains its topics a few times a second from a timer, so hundreds of small messages a
+second cost a few thread wake-ups instead of one each (a wake-up, and the hand-over of the
+interpreter lock, cost more than writing a small message down).
+
 A player wants the reverse: to send what a recording holds as it was recorded. A
 :class:`RawPublisher` is a :class:`~cyborg.bus.topics.Publisher` (same keys, token, QoS,
 latching, shared memory) whose :meth:`RawPublisher.publish_raw` takes CDR bytes (with their
@@ -65,6 +72,10 @@ class RawSubscription(Subscription[RawMessage]):
     backlog_peak = 0
     """The most messages that waited in this subscription's queue at once."""
 
+    def __init__(self, *args: Any, batched: bool = False, **options: Any) -> None:
+        self.batched = batched  # before the base queues a latched publisher's history
+        super().__init__(*args, **options)
+
     def deliver_local(self, message: Any, type_name: str, attachment: Attachment) -> None:
         """A message of this process: queue it as it is, to be serialised when delivered."""
         if type_name != self.type_name:
@@ -75,10 +86,27 @@ class RawSubscription(Subscription[RawMessage]):
         self._enqueue(_Local(message, time.time_ns()), attachment)
 
     def _enqueue(self, message: Any, info: Attachment | None) -> None:
-        super()._enqueue(message, info)
+        if self.batched:
+            with self._lock:  # waits for drain(): no dispatch to the node's thread
+                self._queue.append((message, info))
+        else:
+            super()._enqueue(message, info)
         backlog = len(self._queue)  # a deque's length is read atomically
         if backlog > self.backlog_peak:
             self.backlog_peak = backlog
+
+    def drain(self) -> int:
+        """Hands every waiting message to the callback now, oldest first; how many it were.
+
+        For a batched subscription, on the node's thread (a timer's callback); a subscription
+        that is not batched has nothing waiting for this.
+        """
+        with self._lock:
+            waiting = list(self._queue)
+            self._queue.clear()
+        for message, info in waiting:
+            self._deliver_now(message, info)
+        return len(waiting)
 
     def _decode(self, data: bytes | memoryview) -> Any:
         """The payload itself (copied out of a shared-memory slot), stamped on arrival."""
