@@ -111,6 +111,8 @@ class Phase:
     missing: int = 0
     """Frames sent less frames in the file."""
     backlog_peak: int = 0
+    file_ratio: float = 1.0
+    """The file's size against the messages' (compression)."""
 
     @property
     def mb_per_s(self) -> float:
@@ -158,8 +160,10 @@ def writer_alone(frame: Frame, seconds: float, compression: str, chunk_size: int
         writer.finish()
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     missing = sent - frames_in(path)
+    megabytes = sent * sum(map(len, frame)) / 1e6
+    ratio = path.stat().st_size / 1e6 / megabytes
     path.unlink()
-    return Phase(sent * sum(map(len, frame)) / 1e6, wall, cpu, sent, late, missing)
+    return Phase(megabytes, wall, cpu, sent, late, missing, file_ratio=ratio)
 
 
 def arrive(subscription: RawSubscription, data: bytes, info: Attachment) -> None:
@@ -326,11 +330,12 @@ def chunks_report(frame: Frame, args: argparse.Namespace, folder: Path) -> None:
                       for _round in range(args.rounds)]
             size = f"{compression}, {mib} MiB chunks"
             rows.append((size, f"{spread([p.mb_per_s for p in phases])} MB/s, "
-                               f"{spread([p.megabytes / p.cpu for p in phases])} MB per CPU s",
+                               f"{spread([p.megabytes / p.cpu for p in phases])} MB per CPU s, "
+                               f"file {phases[0].file_ratio:.2f}x",
                          spread([p.mb_per_s / offered for p in phases], 2),
                          "ratio: of the camera's 435 MB/s"))
     print_results("The mcap writer alone, flat out, by compression and chunk size", rows,
-                  markdown=args.markdown, widths=(24, 50, 16))
+                  markdown=args.markdown, widths=(24, 62, 16))
 
 
 def main() -> None:
