@@ -163,3 +163,15 @@ def test_messages_the_full_queue_dropped_are_counted_and_the_rest_written(
     assert rec.backlog_peak == 3
     assert read_mcap(tmp_path / "run.mcap") == {
         "/log": [{"data": "first"}, {"data": "7"}, {"data": "8"}, {"data": "9"}, {"data": "after"}]}
+
+
+def test_messages_that_arrived_just_before_the_close_are_written(
+        bus: Context, tmp_path: Path) -> None:
+    talker = Node("talker", context=bus)
+    publisher = talker.create_publisher("/log", String)
+    rec = recorder(bus, tmp_path / "run.mcap")
+    assert wait_for(lambda: "/log" in rec.stats.topics, 10)
+    for i in range(5):  # queued for the recorder at once (in-process), written in a batch
+        publisher.publish(String(data=str(i)))
+    rec.close()
+    assert read_mcap(tmp_path / "run.mcap") == {"/log": [{"data": str(i)} for i in range(5)]}

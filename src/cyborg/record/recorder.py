@@ -273,7 +273,7 @@ class Recorder:
     # ------------------------------------------------------------------ end
     def close(self) -> None:
         """Writes what arrived last, leaves the bus and finishes the files. Safe to call twice."""
-        if not self._closed:
+        if not self._closed and not self.node.destroyed and not self.context.closed:
             if self.node.callbacks.in_thread():
                 self._write_waiting()
             else:
