@@ -7,6 +7,11 @@ only what it had not handed over), and remembers where the last complete write e
 write fails — a full disk (``ENOSPC``), a quota, an I/O error — the partial write is cut off
 again, so the file ends on a record boundary, and :class:`StorageError` says what happened:
 the recording stops there with a file that :mod:`cyborg.record.completion` can finish.
+
+:meth:`GuardedStream.sync` brings what was written to the disk (``fsync``) on a thread of its
+own, so the writer goes on writing into the operating system's cache while the disk catches
+up: a camera's stream is faster than many disks for a while, and a writer that waited for
+each sync would drop frames that the cache could have taken.
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import threading
 from pathlib import Path
 from typing import BinaryIO
 
@@ -36,6 +42,9 @@ class GuardedStream:
         self.good = 0
         """Bytes of whole writes: the file's length after the last complete write."""
         self.failed: StorageError | None = None
+        self._sync_wanted = threading.Event()
+        self._syncer: threading.Thread | None = None
+        self._closing = False
 
     def write(self, data: bytes | bytearray | memoryview) -> int:
         """Writes all of ``data`` or raises :class:`StorageError` with the file cut back."""
@@ -74,12 +83,33 @@ class GuardedStream:
         """Nothing is buffered here; present because the MCAP writer calls it."""
 
     def sync(self) -> None:
-        """Waits until what was written is on the disk (``fsync``), so power loss keeps it."""
-        if self.failed is None:
+        """Starts bringing what was written to the disk (``fsync``), so power loss keeps it.
+
+        The sync runs on the stream's own thread and this returns at once; one asked for while
+        another runs starts as soon as that one is done.
+        """
+        if self.failed is not None or self._closing:
+            return
+        if self._syncer is None:
+            self._syncer = threading.Thread(target=self._sync_when_asked, daemon=True,
+                                            name=f"sync {self.path.name}")
+            self._syncer.start()
+        self._sync_wanted.set()
+
+    def _sync_when_asked(self) -> None:
+        while True:
+            self._sync_wanted.wait()
+            self._sync_wanted.clear()
+            if self._closing:
+                return
             # not a real file (a test's), or a file system without fsync: nothing to wait for
             with contextlib.suppress(OSError, ValueError):
                 os.fsync(self._file.fileno())
 
     def close(self) -> None:
-        """Closes the file."""
+        """Closes the file, once a sync that is running has finished."""
+        self._closing = True
+        if self._syncer is not None:
+            self._sync_wanted.set()
+            self._syncer.join()
         self._file.close()

@@ -7,11 +7,15 @@ summary offsets written at :meth:`McapFile.close`, with rosbag2's own ``rosbag2`
 record (:mod:`cyborg.record.bag_metadata`) describing the file's topics, counts and times.
 
 **Bounded loss.** The writer closes a chunk when it passes :data:`CHUNK_SIZE`; the recorder
-also calls :meth:`McapFile.flush_if_due` at least every :data:`FLUSH_INTERVAL`, which closes
-the open chunk once it is that old, hands it to the operating system and syncs the file to
-disk (``fsync``). So a recorder killed with ``kill -9``, or a machine losing power, loses at
-most the last second or so (plus the time of one sync); ``cyborg record --recover`` restores
-the rest (:mod:`cyborg.record.recover`).
+also calls :meth:`McapFile.flush_if_due` often, which closes the open chunk once it is
+:data:`FLUSH_INTERVAL` old and hands it to the operating system, then starts syncing the file
+to disk (``fsync``, on the stream's own thread: :mod:`cyborg.record.guarded_stream`). So a
+recorder killed with ``kill -9`` loses at most the last second or so, and a machine losing
+power that plus what the disk had not yet taken; ``cyborg record --recover`` restores the rest
+(:mod:`cyborg.record.recover`).
+
+A message larger than :data:`CHUNK_SIZE` (a camera image) is a chunk of its own: larger
+chunks were measured and do not help (docs/recording.md, "Images").
 
 **Failed writes.** A write that fails (a full disk) stops the file
 (:class:`~cyborg.record.guarded_stream.StorageError`); :meth:`McapFile.close` then finishes it
@@ -42,7 +46,7 @@ log = logging.getLogger(__name__)
 CHUNK_SIZE = 1024 * 1024
 """Bytes of messages after which a chunk is closed (compressed and written), as rosbag2's."""
 FLUSH_INTERVAL = 1.0
-"""Seconds after which an open chunk is closed and synced, however small it is."""
+"""Seconds after which an open chunk is closed, written and its sync started, however small."""
 COMPRESSIONS = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                 "zstd": CompressionType.ZSTD}
 """The compressions a recording may use, by the name the command line gives."""
@@ -136,7 +140,7 @@ class McapFile:
             self.custom_data = dict(values)
 
     def flush_if_due(self, now: float | None = None) -> bool:
-        """Closes, writes and syncs the open chunk if it is :data:`FLUSH_INTERVAL` old."""
+        """Closes and writes the open chunk, and starts its sync, if it is old enough."""
         opened = self._chunk_opened
         now = time.monotonic() if now is None else now
         if opened is None or now - opened < FLUSH_INTERVAL:
@@ -145,7 +149,7 @@ class McapFile:
         return True
 
     def flush(self) -> None:
-        """Closes, writes and syncs the open chunk now."""
+        """Closes and writes the open chunk now, and starts syncing it to the disk."""
         self._chunk_opened = None
         self._writer.flush()
         self.stream.sync()
