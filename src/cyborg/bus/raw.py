@@ -96,7 +96,7 @@ class RawSubscription(Subscription[RawMessage]):
             self.backlog_peak = backlog
 
     def drain(self) -> int:
-        """Hands every waiting message to the callback now, oldest first; how many it were.
+        """Hands every waiting message to the callback now, oldest first; returns how many.
 
         For a batched subscription, on the node's thread (a timer's callback); a subscription
         that is not batched has nothing waiting for this.
