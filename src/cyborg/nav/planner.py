@@ -13,6 +13,13 @@ path, whose ``code`` uses Nav2's names and whose ``length`` is infinity::
     planner = Planner(read_map("columbia.map"))
     result = planner.plan(Pose2D(0, 0), Pose2D(13.0, -12.2))
     result.found, result.length, result.reason
+
+Objects seen lately (people, :mod:`cyborg.nav.temporary_obstacles`) are planned around as
+*discs*: each is stamped into copies of the cached clearance and cost grids (a window around
+the disc, nothing rebuilt), so the robot's centre keeps the disc's keep-out radius plus its
+circumscribed radius from the centre, with the same cost ramp as near walls. A disc holding
+the start or the goal is shrunk until that pose lies just outside it (never ``GOAL_OCCUPIED``
+because someone stands there).
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Path, Pose2D
 from cyborg.nav.grid import MapGrid
 from cyborg.nav.search import astar, shortcut
+from cyborg.nav.temporary_obstacles import clear_of
 
 
 @dataclass(frozen=True)
@@ -117,8 +125,13 @@ class Planner:
 
     # ------------------------------------------------------------------ planning
     def plan(self, start: Pose2D, goal: Pose2D, *, use_heading: bool = False,
-             obstacles: np.ndarray | None = None) -> PlanResult:
-        """Plan from ``start`` to ``goal``; ``obstacles``: extra (N, 2) points (sensed ones)."""
+             obstacles: np.ndarray | None = None,
+             discs: np.ndarray | None = None) -> PlanResult:
+        """Plan from ``start`` to ``goal``.
+
+        ``obstacles``: extra (N, 2) points (sensed ones), blocked like walls; ``discs``: (N, 3)
+        temporary obstacles (centre x, y and keep-out radius, m), see the module.
+        """
         began = time.perf_counter()
         problem = self.check(start, "start") or self.check(goal, "goal")
         if problem is not None:
@@ -132,6 +145,11 @@ class Planner:
         cost = cost.copy()
         for pose in (start, goal):
             self._open_escape(cost, clearance, pose)
+        if discs is not None and len(discs):
+            clearance = clearance.copy()
+            self.stamp_discs(clearance, cost, clear_of(
+                discs, [(start.x, start.y), (goal.x, goal.y)], self.lethal,
+                2 * self.grid.resolution))
         _rows, columns = self.grid.shape
         start_cell = self.grid.cell(start.x, start.y)
         goal_cell = self.grid.cell(goal.x, goal.y)
@@ -145,6 +163,34 @@ class Planner:
         path = self._smooth(cells, clearance, start, goal)
         return PlanResult(Path(path, goal.theta if use_heading else None),
                           planning_time=time.perf_counter() - began)
+
+    def stamp_discs(self, clearance: np.ndarray, cost: np.ndarray, discs: np.ndarray) -> None:
+        """Stamp (N, 3) discs into a clearance grid and its cost grid, in place.
+
+        Around each disc a window of cells gets the smaller of its clearance and its distance
+        to the disc's edge, and the larger of its cost and the cost that distance gives (the
+        planner's lethal radius and ramp, as near a wall); cells outside the windows are left
+        as they are, so a few discs cost a few thousand cells, whatever the map's size.
+        """
+        grid, resolution = self.grid, self.grid.resolution
+        rows, columns = grid.shape
+        for x, y, keep_out in discs:
+            reach = keep_out + self.lethal + self.settings.cost_ramp
+            if reach <= 0:
+                continue
+            row, column = grid.cell(x, y)
+            span = math.ceil(reach / resolution) + 1
+            r0, r1 = max(row - span, 0), min(row + span + 1, rows)
+            c0, c1 = max(column - span, 0), min(column + span + 1, columns)
+            if r0 >= r1 or c0 >= c1:
+                continue
+            centres_y = grid.origin_y + (np.arange(r0, r1) + 0.5) * resolution
+            centres_x = grid.origin_x + (np.arange(c0, c1) + 0.5) * resolution
+            gap = np.hypot(centres_x[None, :] - x, centres_y[:, None] - y) - keep_out
+            window = clearance[r0:r1, c0:c1]
+            np.minimum(window, np.maximum(gap, 0.0).astype(window.dtype), out=window)
+            np.maximum(cost[r0:r1, c0:c1], self._cost(np.maximum(gap, 0.0)),
+                       out=cost[r0:r1, c0:c1])
 
     def _cost(self, clearance: np.ndarray) -> np.ndarray:
         ramp = self.settings.cost_ramp
