@@ -21,3 +21,15 @@ def write(folder: Path, name: str, text: str) -> Path:
     path = folder / name
     path.write_text(text)
     return path
+
+
+def corridor_map(width: float, length: float = 14.0, cairns: list[str] | None = None) -> str:
+    """A straight corridor ``length`` m long and ``width`` m wide along x, closed at both ends.
+
+    Its floor runs from (0, 0) to (``length``, ``width``); ``cairns`` as in :func:`room_map`.
+    """
+    w, n = round(width * 1000), round(length * 1000)
+    walls = [(0, 0, n, 0), (n, 0, n, w), (n, w, 0, w), (0, w, 0, 0)]
+    text = ["2D-Map", "Resolution: 20", *[f"Cairn: {cairn}" for cairn in cairns or []], "LINES"]
+    text += [" ".join(str(value) for value in wall) for wall in walls]
+    return "\n".join([*text, "DATA"]) + "\n"

@@ -245,11 +245,18 @@ class ChargingState(IntEnum):
 
 
 class PathState(StrEnum):
-    """What ``arnl_path_state`` says (ARNL's path planning states)."""
+    """What ``arnl_path_state`` says: ARNL's path planning states, and one of cyborg's.
+
+    ``WAITING_FOR_PATH`` is not ARNL's: the goal is still on, but the only ways to it run
+    through objects seen lately (a person in a narrow corridor,
+    :mod:`cyborg.nav.temporary_obstacles`); the robot stands and plans again now and then
+    until a way opens, and goes on ``MOVING_TO_GOAL``.
+    """
 
     NOT_INITIALIZED = "NOT_INITIALIZED"
     PLANNING_PATH = "PLANNING_PATH"
     MOVING_TO_GOAL = "MOVING_TO_GOAL"
+    WAITING_FOR_PATH = "WAITING_FOR_PATH"
     REACHED_GOAL = "REACHED_GOAL"
     FAILED_PLAN = "FAILED_PLAN"
     FAILED_MOVE = "FAILED_MOVE"
@@ -258,5 +265,6 @@ class PathState(StrEnum):
 
     @property
     def finished(self) -> bool:
-        """Whether the path is over, reached or not: every state but planning and moving."""
-        return self not in (PathState.PLANNING_PATH, PathState.MOVING_TO_GOAL)
+        """Whether the path is over, reached or not: all but planning, moving and waiting."""
+        return self not in (PathState.PLANNING_PATH, PathState.MOVING_TO_GOAL,
+                            PathState.WAITING_FOR_PATH)

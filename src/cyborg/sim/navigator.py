@@ -6,6 +6,16 @@ map does not know about (a box, a person) that blocks the path ahead triggers a 
 treats the laser's returns as walls; when the distance still to go *along the path* has not
 shrunk for ``stall_timeout`` seconds the goal ends in ``FAILED_MOVE``. Cancelling ends it in
 ``ABORTED_PATHPLAN`` and stops the robot.
+
+Objects seen lately (:attr:`Navigator.obstacles`, fed from the tracker's ``objects``) are
+temporary obstacles (:mod:`cyborg.nav.temporary_obstacles`): those within ``obstacle_range``
+are discs the planner keeps clear of. When one comes onto the path ahead (deeper than
+``blocked_hysteresis`` into its lethal zone) the navigator replans around it; when no way
+passes them, the robot stops and the state is ``WAITING_FOR_PATH``: it plans again every
+``wait_retry`` seconds until a way opens (the object moved on, or was forgotten) and goes on
+``MOVING_TO_GOAL``, its stall clock started afresh. Waiting is not stalling: only a wait longer
+than ``wait_timeout`` ends the goal (``FAILED_MOVE``). A goal given while the only way is
+blocked so starts out waiting.
 """
 
 from __future__ import annotations
@@ -19,6 +29,12 @@ from numba import njit
 from cyborg.interfaces.robot import PathState as PathState
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner, PlanResult
+from cyborg.nav.temporary_obstacles import (
+    ObstacleSettings,
+    TemporaryObstacles,
+    clear_of,
+    path_blocked,
+)
 from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
 from cyborg.sim.motion_check import Motion, Surroundings, safest_command
 
@@ -34,6 +50,12 @@ class NavigatorSettings:
     look_ahead: float = 3.0  # metres of path checked against the laser
     sensed_range: float = 6.0  # laser returns within this distance become obstacles
     follower: FollowerSettings = field(default_factory=FollowerSettings)
+    obstacles: ObstacleSettings = field(default_factory=ObstacleSettings)
+    obstacle_range: float = 6.0  # temporary obstacles within this distance count
+    blocked_hysteresis: float = 0.1  # metres into a disc's lethal zone that block the path
+    obstacle_replan_interval: float = 0.5  # seconds between replans around temporary obstacles
+    wait_retry: float = 1.0  # seconds between plans while waiting for a way past them
+    wait_timeout: float = 60.0  # seconds of waiting before giving up
 
 
 class Navigator:
@@ -53,6 +75,11 @@ class Navigator:
         self.follower: PathFollower | None = None
         self.remaining = math.inf
         self.replans = 0
+        self.waits = 0
+        self.obstacles = TemporaryObstacles(self.settings.obstacles)
+        self._waiting_since = 0.0
+        self._tried_at = -math.inf
+        self._obstacle_replan_at = -math.inf
         self._best = math.inf
         self._progress_at = 0.0
         self._replanned_at = -math.inf
@@ -61,17 +88,34 @@ class Navigator:
     def go_to(self, start: Pose2D, goal: Pose2D, use_heading: bool, now: float) -> PlanResult:
         """Plan and start moving; the result says whether a path was found."""
         self.goal, self.use_heading = goal, use_heading
-        self.state = PathState.PLANNING_PATH
-        result = self.planner.plan(start, goal, use_heading=use_heading)
+        self.state, self.follower, self.replans, self.waits = PathState.PLANNING_PATH, None, 0, 0
+        discs = self._discs(now, start)
+        result = self.planner.plan(start, goal, use_heading=use_heading, discs=discs)
+        if result.path is None and len(discs):
+            unblocked = self.planner.plan(start, goal, use_heading=use_heading)
+            if unblocked.path is not None:  # only the objects are in the way: wait for them
+                self.remaining = unblocked.length
+                self._start_waiting(now, len(discs))
+                return unblocked
         if result.path is None:
-            self.state, self.message, self.follower = PathState.FAILED_PLAN, result.reason, None
+            self.state, self.message = PathState.FAILED_PLAN, result.reason
             self.remaining = math.inf
             return result
-        self.follower = PathFollower(result.path, use_heading, self.settings.follower)
+        self._follow(result, now)
+        return result
+
+    def _follow(self, result: PlanResult, now: float) -> None:
+        """Start following a fresh plan: moving, progress counted from here."""
+        assert result.path is not None
+        self.follower = PathFollower(result.path, self.use_heading, self.settings.follower)
         self.state, self.message = PathState.MOVING_TO_GOAL, ""
         self.remaining = self._best = result.length
-        self._progress_at, self.replans = now, 0
-        return result
+        self._progress_at, self._blocked_since = now, None
+
+    @property
+    def waiting(self) -> bool:
+        """Whether the robot stands waiting for a way past temporary obstacles."""
+        return self.state is PathState.WAITING_FOR_PATH
 
     def cancel(self) -> None:
         """Drop the goal; one still under way ends ``ABORTED_PATHPLAN`` ("cancelled")."""
@@ -87,8 +131,11 @@ class Navigator:
         ``ranges`` and ``angles`` are the latest scan's, ``hits`` its returns as map points;
         ``motion``: how the robot moves now (its odometry). With ``motion``, a command whose
         motion until standstill would touch a wall or a return is replaced by a gentler one
-        (:func:`cyborg.sim.motion_check.safest_command`). Zero unless moving to a goal.
+        (:func:`cyborg.sim.motion_check.safest_command`). Zero unless moving to a goal;
+        braking while waiting for a way past temporary obstacles.
         """
+        if self.state is PathState.WAITING_FOR_PATH:
+            return self._wait(now, pose, hits, motion, period)
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
         slow, stop = front_ranges(ranges, angles,
@@ -112,17 +159,75 @@ class Navigator:
             self._blocked_since = now
         stuck = (self._blocked_since is not None
                  and now - self._blocked_since >= self.settings.blocked_patience)
-        if (now - self._replanned_at >= self.settings.replan_interval
+        discs = self._discs(now, pose)
+        if (len(discs) and now - self._obstacle_replan_at
+                >= self.settings.obstacle_replan_interval and self._discs_block(pose, discs)):
+            self._obstacle_replan_at = now
+            self._replan(now, pose, hits, discs)
+        elif (now - self._replanned_at >= self.settings.replan_interval
                 and (stuck or self._path_blocked(pose, hits))):
-            self._replan(now, pose, hits)
+            self._replan(now, pose, hits, discs)
+        if self.waiting:  # the replan found no way past the objects
+            return self._checked(pose, (0.0, 0.0), hits, motion, period)
+        return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
+
+    def _checked(self, pose: Pose2D, command: tuple[float, float], hits: np.ndarray,
+                 motion: Motion | None, period: float) -> tuple[float, float]:
+        """``command``, or a gentler one if braking after it would touch what is known."""
         if motion is None:
-            return command.speed, command.turn_rate
+            return command
         grid = self.planner.grid
         around = Surroundings(self.planner.wall_clearance, (grid.origin_x, grid.origin_y),
                               grid.resolution, hits)
-        return safest_command(pose.x, pose.y, pose.theta, motion,
-                              (command.speed, command.turn_rate), period,
+        return safest_command(pose.x, pose.y, pose.theta, motion, command, period,
                               self.planner.footprint, around)
+
+    # ------------------------------------------------------------------ temporary obstacles
+    def _discs(self, now: float, pose: Pose2D) -> np.ndarray:
+        """The temporary obstacles within ``obstacle_range`` of ``pose``, as discs."""
+        return self.obstacles.discs(now, near=(pose.x, pose.y),
+                                    within=self.settings.obstacle_range)
+
+    def _discs_block(self, pose: Pose2D, discs: np.ndarray) -> bool:
+        """Whether the discs (shrunk as the planner shrinks them) lie on the path ahead."""
+        assert self.follower is not None and self.goal is not None
+        path = self.follower.path
+        along, _gap = path.project(pose.x, pose.y)
+        ahead = path.sample(along, along + self.settings.obstacle_range, 0.1)
+        shrunk = clear_of(discs, [(pose.x, pose.y), (self.goal.x, self.goal.y)],
+                          self.planner.lethal, 2 * self.planner.grid.resolution)
+        return path_blocked(shrunk, ahead, self.planner.lethal,
+                            self.settings.blocked_hysteresis)
+
+    def _start_waiting(self, now: float, count: int) -> None:
+        self.state, self.waits = PathState.WAITING_FOR_PATH, self.waits + 1
+        self.message = (f"waiting: {count} object{'s' if count != 1 else ''} seen lately "
+                        f"block every way to the goal")
+        self._waiting_since = self._tried_at = now
+
+    def _wait(self, now: float, pose: Pose2D, hits: np.ndarray, motion: Motion | None,
+              period: float) -> tuple[float, float]:
+        """Stand, and plan again every ``wait_retry`` s until a way opens or time is up."""
+        settings = self.settings
+        if now - self._waiting_since > settings.wait_timeout:
+            self.state, self.follower = PathState.FAILED_MOVE, None
+            self.message = (f"waited {settings.wait_timeout:g} s for the objects in the way "
+                            f"to move")
+            return 0.0, 0.0
+        if now - self._tried_at >= settings.wait_retry:
+            self._tried_at = now
+            result = self._plan_around(pose, hits, self._discs(now, pose))
+            if result.path is not None:
+                self._follow(result, now)
+        return self._checked(pose, (0.0, 0.0), hits, motion, period)
+
+    def _plan_around(self, pose: Pose2D, hits: np.ndarray, discs: np.ndarray) -> PlanResult:
+        """A plan from ``pose`` past the laser's near returns and the discs."""
+        assert self.goal is not None
+        near = hits[np.hypot(hits[:, 0] - pose.x, hits[:, 1] - pose.y)
+                    < self.settings.sensed_range]
+        return self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near,
+                                 discs=discs)
 
     def _path_blocked(self, pose: Pose2D, hits: np.ndarray) -> bool:
         assert self.follower is not None
@@ -133,16 +238,16 @@ class Navigator:
             return False
         return bool(closest_gap(hits, ahead) < self.planner.footprint.inscribed_radius + 0.05)
 
-    def _replan(self, now: float, pose: Pose2D, hits: np.ndarray) -> None:
-        assert self.goal is not None
+    def _replan(self, now: float, pose: Pose2D, hits: np.ndarray, discs: np.ndarray) -> None:
+        """Plan past what the laser sees and the discs; wait if only the discs are in the way."""
         self._replanned_at = now
-        near = hits[np.hypot(hits[:, 0] - pose.x, hits[:, 1] - pose.y)
-                    < self.settings.sensed_range]
-        result = self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near)
+        result = self._plan_around(pose, hits, discs)
         if result.path is not None:  # a detour may be longer: progress counts from here on,
             self.replans += 1           # but the stall clock keeps running
             self.follower = PathFollower(result.path, self.use_heading, self.settings.follower)
             self._best = result.length
+        elif len(discs):
+            self._start_waiting(now, len(discs))
 
 
 @njit(cache=True)

@@ -1,0 +1,115 @@
+"""The navigator with objects seen lately: around a person where there is room, waiting where
+there is none, on again once the person is forgotten; waiting is not stalling."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from cyborg.nav.arnl_map import parse_map
+from cyborg.nav.geometry import Pose2D
+from cyborg.sim.navigator import NavigatorSettings, PathState
+from cyborg.sim.simulator import SimSettings, Simulator
+from tests.small_maps import corridor_map
+
+SEEN_EVERY = 0.1  # seconds between the tracker's lists, as at 10 frames a second
+
+
+@dataclass
+class Person:
+    """A person the tracker reports standing at ``(x, y)`` from ``appears`` until ``leaves``."""
+
+    x: float
+    y: float
+    appears_at_x: float  # the person is first seen when the robot gets this far
+    stays: float = math.inf  # seconds seen after first seen
+    seen_from: float | None = None
+    closest: float = math.inf
+    states: list[PathState] = field(default_factory=list)
+
+    def report(self, sim: Simulator) -> None:
+        if self.seen_from is None and sim.pose.x >= self.appears_at_x:
+            self.seen_from = sim.time
+        if self.seen_from is not None and sim.time - self.seen_from <= self.stays:
+            sim.navigator.obstacles.see(1, self.x, self.y, seen_at=sim.time)
+            self.closest = min(self.closest, math.hypot(sim.pose.x - self.x,
+                                                        sim.pose.y - self.y))
+
+
+def drive(sim: Simulator, person: Person, timeout: float) -> None:
+    """Run until the goal is over, the tracker reporting ``person`` every ``SEEN_EVERY`` s."""
+    end, reported = sim.time + timeout, -math.inf
+    while not sim.navigator.state.finished and sim.time < end:
+        if sim.time - reported >= SEEN_EVERY:
+            reported = sim.time
+            person.report(sim)
+        sim.step()
+        if not person.states or person.states[-1] is not sim.navigator.state:
+            person.states.append(sim.navigator.state)
+
+
+def corridor(width: float, settings: NavigatorSettings | None = None) -> Simulator:
+    return Simulator(parse_map(corridor_map(width)), start=Pose2D(1.0, width / 2, 0.0),
+                     settings=SimSettings(navigator=settings or NavigatorSettings()))
+
+
+def test_a_person_in_a_wide_corridor_is_driven_around() -> None:
+    sim = corridor(3.6)
+    assert sim.go_to(Pose2D(13.0, 1.8)).found
+    person = Person(7.0, 1.8, appears_at_x=2.5)
+    drive(sim, person, timeout=120)
+    assert sim.navigator.state is PathState.REACHED_GOAL, sim.navigator.message
+    assert sim.navigator.replans >= 1 and sim.navigator.waits == 0
+    assert PathState.WAITING_FOR_PATH not in person.states
+    assert person.closest >= 0.7, "the robot kept the person's clearance"
+    assert sim.base.bumps == 0
+
+
+def test_a_person_in_a_narrow_corridor_is_waited_for_longer_than_the_stall_timeout() -> None:
+    sim = corridor(2.0)
+    assert sim.go_to(Pose2D(13.0, 1.0)).found
+    stall = sim.navigator.settings.stall_timeout
+    person = Person(7.0, 1.0, appears_at_x=2.5, stays=stall + 10.0)
+    drive(sim, person, timeout=stall + 5.0)
+    assert sim.navigator.state is PathState.WAITING_FOR_PATH, sim.navigator.message
+    assert "block every way" in sim.navigator.message
+    assert abs(sim.base.speed) < 0.01, "the robot stands while it waits"
+    waited_at = sim.pose.x
+    assert waited_at < 7.0 - 0.8, "it stopped short of the person"
+    drive(sim, person, timeout=120)
+    assert person.states == [PathState.MOVING_TO_GOAL, PathState.WAITING_FOR_PATH,
+                             PathState.MOVING_TO_GOAL, PathState.REACHED_GOAL]
+    assert sim.navigator.waits == 1 and sim.base.bumps == 0
+    assert person.seen_from is not None
+    forget_after = sim.navigator.obstacles.settings.forget_after
+    assert sim.time > person.seen_from + person.stays + forget_after
+
+
+def test_a_wait_that_never_ends_gives_up_after_the_wait_timeout() -> None:
+    sim = corridor(2.0, NavigatorSettings(wait_timeout=8.0))
+    assert sim.go_to(Pose2D(13.0, 1.0)).found
+    person = Person(7.0, 1.0, appears_at_x=2.5)
+    drive(sim, person, timeout=120)
+    assert sim.navigator.state is PathState.FAILED_MOVE
+    assert "waited 8 s" in sim.navigator.message
+    assert person.seen_from is not None and sim.time < person.seen_from + 15.0
+
+
+def test_a_goal_given_while_a_person_blocks_the_only_way_starts_out_waiting() -> None:
+    sim = corridor(2.0)
+    sim.navigator.obstacles.see(1, 5.0, 1.0, seen_at=sim.time)
+    plan = sim.go_to(Pose2D(13.0, 1.0))
+    assert plan.found, "the goal itself is reachable"
+    assert sim.navigator.waiting and sim.navigator.follower is None
+    sim.run(10.0)  # the person is not seen again: forgotten after 4 s, the way is open
+    assert not sim.navigator.waiting and sim.navigator.follower is not None
+    assert sim.run_until(lambda: sim.navigator.state.finished, timeout=60)
+    assert sim.navigator.state is PathState.REACHED_GOAL
+
+
+def test_cancelling_a_wait_ends_the_goal() -> None:
+    sim = corridor(2.0)
+    sim.navigator.obstacles.see(1, 5.0, 1.0, seen_at=sim.time)
+    sim.go_to(Pose2D(13.0, 1.0))
+    sim.cancel()
+    assert sim.navigator.state is PathState.ABORTED_PATHPLAN
