@@ -32,6 +32,7 @@ from cyborg.robot.bus_robot import BusRobot
 from cyborg.runner.tree_runner import TreeRunnerNode
 from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
+from cyborg.sim.object_feed import ObjectFeed
 from cyborg.sim.simulator import Simulator
 from cyborg.vision import CameraNode, CameraTopics, DetectionPipeline, Detector, DetectorNode
 from cyborg.vision.samples import SampleSource
@@ -411,5 +412,21 @@ def test_the_tracker_and_the_robot_client_agree_on_objects_say_and_speeds(bus: C
             graph, "/elsewhere/bt", [EntityKind.PUBLISHER])}
         assert published == {(topic.full_name("/robot3"), topic.type_name)
                              for topic in (perception.SAY, robot.CMD_VEL, HELP)}
+    finally:
+        tracker.stop()
+
+
+def test_the_simulator_plans_on_the_objects_its_robots_tracker_publishes(
+        bus: Context, shared: Path) -> None:
+    tracker = tracker_component.start(bus, NodeSpec("tracker", "tracker", "/robot3"))
+    node = Node("arnl", "/robot3", context=bus)
+    ObjectFeed(node, SimulationLoop(Simulator(read_map(shared / "maps" / "AMROffice.map"),
+                                              start="Dock")))
+    graph = bus.graph
+    try:
+        settle(graph, lambda: len(endpoints(graph, "/robot3/arnl",
+                                            [EntityKind.SUBSCRIPTION])) >= 1)
+        assert_serves(graph, "/robot3/tracker", "/robot3", [perception.OBJECTS])
+        assert_subscribes(graph, "/robot3/arnl", "/robot3", [perception.OBJECTS])
     finally:
         tracker.stop()

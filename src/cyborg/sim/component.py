@@ -16,6 +16,10 @@ parameter      meaning (default)
 ``robots``     how many robots (:data:`ROBOTS`, 1; read-only); see below
 ``battery_``   with several robots: percent each next robot's battery starts fuller than
 ``step``       the one before (up to full; 0: all alike; read-only)
+``avoid_``     whether the navigator plans around the tracker's ``objects`` (true;
+``objects``    read-only; :mod:`cyborg.sim.object_feed`)
+``obstacle_``  the labels it plans around (``["person"]``; an empty string alone: every
+``labels``     label; read-only)
 =============  ========================================================================
 
 With ``robots`` N > 1 it simulates a fleet on the map (:mod:`cyborg.sim.fleet`): one loop, one
@@ -41,6 +45,7 @@ from cyborg.sim.battery import Battery
 from cyborg.sim.fleet import MAX_ROBOTS, Fleet, robot_loops
 from cyborg.sim.loop import REAL_TIME, PacedLoop, SimulationLoop
 from cyborg.sim.node import SimulatorNode
+from cyborg.sim.object_feed import follow_objects
 from cyborg.sim.simulator import Simulator
 
 NAME = "arnl"
@@ -97,6 +102,7 @@ def start(context: Context, spec: NodeSpec) -> RunningSimulator | RunningFleet:
             raise spec.error(str(exc).strip("\"'")) from exc
         _pace(node, loop)
         SimulatorNode(node, loop)
+        follow_objects(node, loop, spec)
         loop.start()
     except BaseException:
         node.destroy()
@@ -183,6 +189,7 @@ def _start_fleet(context: Context, spec: NodeSpec, count: int) -> RunningFleet:
             _pace(node, loop)
             SimulatorNode(node, share, initial_pose=index == 0, publishes_clock=index == 0,
                           frame_prefix=node.namespace.strip("/") + "/")
+            follow_objects(node, share, spec)
         loop.start()
     except BaseException:
         for node in nodes:
