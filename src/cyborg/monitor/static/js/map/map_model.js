@@ -42,7 +42,7 @@ export { PALETTE } from "../robots.js";
 export const DEFAULT_FOOTPRINT = Float32Array.from([
   0.32, 0.18, 0.29, 0.21, 0.26, 0.24, -0.26, 0.24, -0.29, 0.21, -0.32, 0.18,
   -0.32, -0.18, -0.29, -0.21, -0.26, -0.24, 0.26, -0.24, 0.29, -0.21, 0.32, -0.18]);
-const MOVING = new Set(["PLANNING_PATH", "MOVING_TO_GOAL"]);
+const MOVING = new Set(["PLANNING_PATH", "MOVING_TO_GOAL", "WAITING_FOR_PATH"]);
 const MAGIC = [67, 89, 77, 65, 80, 0]; // "CYMAP\0"
 const MAX_BEAMS = 8192;
 const MAX_PATH_NUMBERS = 2 * 20000 + 2;
