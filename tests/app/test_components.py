@@ -88,6 +88,12 @@ def test_cyborg_up_takes_its_defaults_from_the_components() -> None:
     assert moved["tree_runner"].parameters["robot_namespace"] == "/robot1"
 
 
+def test_the_people_cyborg_ups_video_camera_sees_are_not_in_the_simulated_robots_way() -> None:
+    specs = {spec.kind: spec for spec in up_description(build_parser().parse_args(
+        ["up", "--no-detector"])).nodes}
+    assert specs["simulator"].parameters["avoid_objects"] is False
+
+
 def test_cyborg_up_wires_the_camera_to_the_detector_by_the_contract(
         monkeypatch: pytest.MonkeyPatch) -> None:
     args = build_parser().parse_args(["up"])

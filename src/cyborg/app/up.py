@@ -146,7 +146,10 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     fleet = "/" if args.robots > 1 else under_robot(args.namespace, sim.NAMESPACE)
     namespaces = fleet_namespaces(fleet, args.robots)
     trees = [under_robot(namespace, runner.NAMESPACE) for namespace in namespaces]
-    robot: dict[str, Any] = {"map": str(map_path), "speed": args.speed, "battery": args.battery}
+    robot: dict[str, Any] = {"map": str(map_path), "speed": args.speed, "battery": args.battery,
+                             # the camera plays a recorded video, not the simulated world:
+                             # the people it sees are not in the simulated robot's way
+                             "avoid_objects": False}
     if args.start:
         robot["start"] = args.start
     if args.robots > 1:
