@@ -99,6 +99,9 @@ def test_a_person_in_the_door_cuts_the_rooms_apart_without_touching_the_cached_g
     assert planner.plan(LEFT, RIGHT).found, "without the person the door is open"
     np.testing.assert_array_equal(planner.clearance, clearance)
     np.testing.assert_array_equal(planner.cost, cost)
+    with_nan = np.vstack([disc(5.0, 3.0), [[math.nan, 3.0, KEEP_OUT]]])
+    assert planner.plan(LEFT, RIGHT, discs=with_nan).code == NO_VALID_PATH, \
+        "a disc that is not a number is left out, the others still count"
 
 
 def test_a_person_standing_at_the_goal_or_beside_the_start_never_cuts_it_off(

@@ -170,11 +170,12 @@ class Planner:
         Around each disc a window of cells gets the smaller of its clearance and its distance
         to the disc's edge, and the larger of its cost and the cost that distance gives (the
         planner's lethal radius and ramp, as near a wall); cells outside the windows are left
-        as they are, so a few discs cost a few thousand cells, whatever the map's size.
+        as they are, so a few discs cost a few thousand cells, whatever the map's size. A
+        disc with a number that is not finite is left out.
         """
         grid, resolution = self.grid, self.grid.resolution
         rows, columns = grid.shape
-        for x, y, keep_out in discs:
+        for x, y, keep_out in discs[np.isfinite(discs).all(axis=1)]:
             reach = keep_out + self.lethal + self.settings.cost_ramp
             if reach <= 0:
                 continue
