@@ -117,7 +117,8 @@ def test_a_person_in_a_narrow_corridor_is_waited_for_until_they_are_gone(tmp_pat
         states, said, closest = drive_past(system, tracker, 8.0, timeout=120)
         assert said[0].data == "arrived" and arrived_at_the_end(system)
         waiting = states.index(PathState.WAITING_FOR_PATH)
-        assert states[waiting - 1] == PathState.MOVING_TO_GOAL
+        # the person may be seen before the goal is sent (the goal then starts out waiting)
+        assert states[waiting - 1] in (PathState.MOVING_TO_GOAL, PathState.NOT_INITIALIZED)
         assert states[waiting + 1] == PathState.MOVING_TO_GOAL, "on again once they left"
         assert states.count(PathState.WAITING_FOR_PATH) == 1
         assert not {PathState.FAILED_MOVE, PathState.FAILED_PLAN} & set(states)
