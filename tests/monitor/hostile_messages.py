@@ -1,6 +1,7 @@
 """A hostile robot for the monitor's tests: random, malformed messages of every kind the
 monitor's map reads (pose, scan, path, path state, battery, current goal, footprint,
-``/tf_static``, map geometry, the detector's detections and predictions), drawn from a
+``/tf_static``, map geometry, the detector's detections and predictions, the tracker's
+objects), drawn from a
 ``random.Random`` (hypothesis's ``st.randoms()`` in the fuzz test, so failures shrink; a seeded
 one in the browser test), published by a :class:`~tests.monitor.robot_messages.FakeMapRobot`.
 
@@ -34,6 +35,8 @@ from tests.monitor.robot_messages import (
     pose,
     predictions,
     scan,
+    tracked,
+    tracked_objects,
     transforms,
 )
 
@@ -45,7 +48,7 @@ NUMBERS32 = (math.nan, math.inf, -math.inf, 1e30, -1e30, 1e12, 1e4 + 1, 0.0)
 TEXTS = ("", "room1", "x" * 500, "a\nb", "ünïcødé ☃", "'\"<script>alert(1)</script>", "\t \r")
 FRAMES = ("base_link", "laser", "camera_left", "", "x" * 300, "laser")
 KINDS = ("pose", "scan", "path", "state", "battery", "goal", "footprint", "tf", "map",
-         "detections", "predictions")
+         "detections", "predictions", "objects")
 
 
 def number(rng: random.Random, hostile: tuple[float, ...] = NUMBERS) -> float:
@@ -94,6 +97,13 @@ def hostile_message(rng: random.Random, kind: str) -> Any:
                                 (number(rng), number(rng), number(rng)),
                                 [n32() for _ in range(rng.choice((0, 3, 4, 8)))])],
             source=_text(rng))
+    if kind == "objects":
+        return tracked_objects(*[
+            tracked(rng.choice((0, 1, 2, 2**32 - 1)), _text(rng), (number(rng), number(rng)),
+                    (n32(), n32()), confidence=n32(), last_seen=rng.choice((0.0, 5.0, 1e9)),
+                    times_seen=rng.choice((0, 1, 2**32 - 1)))
+            for _ in range(rng.choice((0, 1, 3, 250)))],
+            now=rng.choice((0.0, 10.0, 2e9)), frame=rng.choice(("map", "map", "odom", "")))
     objects = [(_text(rng), number(rng), number(rng))
                for _ in range(rng.choice((0, 1, 3, 250)))]
     return detections(*objects) if kind == "detections" else predictions(*objects)
@@ -105,7 +115,7 @@ def publish(robot: FakeMapRobot, kind: str, message: Any) -> None:
         "pose": robot.pose, "scan": robot.scan, "path": robot.path, "state": robot.path_state,
         "battery": robot.battery, "goal": robot.goal, "footprint": robot.footprint,
         "tf": robot.tf_static, "map": robot.map, "detections": robot.detections,
-        "predictions": robot.predictions}
+        "predictions": robot.predictions, "objects": robot.objects}
     publishers[kind].publish(message)
 
 
@@ -121,6 +131,7 @@ def certainly_bad() -> list[tuple[str, Any]]:
         ("tf", transforms(("base_link", "laser", math.nan, 0.0, 0.0))),
         ("map", map_geometry(points=np.array([1.0, math.nan], np.float32))),
         ("detections", detections(("person", 0.9, math.inf))),
+        ("objects", tracked_objects(tracked(1, at=(math.nan, 0.0)))),
     ]
 
 

@@ -16,7 +16,7 @@ from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.map_store import StoredMap
 from cyborg.monitor.robot_clients import MoveGoal, RobotClients, clamp_drive
-from cyborg.monitor.robot_hub import DETECTIONS_INTERVAL, PATH_INTERVAL
+from cyborg.monitor.robot_hub import DETECTIONS_INTERVAL, OBJECTS_INTERVAL, PATH_INTERVAL
 from cyborg.monitor.robot_outbox import RobotOutbox, Throttle
 from cyborg.monitor.robot_source import RobotSource
 from tests.monitor.monitor_protocol import bare_hub
@@ -118,7 +118,8 @@ def acting_hub(*, token: str | None = None, objects: tuple[dict[str, Any], ...] 
     stored = StoredMap("0" * 32, b"", 0, "campus.map", {"lines": 0, "points": 0,
                                                         "objects": len(objects)}, objects)
     hub.robot_hub.robots[ROBOT] = RobotOutbox(source, Throttle(PATH_INTERVAL),
-                                              Throttle(DETECTIONS_INTERVAL), map=stored)
+                                              Throttle(DETECTIONS_INTERVAL),
+                                              Throttle(OBJECTS_INTERVAL), map=stored)
     buses: dict[str, FakeBus] = {}
 
     def make(namespace: str) -> RobotClients:

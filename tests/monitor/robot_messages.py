@@ -1,6 +1,6 @@
 """Helpers for the map data path's tests: a robot's messages built by hand (pose, scan, path,
 battery, current goal, footprint, fixed transforms, map geometry, the detector's detections
-and predictions), and a fake robot that publishes them on a bus."""
+and predictions, the tracker's objects), and a fake robot that publishes them on a bus."""
 
 from __future__ import annotations
 
@@ -18,6 +18,8 @@ from cyborg.bus.msgs.cyborg_msgs.msg import (
     MapObject,
     Prediction,
     Predictions,
+    TrackedObject,
+    TrackedObjects,
 )
 from cyborg.bus.msgs.geometry_msgs.msg import (
     Point,
@@ -46,7 +48,7 @@ from cyborg.bus.msgs.vision_msgs.msg import (
     Point2D,
 )
 from cyborg.bus.msgs.vision_msgs.msg import Pose2D as VisionPose2D
-from cyborg.interfaces import detector, robot
+from cyborg.interfaces import detector, perception, robot
 
 BEAMS = 541
 INCREMENT = math.radians(0.5)
@@ -162,6 +164,29 @@ def predictions(*objects: tuple[str, float, float], frame: str = "camera_left") 
         for label, score, distance in objects])
 
 
+def stamp(seconds: float) -> Time:
+    """A ``builtin_interfaces/Time`` of ``seconds`` (0 or more)."""
+    whole = int(seconds)
+    return Time(sec=whole, nanosec=round((seconds - whole) * 1e9))
+
+
+def tracked(id_: int, label: str = "person", at: tuple[float, float] = (1.0, 2.0),
+            velocity: tuple[float, float] = (0.0, 0.0), *, confidence: float = 0.8,
+            last_seen: float = 10.0, times_seen: int = 3) -> TrackedObject:
+    """One object the tracker follows, at ``at`` (m, map frame), last seen at ``last_seen`` s."""
+    return TrackedObject(id=id_, label=label, confidence=confidence,
+                         position=Point(x=at[0], y=at[1], z=0.0),
+                         velocity=Vector3(x=velocity[0], y=velocity[1], z=0.0),
+                         last_seen=stamp(last_seen), times_seen=times_seen, distance=2.0,
+                         bearing=0.1)
+
+
+def tracked_objects(*objects: TrackedObject, now: float = 10.0,
+                    frame: str = "map") -> TrackedObjects:
+    """The tracker's ``objects`` message as of ``now`` s."""
+    return TrackedObjects(header=Header(stamp=stamp(now), frame_id=frame), objects=list(objects))
+
+
 class FakeMapRobot:
     """Publishes a robot's topics under ``namespace`` on ``node``'s bus, by hand."""
 
@@ -178,6 +203,7 @@ class FakeMapRobot:
         seeing = detector.detector_of_robot(namespace)
         self.detections = detector.DETECTIONS.publisher(node, seeing)
         self.predictions = detector.PREDICTIONS.publisher(node, seeing)
+        self.objects = perception.OBJECTS.publisher(node, namespace)
         self.tf_static = robot.TF_STATIC.publisher(node)
 
     def state(self, text: str) -> None:

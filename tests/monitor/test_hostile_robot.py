@@ -1,9 +1,9 @@
 """Hostile input end to end: random, malformed robot messages of every kind (absurd maps,
 NaN and infinite poses, scans of the wrong length, giant footprints, bad transforms, bad
-current goals, bad detections; tests/monitor/hostile_messages.py) go over the bus into a
-running monitor, whose page-bound messages must stay strict JSON within the documented limits
-(docs/monitor.md, "The map's data path"); each kind that cannot be drawn is a warning; no
-exception is logged and the page's connection stays open."""
+current goals, bad detections and tracked objects; tests/monitor/hostile_messages.py) go over
+the bus into a running monitor, whose page-bound messages must stay strict JSON within the
+documented limits (docs/monitor.md, "The map's data path"); each kind that cannot be drawn is a
+warning; no exception is logged and the page's connection stays open."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cyborg.interfaces import detector
+from cyborg.interfaces import detector, perception
 from tests.monitor.hostile_messages import KINDS, certainly_bad, hostile_message, publish
 from tests.monitor.monitor_protocol import RECEIVE_TIMEOUT, local_client
 from tests.monitor.robot_messages import map_geometry, pose
@@ -91,6 +91,13 @@ def check(message: dict[str, Any]) -> None:
         for item in message["d"]:
             assert _finite(item["p"], WORLD_M + 200) and 0 <= item["score"] <= 1
             assert len(item["label"]) <= 60
+    elif kind == "obj":
+        assert len(message["o"]) <= 200 and len({item["id"] for item in message["o"]}) == len(
+            message["o"])
+        for item in message["o"]:
+            assert _finite((item["x"], item["y"]), WORLD_M)
+            assert _finite((item["vx"], item["vy"]), 20.0) and 0 <= item["conf"] <= 1
+            assert 0 <= item["age"] <= 3600 and len(item["label"]) <= 60
     elif kind == "map_ref":
         assert message["key"] is None or KEY.match(message["key"])
         counts = message["counts"]
@@ -139,6 +146,7 @@ def test_hostile_messages_of_every_kind_never_break_the_page_bound_stream(
         graph = monitor.node.context.graph
         wait_until(partial(_subscribed, graph,
                            detector.DETECTIONS.full_name("/robot1/detector")), 10.0)
+        wait_until(partial(_subscribed, graph, perception.OBJECTS.full_name("/robot1")), 10.0)
         warned: set[str] = set()
         fake.map.publish(map_geometry(points=np.zeros(2 * 2_000_001, np.float32)))
         wait_until(lambda: "map" in _drain(socket, 1, warned), 30.0,

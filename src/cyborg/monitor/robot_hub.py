@@ -28,6 +28,9 @@ except :meth:`RobotHub.notify`, which the bus calls from its threads.
   for ``/robot1``, :func:`cyborg.interfaces.detector.detector_of_robot`) is listened to, and
   what it saw goes out placed on the map as ``det``, at most one per
   :data:`DETECTIONS_INTERVAL` per robot (:mod:`cyborg.monitor.detection_wire`).
+* **Tracked objects**: while some page shows the map, each robot's ``objects`` (its tracker's,
+  :data:`cyborg.interfaces.perception.OBJECTS`) are listened to, and go out checked as ``obj``,
+  at most one per :data:`OBJECTS_INTERVAL` per robot (:mod:`cyborg.monitor.object_wire`).
 * **Warnings** about a robot's messages go out as ``robot_warn``, at most one per second per
   kind, with how often it happened.
 
@@ -68,6 +71,11 @@ PATH_INTERVAL = 0.5
 """Shortest time between two ``path`` messages of one robot (s)."""
 DETECTIONS_INTERVAL = 0.2
 """Shortest time between two ``det`` messages of one robot (s): at most 5 a second."""
+OBJECTS_INTERVAL = 0.2
+"""Shortest time between two ``obj`` messages of one robot (s): at most 5 a second."""
+OBJECTS_KEPT = 3.0
+"""A page that starts to look is sent a robot's tracked objects only if they came within this
+many seconds (the page itself stops drawing them as long after the last ``obj``)."""
 RS_KINDS = frozenset({"pose", "scan", "state", "battery", "goal", "footprint"})
 """Changes that an ``rs`` message tells."""
 
@@ -133,7 +141,7 @@ class RobotHub:
                     changed = self._found(namespace) or changed
                 if changed:
                     self._changed()
-            self._follow_detections()  # robots found, pages gone
+            self._follow_seen()  # robots found, pages gone
             for robot in list(self.robots.values()):
                 if robot.source.warnings.pending():
                     self._send_warnings(robot, self._viewers())
@@ -160,7 +168,8 @@ class RobotHub:
                 return False
             self._release(gone)
         self.robots[namespace] = RobotOutbox(self._make(namespace), Throttle(PATH_INTERVAL),
-                                             Throttle(DETECTIONS_INTERVAL))
+                                             Throttle(DETECTIONS_INTERVAL),
+                                             Throttle(OBJECTS_INTERVAL))
         self.tree_changed(self._tree_of(namespace) or "")  # what its tree runs now
         self._request(namespace)  # what arrived while the source was being made
         return True
@@ -258,6 +267,8 @@ class RobotHub:
             self._send(viewers, state)
         self._throttled(robot, robot.detections_throttle, source.detections_id, viewers,
                         robot.detections_message)
+        self._throttled(robot, robot.objects_throttle, source.objects_id, viewers,
+                        robot.objects_message)
         if "warn" in changes:
             self._send_warnings(robot, viewers)
 
@@ -334,18 +345,19 @@ class RobotHub:
     def view(self, client: Client, on: bool) -> None:
         """Makes ``client`` show the map (``on``) or not; a page that starts gets everything."""
         was, client.map_view = client.map_view, on
-        self._follow_detections()
+        self._follow_seen()
         if on and not was:
             self.resend(client)
 
-    def _follow_detections(self) -> None:
-        """Listens to the robots' detectors while some page shows the map, and only then.
+    def _follow_seen(self) -> None:
+        """Listens to the robots' detectors and trackers while some page shows the map only.
 
         A detector works only while someone listens to it.
         """
         wanted = any(client.map_view for client in self._clients)
         for robot in self.robots.values():
             robot.source.follow_detections(wanted)
+            robot.source.follow_objects(wanted)
 
     def resend(self, client: Client) -> None:
         """Sends ``client``, if it shows the map, every robot's map, path, state and warnings."""
@@ -359,6 +371,7 @@ class RobotHub:
                 self._send([client], robot.path_message())
             self._send([client], robot.rs_message(scan=True, everything=True))
             self._send([client], robot.detections_message())
+            self._send([client], robot.objects_message(within=OBJECTS_KEPT))
             for kind, message, count in source.warnings.latest():
                 self._send([client], {"t": "robot_warn", "ns": source.namespace,
                                       "kind": kind, "message": message, "count": count})

@@ -2,14 +2,16 @@
 
 :class:`~cyborg.monitor.robot_hub.RobotHub` keeps a :class:`RobotOutbox` per robot beside its
 :class:`~cyborg.monitor.robot_source.RobotSource`, and decides when to send; this module says
-what: the ``rs``, ``path``, ``det`` and ``map_ref`` messages (docs/monitor.md, "The map's data
-path") built from the source's latest state, and the marks of what every page already has (the
-footprint, the current goal and the running node go in an ``rs`` only when they changed).
-A :class:`Throttle` spaces the messages of one kind out (paths, detections).
+what: the ``rs``, ``path``, ``det``, ``obj`` and ``map_ref`` messages (docs/monitor.md, "The
+map's data path") built from the source's latest state, and the marks of what every page
+already has (the footprint, the current goal and the running node go in an ``rs`` only when
+they changed).
+A :class:`Throttle` spaces the messages of one kind out (paths, detections, tracked objects).
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,6 +52,7 @@ class RobotOutbox:
     source: RobotSource
     path_throttle: Throttle
     detections_throttle: Throttle
+    objects_throttle: Throttle
     seq: int = 0
     last: float = -float("inf")
     """When the robot's changes were last sent (monotonic s)."""
@@ -122,6 +125,18 @@ class RobotOutbox:
         if seen is None:
             return None
         return {"t": "det", "ns": self.namespace, "id": seen["id"], "d": seen["d"]}
+
+    def objects_message(self, *, within: float | None = None) -> dict[str, Any] | None:
+        """The robot's ``obj``: what its tracker follows; None before it, or older than ``within``.
+
+        ``within`` keeps a page that starts to look from being sent a list the tracker
+        stopped renewing long ago.
+        """
+        seen = self.source.objects
+        if seen is None or (within is not None and time.monotonic() - seen["at"] > within):
+            return None
+        return {"t": "obj", "ns": self.namespace, "id": seen["id"], "stamp": seen["stamp"],
+                "o": seen["o"]}
 
     def map_ref(self) -> dict[str, Any]:
         """The robot's ``map_ref``: its map's key, address, file name and counts (or nulls)."""

@@ -8,7 +8,8 @@ only check, store and notify: each message goes through its function in
 :mod:`cyborg.monitor.robot_wire`, the result replaces the one kept (a message that cannot be
 drawn leaves it as it was), any warning goes to the robot's :class:`WarningLog`, and the
 listener hears ``listener(namespace, what)`` (``"pose"``, ``"scan"``, ``"path"``,
-``"state"``, ``"battery"``, ``"goal"``, ``"footprint"``, ``"map"``, ``"warn"``, ``"alive"``).
+``"state"``, ``"battery"``, ``"goal"``, ``"footprint"``, ``"map"``, ``"warn"``, ``"alive"``,
+``"det"``, ``"obj"``).
 The map is kept as the message itself: laying it out and compressing it is the hub's work,
 off the bus thread
 (:mod:`cyborg.monitor.map_store`).
@@ -21,6 +22,11 @@ name only (the latest transform to a child frame wins), as in ROS without per-ro
 prefixes. Until the transform is known a scan goes without ``"m"`` (the page draws it from the
 robot's centre); after :data:`MOUNT_GRACE` such scans that is a warning, once per frame.
 
+What the robot sees is followed only on demand (:meth:`RobotSource.follow_detections`,
+:meth:`RobotSource.follow_objects`: while some page shows the map): its detector's detections,
+placed on the map here (:mod:`cyborg.monitor.detection_wire`), and its tracker's ``objects``,
+already on the map (:mod:`cyborg.monitor.object_wire`).
+
 Liveness comes from the bus graph: the robot is alive while something publishes its pose.
 """
 
@@ -30,11 +36,16 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bus import Node, Qos, Subscription
-from cyborg.bus.msgs.cyborg_msgs.msg import BatteryStatus, GoalWithHeading, MapGeometry, Predictions
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BatteryStatus,
+    GoalWithHeading,
+    MapGeometry,
+    Predictions,
+    TrackedObjects,
+)
 from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
@@ -42,8 +53,10 @@ from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
 from cyborg.bus.msgs.vision_msgs.msg import Detection2DArray
 from cyborg.bus.wire import EntityKind
-from cyborg.interfaces import detector, robot
+from cyborg.interfaces import detector, perception, robot
 from cyborg.monitor.detection_wire import Found, detections_wire, place, predictions_wire
+from cyborg.monitor.object_wire import objects_wire
+from cyborg.monitor.robot_warnings import WarningLog
 from cyborg.monitor.robot_wire import (
     FRAMES_KEPT,
     Transforms,
@@ -65,69 +78,12 @@ log = logging.getLogger("cyborg.monitor")
 Listener = Callable[[str, str], None]
 """``listener(namespace, what)``."""
 
-WARNING_INTERVAL = 1.0
-"""Shortest time between two warnings of one kind about one robot sent to the pages (s)."""
 PREFER_DETECTIONS = 2.0
 """Seconds after a ``detections`` message during which ``predictions`` (the same objects, in
 the 2018 message) are ignored; a detector that publishes only those is followed through them."""
 MOUNT_GRACE = 20
 """Scans without a known mount (``/tf_static`` may come after the first scans) before that is
 a warning."""
-
-
-@dataclass
-class _Warning:
-    message: str
-    count: int
-    told: int = 0
-    """The count the pages were last told."""
-    told_at: float = -float("inf")
-
-
-class WarningLog:
-    """One robot's warnings by kind: the latest text of each, how often, what pages were told.
-
-    Safe to use from several threads: the bus thread adds, the web server's loop reads.
-    """
-
-    def __init__(self) -> None:
-        self._lock = threading.Lock()
-        self._kinds: dict[str, _Warning] = {}
-
-    def add(self, kind: str, message: str) -> None:
-        """Counts one more warning of ``kind``; ``message`` becomes its latest text."""
-        with self._lock:
-            found = self._kinds.get(kind)
-            if found is None:
-                self._kinds[kind] = _Warning(message, 1)
-            else:
-                found.message, found.count = message, found.count + 1
-
-    def due(self, now: float | None = None) -> list[tuple[str, str, int]]:
-        """``(kind, message, count)`` of each kind the pages should hear of now; marks them told.
-
-        A kind is due when it happened since the pages were last told, and that was at least
-        :data:`WARNING_INTERVAL` s ago.
-        """
-        now = time.monotonic() if now is None else now
-        due = []
-        with self._lock:
-            for kind, warning in self._kinds.items():
-                if warning.count > warning.told and now - warning.told_at >= WARNING_INTERVAL:
-                    warning.told, warning.told_at = warning.count, now
-                    due.append((kind, warning.message, warning.count))
-        return due
-
-    def pending(self) -> bool:
-        """Whether some warning has not been told yet (it may not be due yet)."""
-        with self._lock:
-            return any(warning.count > warning.told for warning in self._kinds.values())
-
-    def latest(self) -> list[tuple[str, str, int]]:
-        """``(kind, message, count)`` of every kind so far, for a page that starts to look."""
-        with self._lock:
-            return [(kind, warning.message, warning.count)
-                    for kind, warning in self._kinds.items()]
 
 
 class RobotSource:
@@ -156,6 +112,13 @@ class RobotSource:
         :func:`~cyborg.monitor.detection_wire.place` gives it); ``id`` counts them from 1."""
         self._detections_at = -float("inf")
         self._detector: list[Subscription[Any]] = []
+        self.objects: dict[str, Any] | None = None
+        """What the robot's tracker follows, checked: ``{"id", "stamp", "o", "at"}`` (``o`` as
+        :func:`~cyborg.monitor.object_wire.objects_wire` gives it, ``at`` when it came,
+        monotonic s); ``id`` counts them from 1. None while not followed."""
+        self.objects_id = 0
+        """Counts the tracker's messages taken (it goes on across :meth:`follow_objects`)."""
+        self._tracker: Subscription[Any] | None = None
         self.warnings = WarningLog()
         self._transforms: Transforms = {}
         self._unmounted: dict[str, int] = {}
@@ -295,6 +258,32 @@ class RobotSource:
         self.detections = {"id": self.detections_id + 1, "d": place(found, pose, mount)}
         self._mark("det")
 
+    def follow_objects(self, on: bool) -> None:
+        """Subscribes to the robot's tracked ``objects`` (``on``), or withdraws and forgets them.
+
+        Call it from one thread only (the hub's loop).
+        """
+        if on == (self._tracker is not None):
+            return
+        if on:
+            self._tracker = perception.OBJECTS.subscription(self.node, self._on_objects,
+                                                            self.namespace)
+            return
+        assert self._tracker is not None
+        self._tracker.destroy()
+        self._tracker, self.objects = None, None
+
+    def _on_objects(self, message: TrackedObjects) -> None:
+        found, warnings = objects_wire(message)
+        self._warn("objects", warnings)
+        if found is None or self._tracker is None:
+            return
+        self.objects_id += 1
+        stamp = message.header.stamp
+        self.objects = {"id": self.objects_id, "o": found, "at": time.monotonic(),
+                        "stamp": round(float(stamp.sec) + float(stamp.nanosec) * 1e-9, 3)}
+        self._mark("obj")
+
     def _check_alive(self) -> None:
         alive = self.node.context.graph.count(robot.POSE.full_name(self.namespace),
                                               EntityKind.PUBLISHER) > 0
@@ -348,6 +337,7 @@ class RobotSource:
         """Withdraws the subscriptions; the listener hears nothing more."""
         self._remove_graph_listener()
         self.follow_detections(False)
+        self.follow_objects(False)
         for subscription in self._subscriptions:
             subscription.destroy()
         self._subscriptions = []
