@@ -2,11 +2,14 @@
 // toggles, warnings and the "no map yet" line. HTML rather than canvas, so it is crisp, takes
 // clicks, and costs nothing per frame: each part is rewritten only when what it shows changes.
 //
-// Layer choices are kept in localStorage, so a reload (or the next visit) shows the same.
+// Layer choices are kept in localStorage, so a reload (or the next visit) shows the same. A
+// layer nobody chose may change its default while the page runs (autoLayer): "Detected objects"
+// goes off once a tracker's objects come, which show the same things better placed.
 
 export const LAYERS = [
   ["walls", "Walls"], ["points", "Scanned points"], ["forbidden", "Forbidden lines and areas"],
-  ["goals", "Goals, docks, home"], ["paths", "Paths"], ["laser", "Laser"], ["detections", "Detected objects"],
+  ["goals", "Goals, docks, home"], ["paths", "Paths"], ["laser", "Laser"],
+  ["tracked", "Tracked objects"], ["detections", "Detected objects"],
   ["robots", "Robots"], ["labels", "Labels"],
 ];
 const STORE = "cyborg-monitor-map-layers";
@@ -25,7 +28,9 @@ export class Hud {
     this.warningCount = $("#map-warning-count");
     this.warningList = $("#map-warning-list");
     this.follow = $("#map-follow");
-    this.layers = loadLayers();
+    [this.layers, this.chosen] = loadLayers();
+    this.onLayers = onLayers;
+    this.boxes = new Map(); // layer name -> its checkbox
     this.shown = { scale: null, warnings: "", status: null };
     const menu = $("#map-layer-list");
     for (const [name, label] of LAYERS) {
@@ -34,10 +39,13 @@ export class Hud {
       box.type = "checkbox";
       box.dataset.layer = name;
       box.checked = this.layers[name];
+      this.boxes.set(name, box);
       box.addEventListener("change", () => {
         this.layers = { ...this.layers, [name]: box.checked };
+        this.chosen.add(name);
         try {
-          localStorage.setItem(STORE, JSON.stringify(this.layers));
+          const saved = Object.fromEntries([...this.chosen].map((chosen) => [chosen, this.layers[chosen]]));
+          localStorage.setItem(STORE, JSON.stringify(saved));
         } catch {
           // storage full or refused (private windows): the choice lasts this page only
         }
@@ -48,6 +56,15 @@ export class Hud {
     }
     $("#map-fit").addEventListener("click", () => onFit());
     this.follow.addEventListener("change", () => onFollow(this.follow.checked));
+  }
+
+  // Switches layer `name` on or off by default, unless the user chose it (in Layers, now or
+  // on an earlier visit).
+  autoLayer(name, on) {
+    if (this.chosen.has(name) || this.layers[name] === on) return;
+    this.layers = { ...this.layers, [name]: on };
+    this.boxes.get(name).checked = on;
+    this.onLayers(this.layers);
   }
 
   setFollow(on) {
@@ -92,15 +109,21 @@ export class Hud {
   }
 }
 
+// [layers, the names the user chose]: every layer on but those chosen off.
 function loadLayers() {
   const layers = Object.fromEntries(LAYERS.map(([name]) => [name, true]));
+  const chosen = new Set();
   try {
     const saved = JSON.parse(localStorage.getItem(STORE) || "{}");
-    for (const [name] of LAYERS) if (typeof saved[name] === "boolean") layers[name] = saved[name];
+    for (const [name] of LAYERS) {
+      if (typeof saved[name] !== "boolean") continue;
+      layers[name] = saved[name];
+      chosen.add(name);
+    }
   } catch {
     // nothing saved, or not readable: all layers on
   }
-  return layers;
+  return [layers, chosen];
 }
 
 // The 1, 2 or 5 × 10ⁿ m closest to `metres` (on a log scale).

@@ -18,6 +18,8 @@
 //   {t:"path", ns, id, xy:[x y ... in mm]}   the planned path (latched: paired with st, pid)
 //   {t:"det", ns, id, d:[{label, score, p:[x, y]}]}   what the robot's detector saw last, placed
 //       on the map by the monitor (m); shown for DETECTIONS_SHOWN_MS after it came
+//   {t:"obj", ns, id, stamp, o:[{id, label, x, y, vx, vy, conf, age, seen}]}   what the robot's
+//       tracker follows, on the map (read by tracked_objects.js); replaces the robot's list
 //   {t:"robot_warn", ns, kind, message, count}   something the monitor refused or mended
 //   {t:"robots", ..., map_robots:[{ns, tree, alive, map}]}   (app.js's message) which tree drives
 //       which robot, and whether the robot is on the bus; read by MapPanel.pairRobots
@@ -35,6 +37,7 @@
 // page: every message is applied inside try/catch.
 
 import { colourOf } from "../robots.js";
+import { readTracked } from "./tracked_objects.js";
 
 export const CATEGORY = { OTHER: 0, GOAL: 1, GOAL_WITH_HEADING: 2, DOCK: 3, HOME: 4, FORBIDDEN_LINE: 5, FORBIDDEN_AREA: 6, SIM_OBSTACLE: 7 };
 export { PALETTE } from "../robots.js";
@@ -178,11 +181,12 @@ export class MapModel {
   // it was malformed), null otherwise.
   receive(message) {
     const type = message && typeof message === "object" ? message.t : undefined;
-    if (!["rs", "path", "det", "map_ref", "robot_warn"].includes(type)) return null;
+    if (!["rs", "path", "det", "obj", "map_ref", "robot_warn"].includes(type)) return null;
     try {
       if (type === "rs") this.robotState(message);
       else if (type === "path") this.path(message);
       else if (type === "det") this.detections(message);
+      else if (type === "obj") this.robot(namespace(message)).tracked = readTracked(message);
       else if (type === "map_ref") this.mapRef(message);
       else this.serverWarning(message);
       this.version += 1;
@@ -220,6 +224,7 @@ export class MapModel {
         ns, seq: null, pose: null, scan: null, scanCount: 0, mount: null, footprint: DEFAULT_FOOTPRINT, alive: this.alive.get(ns) ?? true,
         node: "", state: "", goal: null, battery: null, pathId: null, path: null, progress: null, colour: colourOf(ns),
         seen: null, // {at (ms), items: [{label, score, x, y}]}: the detector's objects
+        tracked: null, // {at (ms), stamp, items}: the tracker's objects (tracked_objects.js)
       };
       this.robots.set(ns, robot);
     }

@@ -13,11 +13,13 @@
 // an error for "map"; the panel swallows it and keeps saying "no map yet".
 //
 // `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
-// {points, lines, objects}, moving: {robots, laser, paths, goals, detections, names}, warnings,
+// {points, lines, objects}, moving: {robots, laser, paths, goals, tracked, arrows, trackedLabels,
+// detections, names}, warnings, objectTip() (the tracked object's tooltip text, or null),
 // toScreen(x, y), toWorld(sx, sy), view(), colourOf(ns), robot(ns), selected(), fetches,
 // renders, where, frameMs, messageMs}; robot(ns) is a copy of what the page knows of a robot
 // (pose, mount, footprint, battery, alive, state, path and scan sizes, whether its path is
-// drawn and how far its end is, the running node, the current goal), or null; acting() what acting from the map stands
+// drawn and how far its end is, the running node, the current goal, the detector's objects
+// `seen` and the tracker's `tracked`, aged to now), or null; acting() what acting from the map stands
 // at ({robot, canAct, mode, points}); highlight() the goal ringed for the node selected in
 // the tree ({name, x, y, th, category}, or null).
 
@@ -26,11 +28,14 @@ import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
 import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
+import { describe } from "./map_probe.js";
 import { CATEGORY, DETECTIONS_SHOWN_MS, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
 import { pickOnClick, robotAt } from "./robot_pick.js";
 import { StaticLayer } from "./static_layer.js";
+import { ObjectTip } from "./object_tip.js";
 import { MapTools } from "./tools.js";
+import { TRACKED_SHOWN_MS, trackedAt } from "./tracked_objects.js";
 import { ViewTransform } from "./view_transform.js";
 
 const FRAME_SAMPLES = 600;
@@ -71,6 +76,7 @@ export class MapPanel {
     this.actions = new MapActions(root, { send, robot: () => this.actingRobot(), onChange: () => this.schedule() });
     this.tools = new MapTools(this.canvas, { view: this.view, actions: this.actions, markerAt: (sx, sy, px) => this.markerAt(sx, sy, px), robotAt: (sx, sy) => robotAt(this.model.robots.values(), this.view, sx, sy), schedule: () => this.schedule() });
     this.driver = new Driver(root, { actions: this.actions, post });
+    this.objectTip = new ObjectTip(root, this.canvas, (sx, sy, px) => (this.hud.layers.tracked ? trackedAt(this.drawnRobots(), this.view, sx, sy, px) : null));
     const panel = this; // for the getters below
     this.stats = window.__map = {
       firstPaint: null, paints: 0, recordPaints: false, paintTimes: [],
@@ -87,6 +93,7 @@ export class MapPanel {
       acting: () => ({ robot: this.actingRobot(), canAct: this.actions.canAct, mode: this.tools.mode, points: this.tools.points.map((p) => [...p]) }),
       highlight: () => this.goalHighlight.target && { ...this.goalHighlight.target },
       selected: () => this.selected(),
+      objectTip: () => this.objectTip.text(),
     };
     // a click on a robot selects it (js/robots.js): its tree is shown, the actions go to it;
     // not while a tool is chosen
@@ -133,6 +140,10 @@ export class MapPanel {
     if (type === null) return false;
     if (type === "map_ref") this.loadMaps();
     if (type === "det") setTimeout(() => this.schedule(), DETECTIONS_SHOWN_MS + 50); // to wipe them
+    if (type === "obj") {
+      setTimeout(() => this.schedule(), TRACKED_SHOWN_MS + 50);
+      this.hud.autoLayer("detections", false); // the tracker's objects say it better
+    }
     this.stats.messages += 1;
     this.stats.messageMs += performance.now() - started;
     this.schedule();
@@ -331,10 +342,7 @@ export class MapPanel {
     }
     const layers = this.hud.layers;
     const ready = this.staticLayer.update(this.view.snapshot(), dpr, layers);
-    const robots = [...this.model.robots.values()].filter((robot) => {
-      const ref = this.model.refs.get(robot.ns);
-      return !ref || !this.shownKey || ref.key === this.shownKey;
-    });
+    const robots = this.drawnRobots();
     const placement = this.staticLayer.placement(this.view);
     const lowerKey = placement ? `${placement.serial}:${placement.x}:${placement.y}:${placement.w}:${placement.h}` : "none";
     if (lowerKey !== this.lowerKey) {
@@ -343,6 +351,7 @@ export class MapPanel {
     }
     this.stats.moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, robots, layers, selected });
     this.tools.draw(this.ctx);
+    this.objectTip.refresh();
     this.actions.refresh();
     if (this.goalHighlight.draw(this.ctx, this.view)) this.schedule(); // pulsing
     if (this.staticLayer.current) this.stats.drawn = this.staticLayer.current.drawn;
@@ -354,6 +363,14 @@ export class MapPanel {
     frameMs.push(performance.now() - started);
     if (frameMs.length > FRAME_SAMPLES) frameMs.splice(0, frameMs.length - FRAME_SAMPLES);
     this.stamp(placement !== null && ready);
+  }
+
+  // The robots on the map shown (or on no map the page has).
+  drawnRobots() {
+    return [...this.model.robots.values()].filter((robot) => {
+      const ref = this.model.refs.get(robot.ns);
+      return !ref || !this.shownKey || ref.key === this.shownKey;
+    });
   }
 
   statusText() {
@@ -374,17 +391,4 @@ export class MapPanel {
       if (seqs) this.stats.paintTimes.push([now, seqs]);
     }, 0));
   }
-}
-
-function describe(model, robot) {
-  if (!robot) return null;
-  const xy = robot.path?.xy;
-  const end = xy && xy.length ? [xy[xy.length - 2], xy[xy.length - 1]] : null;
-  return {
-    pathShown: model.pathShown(robot), toGo: end && robot.pose ? Math.hypot(end[0] - robot.pose.x, end[1] - robot.pose.y) : null,
-    ns: robot.ns, pose: robot.pose && { ...robot.pose }, mount: robot.mount, footprint: [...robot.footprint],
-    battery: robot.battery && { ...robot.battery }, alive: robot.alive, state: robot.state, pathId: robot.pathId,
-    path: robot.path ? robot.path.xy.length / 2 : 0, scan: robot.scanCount, colour: robot.colour,
-    node: robot.node, goal: robot.goal && { ...robot.goal }, seen: model.seenNow(robot).map((item) => ({ ...item })),
-  };
 }

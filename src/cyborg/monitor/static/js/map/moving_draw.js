@@ -5,11 +5,15 @@
 // and scaled to the current view while a new one is drawn) only when the view or the bitmap
 // changed: a robot moving does not repaint the map under it. The upper one is cleared and
 // drawn every frame: planned paths (the part already travelled faded), the current goal,
-// laser hits, detected objects, robots (footprint in the robot's colour, heading as a white arrow), then names.
+// laser hits, tracked objects (tracked_draw.js), detected objects, robots (footprint in the
+// robot's colour, heading as a white arrow), then names.
 // A robot that left the bus (the monitor's map_robots says it is not alive) is drawn faded,
 // without its laser, where it was last seen.
 //
 // Everything here is in CSS pixels: the context is scaled by the device pixel ratio once.
+
+import { drawTracked } from "./tracked_draw.js";
+import { trackedNow } from "./tracked_objects.js";
 
 const MIN_ROBOT_PX = 14; // a robot is never drawn smaller than this, however far out
 const DOT_PX = 2;
@@ -25,12 +29,12 @@ export function drawBitmap(ctx, view, placement, dpr) {
 
 // The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), robots (the robots
 // to draw, [robot]), layers, selected (ns or null)}. Returns what it drew: {robots, laser,
-// paths, goals, detections, names}.
+// paths, goals, tracked, arrows, trackedLabels, detections, names}.
 export function drawMoving(ctx, scene) {
   const { view, dpr, layers } = scene;
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, view.width, view.height);
-  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, detections: 0, names: 0 };
+  const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, tracked: 0, arrows: 0, trackedLabels: 0, detections: 0, names: 0 };
   if (layers.paths) {
     for (const robot of scene.robots) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
@@ -41,6 +45,16 @@ export function drawMoving(ctx, scene) {
   }
   if (layers.laser) {
     for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
+  }
+  if (layers.tracked) {
+    const placed = layers.labels ? [] : null; // label boxes, shared so robots' labels do not collide
+    for (const robot of scene.robots) {
+      if (!robot.alive) continue;
+      const { objects, arrows, labels } = drawTracked(ctx, view, robot, trackedNow(robot), placed);
+      drawn.tracked += objects;
+      drawn.arrows += arrows;
+      drawn.trackedLabels += labels;
+    }
   }
   if (layers.detections) {
     for (const robot of scene.robots) {
