@@ -4,7 +4,9 @@ bus: a fake robot under /cyborg on a small map and a fake tracker publishing its
 tracker put it, in the robot's colour family (a person round, anything else square), with its
 label and id; a moving one gets an arrow along its velocity, an old one is faded; hovering a
 marker tells what the tracker knows; the raw "Detected objects" layer goes off by default;
-an object left out of the list disappears; the layer switches them off."""
+an object left out of the list disappears; the layer switches them off. Against the stand-in
+monitor: a "Detected objects" layer the user chose stays as chosen, and a malformed ``obj`` is
+a warning that changes nothing."""
 
 from __future__ import annotations
 
@@ -20,7 +22,8 @@ from cyborg.bus import BusConfig, Context, Node, Publisher
 from cyborg.bus.msgs.cyborg_msgs.msg import TrackedObject, TrackedObjects
 from cyborg.interfaces import perception
 from cyborg.monitor import Monitor
-from tests.monitor.map_page import on_map, open_map_page, pixel, rgb
+from tests.monitor.map_page import ROBOT as STAND_IN_ROBOT
+from tests.monitor.map_page import START, StandInMonitor, on_map, open_map_page, pixel, rgb
 from tests.monitor.robot_messages import FakeMapRobot, map_geometry, pose, tracked, tracked_objects
 from tests.running_system import wait_until
 
@@ -143,3 +146,30 @@ def _check_tooltip(page: Page) -> None:
     assert page.is_visible("#map-object-tip")
     page.mouse.move(box["x"] + 5, box["y"] + 5)
     page.wait_for_function("window.__map.objectTip() === null")
+
+
+def test_a_chosen_detections_layer_stays_and_a_malformed_list_changes_nothing(
+        browser: Browser, server: StandInMonitor) -> None:
+    errors: list[str] = []
+    page = open_map_page(browser, server.url, errors)
+    page.wait_for_function(f"window.__map.robot({STAND_IN_ROBOT!r}) !== null")
+    page.click("#map-layers summary")
+    page.uncheck("#map-layer-list input[data-layer=detections]")
+    page.check("#map-layer-list input[data-layer=detections]")  # chosen: on
+    x, y = START[0] + 1.0, START[1] + 1.0
+    server.push({"t": "obj", "ns": STAND_IN_ROBOT, "id": 1, "stamp": 5.0, "o": [
+        {"id": 3, "label": "person", "x": x, "y": y, "vx": 0, "vy": 0, "conf": 0.9, "age": 0,
+         "seen": 2}]})
+    page.wait_for_function("window.__map.moving.tracked === 1")
+    assert page.is_checked("#map-layer-list input[data-layer=detections]"), \
+        "a layer the user chose is left as chosen"
+    server.push({"t": "obj", "ns": STAND_IN_ROBOT, "id": 2, "o": "many"},
+                {"t": "obj", "ns": STAND_IN_ROBOT, "id": 3, "o": [{"id": 1, "x": "far", "y": 0}]})
+    page.wait_for_function("window.__map.warnings.some(w => w.kind === 'bad obj' && "
+                           "w.count === 2)")
+    assert [item["id"] for item in on_map(page, f"m.robot({STAND_IN_ROBOT!r}).tracked")] == [3]
+    page.reload()
+    page.wait_for_function("window.__map && window.__map.firstPaint !== null", timeout=20000)
+    page.click("#map-layers summary")
+    assert page.is_checked("#map-layer-list input[data-layer=detections]"), "kept for next time"
+    assert errors == [], json.dumps(errors)
