@@ -47,6 +47,9 @@ CAMERA_STREAMS: dict[str, Topic[Image]] = {"image": IMAGE, "depth": DEPTH, "righ
 DEFAULT_IMAGE_TOPIC = IMAGE.full_name(CAMERA_NAMESPACE)
 DEFAULT_DEPTH_TOPIC = DEPTH.full_name(CAMERA_NAMESPACE)
 
+CAMERA_FRAME = "camera_left"
+"""The frame of the camera's images, and so of the detections' headers (the ZED's left eye)."""
+
 # ---------------------------------------------------------------------- the detector
 PREDICTIONS = Topic("predictions", Predictions, latched=True)
 DETECTIONS = Topic("detections", Detection2DArray, depth=5)

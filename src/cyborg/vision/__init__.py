@@ -11,7 +11,8 @@
   :mod:`~cyborg.vision.backends`, :mod:`~cyborg.vision.letterbox`);
 * the distance of each detection: the median of valid depth in its box
   (:mod:`~cyborg.vision.distance`), the annotated image (:mod:`~cyborg.vision.annotate`), and
-  the bus messages (:mod:`~cyborg.vision.predictions`);
+  the bus messages (:mod:`cyborg.interfaces.detection_messages`, shared with the simulated
+  camera);
 * the nodes: :class:`DetectorNode` and :class:`CameraNode`; model files by name or path
   (:func:`find_model`, :mod:`~cyborg.vision.models`), as ``cyborg detect --model`` finds
   them::

@@ -23,7 +23,7 @@ import numpy as np
 from cyborg.bus import Node
 from cyborg.bus.topics import Publisher
 from cyborg.interfaces.contract import Topic
-from cyborg.interfaces.detector import DEPTH, IMAGE, RIGHT_IMAGE
+from cyborg.interfaces.detector import CAMERA_FRAME, DEPTH, IMAGE, RIGHT_IMAGE
 from cyborg.vision.frames import FrameSource, VisionError
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image
 
@@ -33,8 +33,8 @@ IMAGE_TOPIC, RIGHT_TOPIC, DEPTH_TOPIC = IMAGE.name, RIGHT_IMAGE.name, DEPTH.name
 """The topics' names in the camera's namespace."""
 DEFAULT_RATE = 15.0
 """Frames per second a file source is played at unless told otherwise."""
-DEFAULT_FRAME_ID = "camera_left"
-"""The images' frame unless told otherwise."""
+DEFAULT_FRAME_ID = CAMERA_FRAME
+"""The images' frame unless told otherwise (the contract's ``camera_left``)."""
 
 
 class CameraNode:

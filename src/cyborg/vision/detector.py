@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from cyborg.interfaces.detection_messages import corners
 from cyborg.vision.backends import Backend, OnnxRuntimeBackend, OpenCvBackend
 from cyborg.vision.frames import VisionError, check_image
 from cyborg.vision.labels import COCO, label_of, read_labels
@@ -61,8 +62,7 @@ class Detection:
     @property
     def corners(self) -> tuple[tuple[float, float], ...]:
         """Top-left, top-right, bottom-right, bottom-left (the 2018 polygon order)."""
-        x1, y1, x2, y2 = self.box
-        return (x1, y1), (x2, y1), (x2, y2), (x1, y2)
+        return corners(self.box)
 
 
 @dataclass

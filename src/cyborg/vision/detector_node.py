@@ -32,6 +32,7 @@ from typing import Any
 
 from cyborg.bus import Node
 from cyborg.bus.wire import EntityKind
+from cyborg.interfaces.detection_messages import detection_array_message, predictions_message
 from cyborg.interfaces.detector import (
     CAMERA_STREAMS,
     CLASSES,
@@ -46,7 +47,6 @@ from cyborg.vision.camera_topics import CameraTopics
 from cyborg.vision.frames import VisionError
 from cyborg.vision.image_messages import bgr_to_image, stamp_ns
 from cyborg.vision.pipeline import DetectionPipeline, Result
-from cyborg.vision.predictions import detection_array_message, predictions_message
 
 log = logging.getLogger(__name__)
 

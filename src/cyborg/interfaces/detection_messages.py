@@ -1,5 +1,11 @@
 """Detections as bus messages: 2018's ``cyborg_msgs/Predictions``, ROS 2's ``Detection2DArray``.
 
+Both producers of detections build their messages here, so that a consumer cannot tell them
+apart: the detector node on camera frames (:mod:`cyborg.vision.detector_node`) and the
+simulated camera (:mod:`cyborg.sim.camera_node`). Each takes any object with a ``label``, a
+``confidence``, a ``box`` (``x1, y1, x2, y2`` in image pixels) and a ``distance``
+(:class:`BoxedObject`).
+
 ``Predictions`` keeps the 2018 fields: a header (when the detections were made), the image's
 header, and per object the label, confidence, distance (metres; NaN when unknown) and a
 polygon of the box's four corners (top-left, top-right, bottom-right, bottom-left).
@@ -13,7 +19,7 @@ size, and the distance along the camera's optical axis in ``results[0].pose.pose
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -37,7 +43,32 @@ from cyborg.bus.msgs.vision_msgs.msg import (
     Point2D,
     Pose2D,
 )
-from cyborg.vision.detector import Detection
+
+
+class BoxedObject(Protocol):
+    """What a message needs of one detection: class, confidence, box in pixels, distance (m)."""
+
+    @property
+    def label(self) -> str:
+        """The class name (``person``)."""
+
+    @property
+    def confidence(self) -> float:
+        """The detector's confidence, 0..1."""
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        """``x1, y1, x2, y2`` in image pixels."""
+
+    @property
+    def distance(self) -> float:
+        """Metres along the camera's optical axis; NaN when unknown."""
+
+
+def corners(box: tuple[float, float, float, float]) -> tuple[tuple[float, float], ...]:
+    """Top-left, top-right, bottom-right, bottom-left of ``box`` (the 2018 polygon order)."""
+    x1, y1, x2, y2 = box
+    return (x1, y1), (x2, y1), (x2, y2), (x1, y2)
 
 
 def _copy_header(header: Any) -> Header:
@@ -45,7 +76,7 @@ def _copy_header(header: Any) -> Header:
                   frame_id=str(header.frame_id))
 
 
-def predictions_message(detections: Sequence[Detection],
+def predictions_message(detections: Sequence[BoxedObject],
                         image_header: Any, now_ns: int) -> Predictions:
     """``cyborg_msgs/msg/Predictions`` for one image, made at ``now_ns`` (nanoseconds)."""
     return Predictions(
@@ -55,11 +86,11 @@ def predictions_message(detections: Sequence[Detection],
         predictions=[Prediction(
             label=d.label, confidence=float(d.confidence), distance=float(d.distance),
             bounding_box=Polygon(points=[Point32(x=float(x), y=float(y), z=0.0)
-                                         for x, y in d.corners]))
+                                         for x, y in corners(d.box)]))
             for d in detections])
 
 
-def detection_array_message(detections: Sequence[Detection],
+def detection_array_message(detections: Sequence[BoxedObject],
                             image_header: Any) -> Detection2DArray:
     """``vision_msgs/msg/Detection2DArray`` for one image."""
     items = []
