@@ -1,0 +1,306 @@
+"""People walking in the simulated world: between waypoints, pausing, keeping out of the way.
+
+A :class:`Crowd` walks its :class:`Person` s over the map's free space. Each person has a
+walking speed of their own (drawn between :attr:`PeopleSettings.min_speed` and
+:attr:`~PeopleSettings.max_speed`, 0.5 to 1.5 m/s), a list of waypoints they visit in turn and
+then again from the first, and pauses of random length (:attr:`~PeopleSettings.min_pause` to
+:attr:`~PeopleSettings.max_pause` s) at each. Between two waypoints they follow the route the
+navigation planner (:class:`cyborg.nav.planner.Planner`) finds on the map, which keeps the
+robot's clearance from walls and forbidden zones, so nobody ever walks into a wall; routes are
+planned once per pair of points and reused (:class:`RouteBook`).
+
+Nobody walks into anybody: a person whose way ahead (:attr:`~PeopleSettings.look_ahead` m
+plus both bodies) is taken by a robot or another person stops and waits. Still blocked after
+:attr:`~PeopleSettings.patience` s, they turn back towards the waypoint they came from, as a
+person in a corridor does when a robot stands in it.
+
+A person's body is a circle of :attr:`~PeopleSettings.radius` m, drawn as a regular octagon
+around it (:meth:`Crowd.outlines`): the shape the laser sees and the robot's drive cannot enter,
+exactly as another robot's outline (:mod:`cyborg.sim.bodies`). The crowd steps with the sensor
+period (10 Hz), which at 1.5 m/s is 15 cm a step::
+
+    crowd = Crowd(planner, random_people(arnl_map, planner, 3, seed=1), seed=1)
+    crowd.advance(0.1, robot_outlines)
+    crowd.positions          # (N, 2) metres in the map frame
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from cyborg.nav.geometry import Pose2D
+from cyborg.nav.planner import Planner
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class PeopleSettings:
+    """How people walk: body (m), speeds (m/s), pauses and patience (s), look-ahead (m)."""
+
+    radius: float = 0.25  # metres: a person's body, seen from above
+    height: float = 1.7  # metres: what the camera's box spans
+    min_speed: float = 0.5
+    max_speed: float = 1.5
+    min_pause: float = 2.0
+    max_pause: float = 8.0
+    look_ahead: float = 0.6  # metres of free way a walking person wants beyond the bodies
+    patience: float = 3.0  # seconds blocked before turning back
+
+
+@dataclass(frozen=True)
+class PersonPlan:
+    """Who walks where: a name, a start point and waypoints (m); ``line`` of the map, if any."""
+
+    name: str
+    start: Point
+    waypoints: tuple[Point, ...]
+    line: int = 0
+
+
+class Gait(Enum):
+    """What a person is doing now."""
+
+    WALKING = "walking"
+    PAUSING = "pausing"  # at a waypoint, for a while
+    WAITING = "waiting"  # blocked on the way
+    STANDING = "standing"  # no waypoint can be reached: stays where they are
+
+
+@dataclass
+class Person:
+    """One person: where they are and head (m, rad), how fast they walk, where they go next.
+
+    ``leg_from`` is the point they last left (a waypoint, their start, or where they turned
+    back), ``goal`` the point they walk to now, ``then`` the index of the waypoint they set off
+    for after the next pause; ``route`` the rest of the way to ``goal`` ((K, 2), m), ``trail``
+    the corners they passed on it (the way back).
+    """
+
+    name: str
+    x: float
+    y: float
+    speed: float
+    waypoints: tuple[Point, ...]
+    heading: float = 0.0
+    gait: Gait = Gait.WALKING
+    leg_from: Point = (0.0, 0.0)
+    goal: Point = (0.0, 0.0)
+    then: int = 0
+    route: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    trail: list[Point] = field(default_factory=list)
+    until: float = 0.0  # when a pause ends, simulated seconds
+    waited: float = 0.0  # seconds blocked so far
+
+    @property
+    def pose(self) -> Pose2D:
+        """Where the person stands, facing where they walk."""
+        return Pose2D(self.x, self.y, self.heading)
+
+
+class RouteBook:
+    """Routes between points on the map, planned once each and kept (people repeat their legs).
+
+    A route is the planner's path from one point to another, (K, 2) metres, its first point
+    the start; None when the planner finds none (kept too: it would not find one again). The
+    way back is the way there reversed, not planned again.
+    """
+
+    def __init__(self, planner: Planner) -> None:
+        self.planner = planner
+        self._routes: dict[tuple[float, float, float, float], np.ndarray | None] = {}
+        self.planned = 0
+
+    def route(self, start: Point, goal: Point) -> np.ndarray | None:
+        """The way from ``start`` to ``goal`` (rounded to the centimetre), or None."""
+        key = (round(start[0], 2), round(start[1], 2), round(goal[0], 2), round(goal[1], 2))
+        if key not in self._routes:
+            reverse = (key[2], key[3], key[0], key[1])
+            if reverse in self._routes:  # the way back is the way there, reversed
+                back = self._routes[reverse]
+                self._routes[key] = None if back is None else back[::-1].copy()
+            else:
+                self.planned += 1
+                result = self.planner.plan(Pose2D(*start), Pose2D(*goal))
+                self._routes[key] = None if result.path is None else result.path.points.copy()
+        return self._routes[key]
+
+
+ARRIVED_NEAR = 1.5
+"""Metres from a waypoint within which a person blocked on the way counts as arrived there:
+someone else stands on it (a robot, a person pausing)."""
+OCTAGON = np.array([[math.cos(k * math.pi / 4), math.sin(k * math.pi / 4)] for k in range(8)])
+"""A regular octagon of circumradius 1, counter-clockwise."""
+
+
+class Crowd:
+    """People walking on a map; see the module doc. ``seed`` makes their speeds and pauses."""
+
+    def __init__(self, planner: Planner, plans: Sequence[PersonPlan],
+                 settings: PeopleSettings | None = None, seed: int = 0) -> None:
+        self.settings = settings or PeopleSettings()
+        self.routes = RouteBook(planner)
+        self._random = np.random.default_rng(seed)
+        self.time = 0.0
+        s = self.settings
+        self.people = [Person(plan.name, plan.start[0], plan.start[1],
+                              float(self._random.uniform(s.min_speed, s.max_speed)),
+                              plan.waypoints, leg_from=plan.start) for plan in plans]
+        self._clearance = planner.wall_clearance
+        for person in self.people:
+            self._leave(person)
+        # the octagon's edges touch the circle of `radius`, so the body is at least that round
+        self._octagon = OCTAGON * (s.radius / math.cos(math.pi / 8))
+
+    def __len__(self) -> int:
+        """How many people walk."""
+        return len(self.people)
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Every person's position, (N, 2) metres in the map frame."""
+        return np.array([(p.x, p.y) for p in self.people], dtype=np.float64).reshape(-1, 2)
+
+    def outlines(self) -> np.ndarray:
+        """Every person's body as an octagon: (N, 8, 2) map coordinates."""
+        return self.positions[:, None, :] + self._octagon[None, :, :]
+
+    def around(self, x: float, y: float, reach: float) -> tuple[np.ndarray, ...]:
+        """The bodies (8 x 2 each) of the people within ``reach`` m of ``(x, y)``."""
+        if not self.people:
+            return ()
+        positions = self.positions
+        near = np.hypot(positions[:, 0] - x, positions[:, 1] - y) <= reach
+        outlines = self.outlines()
+        return tuple(outlines[index] for index in np.flatnonzero(near))
+
+    # ------------------------------------------------------------------ walking
+    def advance(self, dt: float, robots: Sequence[np.ndarray] = ()) -> None:
+        """Walk everyone ``dt`` seconds, keeping clear of ``robots`` (outlines, K x 2 each)."""
+        self.time += dt
+        walking = []
+        for person in self.people:
+            if person.gait is Gait.STANDING:
+                continue
+            if person.gait is Gait.PAUSING and (
+                    self.time < person.until
+                    or not self._leave(person)):
+                continue
+            if len(person.route) == 0:
+                self._arrive(person)
+                continue
+            ahead = person.route[0]
+            if (ahead[0], ahead[1]) != (person.x, person.y):
+                person.heading = math.atan2(ahead[1] - person.y, ahead[0] - person.x)
+            walking.append(person)
+        if walking:
+            for person, blocked in zip(walking, self._blocked(walking, robots), strict=True):
+                self._walk(person, dt, bool(blocked))
+
+    def _walk(self, person: Person, dt: float, blocked: bool) -> None:
+        if blocked:
+            if math.hypot(person.goal[0] - person.x, person.goal[1] - person.y) <= ARRIVED_NEAR:
+                self._arrive(person)  # someone stands at the waypoint: near enough
+                return
+            person.gait = Gait.WAITING
+            person.waited += dt
+            if person.waited >= self.settings.patience:
+                self._turn_back(person)
+            return
+        person.gait, person.waited = Gait.WALKING, 0.0
+        left = person.speed * dt
+        while left > 0.0 and len(person.route):
+            tx, ty = person.route[0]
+            gap = math.hypot(tx - person.x, ty - person.y)
+            if gap <= left:
+                person.x, person.y = float(tx), float(ty)
+                person.trail.append((person.x, person.y))
+                person.route = person.route[1:]
+                left -= gap
+            else:
+                person.x += (tx - person.x) * left / gap
+                person.y += (ty - person.y) * left / gap
+                left = 0.0
+        if len(person.route) == 0:
+            self._arrive(person)
+
+    def _blocked(self, walking: list[Person], robots: Sequence[np.ndarray]) -> np.ndarray:
+        """For each of ``walking``: whether a robot or another person stands in the way ahead.
+
+        In the way means ahead of them (along their heading) by at most both bodies and
+        :attr:`~PeopleSettings.look_ahead`, and less than both bodies (and 10 cm) aside.
+        """
+        s = self.settings
+        centres = [self.positions]
+        radii = [np.full(len(self.people), s.radius)]
+        for outline in robots:
+            middle = outline.mean(axis=0)
+            centres.append(middle[None, :])
+            radii.append(np.array([np.max(np.hypot(*(outline - middle).T))]))
+        others, reach = np.concatenate(centres), np.concatenate(radii) + s.radius
+        here = np.array([(p.x, p.y) for p in walking])
+        heading = np.array([p.heading for p in walking])
+        ux, uy = np.cos(heading)[:, None], np.sin(heading)[:, None]
+        rx = others[None, :, 0] - here[:, 0:1]
+        ry = others[None, :, 1] - here[:, 1:2]
+        along = rx * ux + ry * uy
+        across = np.abs(rx * uy - ry * ux)
+        ahead = (along > 1e-9) & (along <= reach + s.look_ahead) & (across < reach + 0.1)
+        result: np.ndarray = ahead.any(axis=1)
+        return result
+
+    def _arrive(self, person: Person) -> None:
+        """Pause at the waypoint (or as near it as they got), then go on to the next."""
+        s = self.settings
+        person.gait = Gait.PAUSING
+        person.leg_from = person.goal
+        person.trail = person.trail[-1:] if len(person.route) == 0 else []
+        person.until = self.time + float(self._random.uniform(s.min_pause, s.max_pause))
+
+    def _leave(self, person: Person) -> bool:
+        """Set off for waypoint ``then``, or the next one that can be reached; whether any.
+
+        The leg is the route between the two points (planned once, :class:`RouteBook`),
+        joined from where the person stands: straight to its second corner when nothing is in
+        the way, else back along what is left of the way they came.
+        """
+        count = len(person.waypoints)
+        here = (person.x, person.y)
+        for tried in range(count):
+            goal = person.waypoints[(person.then + tried) % count]
+            route = self.routes.route(person.leg_from, goal)
+            if route is None:
+                continue
+            rest = route[1:]
+            if len(rest) and here != person.leg_from and not self._clear(here, rest[0]):
+                rest = np.vstack([person.route, route[:1], rest]) if len(person.route) else \
+                    np.vstack([route[:1], rest])
+            person.then, person.goal = (person.then + tried + 1) % count, goal
+            person.route, person.gait, person.waited = rest, Gait.WALKING, 0.0
+            person.trail = [here]
+            return True
+        person.gait, person.route = Gait.STANDING, np.zeros((0, 2))
+        return False
+
+    def _clear(self, start: Point, end: np.ndarray) -> bool:
+        """Whether a person walks from ``start`` to ``end`` in a straight line clear of walls."""
+        steps = max(2, math.ceil(math.hypot(end[0] - start[0], end[1] - start[1]) / 0.1))
+        share = np.linspace(0.0, 1.0, steps)
+        grid = self.routes.planner.grid
+        rows, columns = grid.cells_of(np.column_stack([start[0] + share * (end[0] - start[0]),
+                                                       start[1] + share * (end[1] - start[1])]))
+        return bool(np.all(self._clearance[rows, columns] >= self.settings.radius + 0.05))
+
+    def _turn_back(self, person: Person) -> None:
+        """Blocked for too long: walk back the way they came, to try again after a pause."""
+        back = [(person.x, person.y), *reversed(person.trail)]
+        person.route = np.array(back[1:], dtype=np.float64).reshape(-1, 2)
+        person.trail = [back[0]]
+        person.leg_from, person.goal = back[0], back[-1]
+        person.then = (person.then - 1) % len(person.waypoints)  # the waypoint not reached
+        person.gait, person.waited = Gait.WALKING, 0.0
