@@ -29,6 +29,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import ndimage
 
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.footprint import PIONEER_LX, Footprint
@@ -136,13 +137,10 @@ class Planner:
         problem = self.check(start, "start") or self.check(goal, "goal")
         if problem is not None:
             return PlanResult(None, *problem, planning_time=time.perf_counter() - began)
-        clearance, cost = self.clearance, self.cost
         if obstacles is not None and len(obstacles):
-            blocked = self.grid.blocked()
-            self.grid.mark_points(blocked, obstacles)
-            clearance = self.grid.clearance(blocked)
-            cost = self._cost(clearance)
-        cost = cost.copy()
+            clearance, cost = self._around(obstacles)
+        else:
+            clearance, cost = self.clearance, self.cost.copy()
         for pose in (start, goal):
             self._open_escape(cost, clearance, pose)
         if discs is not None and len(discs):
@@ -192,6 +190,30 @@ class Planner:
             np.minimum(window, np.maximum(gap, 0.0).astype(window.dtype), out=window)
             np.maximum(cost[r0:r1, c0:c1], self._cost(np.maximum(gap, 0.0)),
                        out=cost[r0:r1, c0:c1])
+
+    def _around(self, obstacles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Clearance and cost with ``obstacles`` (N x 2 points, m) added to the map's.
+
+        The clearance to walls and points is the smaller of the two clearances, and points
+        change the cost only within the lethal distance and the cost ramp of them: so only the
+        window around the points is computed again (a distance transform of that window),
+        not the whole map.
+        """
+        grid = self.grid
+        reach = math.ceil(max(self.lethal + self.settings.cost_ramp,
+                              self.settings.smoothing_margin) / grid.resolution) + 1
+        rows, columns = grid.cells_of(obstacles)
+        r0, r1 = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, grid.shape[0])
+        c0, c1 = (max(int(columns.min()) - reach, 0),
+                  min(int(columns.max()) + reach + 1, grid.shape[1]))
+        free = np.ones((r1 - r0, c1 - c0), bool)
+        free[rows - r0, columns - c0] = False
+        near = (ndimage.distance_transform_edt(free) * grid.resolution).astype(np.float32)
+        clearance, cost = self.clearance.copy(), self.cost.copy()
+        window = np.minimum(clearance[r0:r1, c0:c1], near)
+        clearance[r0:r1, c0:c1] = window
+        cost[r0:r1, c0:c1] = self._cost(window)
+        return clearance, cost
 
     def _cost(self, clearance: np.ndarray) -> np.ndarray:
         ramp = self.settings.cost_ramp
