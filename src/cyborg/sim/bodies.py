@@ -6,7 +6,9 @@ an obstacle to the others, exactly as drawn: a convex polygon (the footprint of
 
 * :func:`polygon_gap` is the smallest distance between two such outlines, negative (minus the
   depth of the overlap) when they overlap; the drive refuses a step that makes it negative.
-* :func:`cast_onto` shortens laser beams that hit an outline before anything else.
+* :func:`cast_onto` shortens laser beams that hit an outline before anything else;
+  :func:`cast_onto_circles` those that hit a round body (a walking person,
+  :mod:`cyborg.sim.people`).
 * :func:`outline_points` samples an outline as points, which the motion check and the
   navigator take like laser returns (so a robot knows of another even behind its back, where
   the laser is blind); placed (:func:`placed`) along a moving robot's braking way too
@@ -120,6 +122,42 @@ def cast_onto(outline: np.ndarray, x: float, y: float, angles: np.ndarray,
             share = (ax * dy - ay * dx) / denominator  # where on the edge, 0..1
             if along >= 0.0 and 0.0 <= share <= 1.0 and along < ranges[beam]:
                 ranges[beam] = along
+
+
+@njit(cache=True)
+def cast_onto_circles(circles: np.ndarray, x: float, y: float, first: float, increment: float,
+                      ranges: np.ndarray) -> None:  # pragma: no cover - jit
+    """Shorten ``ranges`` whose beams hit one of ``circles`` ((N, 3): x, y, radius; m).
+
+    The beams leave ``(x, y)`` at the absolute angles ``first + k increment``. Only the beams
+    within a circle's angular width are tried, so many people cost the laser little.
+    """
+    beams = ranges.shape[0]
+    for index in range(circles.shape[0]):
+        cx, cy, radius = circles[index, 0] - x, circles[index, 1] - y, circles[index, 2]
+        distance = math.hypot(cx, cy)
+        if distance <= radius:
+            continue  # the scanner inside a body: it sees nothing of it
+        bearing = math.atan2(cy, cx)
+        half = math.asin(radius / distance)
+        offset = (bearing - half - first) % (2.0 * math.pi)
+        low = math.ceil(offset / increment)
+        high = math.floor((offset + 2.0 * half) / increment)
+        for step in range(low, high + 1):
+            beam = step
+            if beam >= beams:
+                beam -= round(2.0 * math.pi / increment)  # a scan wider than it is long
+                if beam < 0 or beam >= beams:
+                    continue
+            angle = first + beam * increment
+            dx, dy = math.cos(angle), math.sin(angle)
+            along = dx * cx + dy * cy
+            aside = distance * distance - along * along
+            if aside > radius * radius or along <= 0.0:
+                continue
+            hit = along - math.sqrt(radius * radius - aside)
+            if 0.0 <= hit < ranges[beam]:
+                ranges[beam] = hit
 
 
 KEEP_CLEAR = 0.1

@@ -38,6 +38,7 @@ from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
 from cyborg.sim.bodies import KEEP_CLEAR, braking_poses, grown, outline_points, placed
 from cyborg.sim.loop import PacedLoop, SimulationLock
+from cyborg.sim.people import Crowd, Meeting
 from cyborg.sim.simulator import SimSettings, Simulator
 from cyborg.sim.start import START_MARGIN, StartChoice, choose_start
 
@@ -105,10 +106,10 @@ class Fleet:
 
     def __init__(self, arnl_map: ArnlMap, count: int, start: Pose2D | str | None = None, *,
                  settings: SimSettings | None = None,
-                 charges: Sequence[float] | None = None) -> None:
+                 charges: Sequence[float] | None = None, planner: Planner | None = None) -> None:
         if not 1 <= count <= MAX_ROBOTS:
             raise ValueError(f"robots: a fleet has 1 to {MAX_ROBOTS} robots, not {count}")
-        planner = Planner(arnl_map)
+        planner = planner or Planner(arnl_map)
         starts = choose_starts(arnl_map, planner, count, start)
         charges = list(charges) if charges is not None else [Battery.charge_percent] * count
         if len(charges) != count:
@@ -120,6 +121,8 @@ class Fleet:
         self._steps = 0
         self._samples = [outline_points(grown(sim.base.footprint.polygon(), KEEP_CLEAR))
                          for sim in self.simulators]  # around each body, in its own frame
+        self.crowd: Crowd | None = None  # people walking among the robots
+        self._met: list[Meeting] = []
 
     @property
     def map(self) -> ArnlMap:
@@ -140,11 +143,17 @@ class Fleet:
         """Advance every robot one physics step, each meeting the others where they are now.
 
         At each sensor step a robot also learns the points along the others' outlines and
-        their braking ways (:mod:`cyborg.sim.bodies`), which its navigator keeps clear of.
+        their braking ways (:mod:`cyborg.sim.bodies`), which its navigator keeps clear of; the
+        fleet's ``crowd``, if any, walks then, and each robot meets the people too.
         """
         sensing = self._steps % self.steps_per_sensor == 0  # as each simulator counts
         self._steps += 1
         outlines = [sim.outline for sim in self.simulators]  # set_pose may have moved one
+        if sensing and self.crowd is not None:
+            sim = self.simulators[0]
+            self.crowd.advance(self.steps_per_sensor / sim.settings.physics_rate, outlines)
+            self._met = [self.crowd.meeting(sim.pose.x, sim.pose.y, sim.laser.spec.range_max)
+                         for sim in self.simulators]
         for index, sim in enumerate(self.simulators):
             near = self._near(index)
             points = None
@@ -152,8 +161,13 @@ class Fleet:
                 placed_points = [placed(self._samples[other], braking_poses(
                     self.simulators[other].pose, self.simulators[other].base.speed,
                     self.simulators[other].base.limits.acceleration)) for other in near]
+                if self._met:
+                    placed_points.append(self._met[index].points)
                 points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
-            sim.meet(tuple(outlines[other] for other in near), points)
+            bodies = tuple(outlines[other] for other in near)
+            met = self._met[index] if self._met else None
+            sim.meet(bodies + met.bodies if met else bodies, points,
+                     met.circles if met and sensing else None)
             sim.step()
             outlines[index] = sim.outline  # where the next robot meets it
 

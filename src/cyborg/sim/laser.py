@@ -1,6 +1,7 @@
 """A simulated 2D laser scanner (SICK S300-like), raycast on an occupancy grid.
 
-Other robots' bodies, given as outlines (:mod:`cyborg.sim.bodies`), are seen as well. Each beam
+Other robots' bodies, given as outlines (:mod:`cyborg.sim.bodies`), and people, given as
+circles, are seen as well. Each beam
 walks the grid cell by cell (the exact cell traversal of Amanatides and Woo), so a
 scan costs a fraction of a millisecond even on a large campus map. Ranges beyond the scanner's
 reach read as ``range_max + 1`` ("nothing seen"), as ``sensor_msgs/LaserScan`` users expect
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from cyborg.sim.bodies import cast_onto
+from cyborg.sim.bodies import cast_onto, cast_onto_circles
 
 
 @dataclass(frozen=True)
@@ -101,13 +102,13 @@ class Laser:
         self._ranges = np.empty(self.spec.beams)
         self._random = np.random.default_rng(seed)
 
-    def scan(self, x: float, y: float, theta: float,
-             bodies: Sequence[np.ndarray] = ()) -> np.ndarray:
+    def scan(self, x: float, y: float, theta: float, bodies: Sequence[np.ndarray] = (),
+             circles: np.ndarray | None = None) -> np.ndarray:
         """Ranges in metres for each beam, from the scanner's mount on the robot at the pose.
 
         A beam reads ``range_max + 1`` where nothing is within reach. The pose is in metres and
         radians; ``bodies`` are other robots' outlines (K x 2 map coordinates each), seen
-        like walls.
+        like walls, and ``circles`` round bodies ((N, 3): x, y, radius; people).
         """
         spec = self.spec
         sx = x + spec.mount_x * math.cos(theta)
@@ -115,10 +116,13 @@ class Laser:
         angles = self._relative + theta
         cast_rays(self.occupied, self.origin[0], self.origin[1], self.resolution, sx, sy,
                   angles, spec.range_max, self._ranges)
-        if bodies:
+        if bodies or (circles is not None and len(circles)):
             for outline in bodies:
                 cast_onto(np.ascontiguousarray(outline, dtype=np.float64), sx, sy, angles,
                           self._ranges)
+            if circles is not None and len(circles):
+                cast_onto_circles(np.ascontiguousarray(circles, dtype=np.float64), sx, sy,
+                                  spec.angle_min + theta, spec.angle_increment, self._ranges)
             self._ranges[self._ranges > spec.range_max] = np.inf
         ranges = self._ranges.copy()
         if spec.noise > 0:

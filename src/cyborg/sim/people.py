@@ -30,11 +30,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
+from cyborg.sim.bodies import outline_points
 
 Point = tuple[float, float]
 
@@ -131,6 +134,24 @@ class RouteBook:
         return self._routes[key]
 
 
+NEAR = 3.0
+"""Metres from a robot within which people are bodies its drive cannot enter, and points its
+navigator keeps clear of even behind it (further off, only its laser sees them)."""
+
+
+class Meeting(NamedTuple):
+    """What one robot meets of a crowd: bodies near it, points along them, circles further off.
+
+    ``bodies`` are the octagons (8 x 2 each, m) of the people within :data:`NEAR`, ``points``
+    (N x 2) lie along them, and ``circles`` ((M, 3): x, y, radius) are everybody within the
+    laser's reach.
+    """
+
+    bodies: tuple[np.ndarray, ...]
+    points: np.ndarray
+    circles: np.ndarray
+
+
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
@@ -156,6 +177,7 @@ class Crowd:
             self._leave(person)
         # the octagon's edges touch the circle of `radius`, so the body is at least that round
         self._octagon = OCTAGON * (s.radius / math.cos(math.pi / 8))
+        self._samples = outline_points(self._octagon)  # around a body, from its centre
 
     def __len__(self) -> int:
         """How many people walk."""
@@ -170,14 +192,21 @@ class Crowd:
         """Every person's body as an octagon: (N, 8, 2) map coordinates."""
         return self.positions[:, None, :] + self._octagon[None, :, :]
 
-    def around(self, x: float, y: float, reach: float) -> tuple[np.ndarray, ...]:
-        """The bodies (8 x 2 each) of the people within ``reach`` m of ``(x, y)``."""
+    def circles(self) -> np.ndarray:
+        """Every person's body as a circle: (N, 3) rows of x, y, radius (m)."""
+        return np.column_stack([self.positions, np.full(len(self.people), self.settings.radius)])
+
+    def meeting(self, x: float, y: float, reach: float) -> Meeting:
+        """What a robot at ``(x, y)`` meets of the crowd (see :class:`Meeting`)."""
         if not self.people:
-            return ()
-        positions = self.positions
-        near = np.hypot(positions[:, 0] - x, positions[:, 1] - y) <= reach
+            return Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
+        circles = self.circles()
+        distance = np.hypot(circles[:, 0] - x, circles[:, 1] - y)
         outlines = self.outlines()
-        return tuple(outlines[index] for index in np.flatnonzero(near))
+        close = distance <= NEAR
+        near = tuple(outlines[index] for index in np.flatnonzero(close))
+        points = (circles[close, None, :2] + self._samples[None, :, :]).reshape(-1, 2)
+        return Meeting(near, points, circles[distance <= reach])
 
     # ------------------------------------------------------------------ walking
     def advance(self, dt: float, robots: Sequence[np.ndarray] = ()) -> None:
@@ -236,23 +265,15 @@ class Crowd:
         :attr:`~PeopleSettings.look_ahead`, and less than both bodies (and 10 cm) aside.
         """
         s = self.settings
-        centres = [self.positions]
-        radii = [np.full(len(self.people), s.radius)]
-        for outline in robots:
+        count = len(self.people) + len(robots)
+        others = np.empty((count, 3))
+        for index, person in enumerate(self.people):
+            others[index] = person.x, person.y, s.radius
+        for index, outline in enumerate(robots, start=len(self.people)):
             middle = outline.mean(axis=0)
-            centres.append(middle[None, :])
-            radii.append(np.array([np.max(np.hypot(*(outline - middle).T))]))
-        others, reach = np.concatenate(centres), np.concatenate(radii) + s.radius
-        here = np.array([(p.x, p.y) for p in walking])
-        heading = np.array([p.heading for p in walking])
-        ux, uy = np.cos(heading)[:, None], np.sin(heading)[:, None]
-        rx = others[None, :, 0] - here[:, 0:1]
-        ry = others[None, :, 1] - here[:, 1:2]
-        along = rx * ux + ry * uy
-        across = np.abs(rx * uy - ry * ux)
-        ahead = (along > 1e-9) & (along <= reach + s.look_ahead) & (across < reach + 0.1)
-        result: np.ndarray = ahead.any(axis=1)
-        return result
+            others[index] = middle[0], middle[1], np.max(np.hypot(*(outline - middle).T))
+        here = np.array([(p.x, p.y, p.heading) for p in walking])
+        return _in_the_way(here, others, s.radius, s.look_ahead)
 
     def _arrive(self, person: Person) -> None:
         """Pause at the waypoint (or as near it as they got), then go on to the next."""
@@ -304,3 +325,25 @@ class Crowd:
         person.leg_from, person.goal = back[0], back[-1]
         person.then = (person.then - 1) % len(person.waypoints)  # the waypoint not reached
         person.gait, person.waited = Gait.WALKING, 0.0
+
+
+@njit(cache=True)
+def _in_the_way(here: np.ndarray, others: np.ndarray, radius: float,
+                look_ahead: float) -> np.ndarray:  # pragma: no cover - jit
+    """For each walker (x, y, heading): whether one of ``others`` (x, y, radius) is ahead.
+
+    Ahead: along the heading by more than nothing and at most both radii plus ``look_ahead``,
+    and less than both radii plus 10 cm aside. A walker never blocks itself (distance 0).
+    """
+    result = np.zeros(here.shape[0], np.bool_)
+    for walker in range(here.shape[0]):
+        ux, uy = math.cos(here[walker, 2]), math.sin(here[walker, 2])
+        for other in range(others.shape[0]):
+            rx, ry = others[other, 0] - here[walker, 0], others[other, 1] - here[walker, 1]
+            along = rx * ux + ry * uy
+            across = abs(rx * uy - ry * ux)
+            reach = radius + others[other, 2]
+            if 1e-9 < along <= reach + look_ahead and across < reach + 0.1:
+                result[walker] = True
+                break
+    return result

@@ -15,7 +15,8 @@ By hand, :meth:`Simulator.teleop` drives at a given speed and turn rate (within 
 :mod:`cyborg.sim.manual`, and never into what the robot knows: the command passes the motion
 check of :mod:`cyborg.sim.motion_check`) until :meth:`Simulator.end_teleop`, and
 :meth:`Simulator.set_pose` puts the robot somewhere else at once. Both end any goal.
-Other robots on the map (:mod:`cyborg.sim.fleet`) are obstacles to it (:meth:`Simulator.meet`).
+Other robots on the map (:mod:`cyborg.sim.fleet`) are obstacles to it (:meth:`Simulator.meet`),
+and so are people walking (:mod:`cyborg.sim.people`): a robot alone walks its ``crowd``.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from cyborg.sim.laser import Laser, LaserSpec
 from cyborg.sim.manual import limit_command, placement_problem
 from cyborg.sim.motion_check import Motion, Surroundings, safest_command, warm_up
 from cyborg.sim.navigator import Navigator, NavigatorSettings, PathState
+from cyborg.sim.people import Crowd
 from cyborg.sim.robot import RobotBase
 from cyborg.sim.start import StartChoice, choose_start
 
@@ -105,6 +107,8 @@ class Simulator:
         self._target: Target | None = None
         self.others: tuple[np.ndarray, ...] = ()
         self._points = np.zeros((0, 2))
+        self.people = np.zeros((0, 3))  # walking people as circles: x, y, radius (m)
+        self.crowd: Crowd | None = None  # people walking around a robot alone
         warm_up()  # the motion check's kernel, before the robot moves
         self.load_map(arnl_map, start, planner)
 
@@ -166,16 +170,20 @@ class Simulator:
         """The robot's outline where it stands: its footprint's corners in the map (K x 2, m)."""
         return outline_at(self.base.footprint.polygon(), self.base.pose)
 
-    def meet(self, others: tuple[np.ndarray, ...], points: np.ndarray | None = None) -> None:
-        """The other robots near this one: their outlines (K x 2 map coordinates each).
+    def meet(self, others: tuple[np.ndarray, ...], points: np.ndarray | None = None,
+             people: np.ndarray | None = None) -> None:
+        """The other robots (and people) near this one: their outlines (K x 2 map coordinates).
 
         Until the next call the laser sees them and the drive cannot pass through them; the
         navigator and the motion check keep clear of ``points`` (N x 2, m: along their outlines
-        and braking ways, :mod:`~cyborg.sim.bodies`; None keeps the last). No others: alone.
+        and braking ways, :mod:`~cyborg.sim.bodies`; None keeps the last). The laser sees
+        ``people`` too ((M, 3): x, y, radius; None keeps the last). No others: alone.
         """
         self.others = self.base.others = others
         if points is not None:
             self._points = points
+        if people is not None:
+            self.people = people
 
     @property
     def current_goal(self) -> Target | None:
@@ -303,6 +311,9 @@ class Simulator:
         """Advance one physics step."""
         dt = 1.0 / self.settings.physics_rate
         if self._steps % self.steps_per_sensor == 0:
+            if self.crowd is not None:
+                self.crowd.advance(self._period, [self.outline])
+                self.meet(*self.crowd.meeting(self.pose.x, self.pose.y, self.laser.spec.range_max))
             self._sense()
             self._command = self._decide()
         self._steps += 1
@@ -335,7 +346,7 @@ class Simulator:
 
     def _sense(self) -> None:
         pose = self.base.pose
-        self.ranges = self.laser.scan(pose.x, pose.y, pose.theta, self.others)
+        self.ranges = self.laser.scan(pose.x, pose.y, pose.theta, self.others, self.people)
         self.hits = self.laser.points(pose.x, pose.y, pose.theta, self.ranges)
         self.scans += 1
 
