@@ -160,6 +160,27 @@ def cast_onto_circles(circles: np.ndarray, x: float, y: float, first: float, inc
                 ranges[beam] = hit
 
 
+@njit(cache=True)
+def cast_onto_circles_at(circles: np.ndarray, x: float, y: float, angles: np.ndarray,
+                         ranges: np.ndarray) -> None:  # pragma: no cover - jit
+    """Shorten ``ranges`` (from ``(x, y)`` along absolute ``angles``) that hit ``circles``.
+
+    ``circles`` are (N, 3) rows of x, y, radius (m); for a few rays at any angles, where
+    :func:`cast_onto_circles` serves a laser's evenly spaced beams.
+    """
+    for ray in range(angles.shape[0]):
+        dx, dy = math.cos(angles[ray]), math.sin(angles[ray])
+        for index in range(circles.shape[0]):
+            cx, cy, radius = circles[index, 0] - x, circles[index, 1] - y, circles[index, 2]
+            along = dx * cx + dy * cy
+            aside = cx * cx + cy * cy - along * along
+            if along <= 0.0 or aside > radius * radius:
+                continue
+            hit = along - math.sqrt(radius * radius - aside)
+            if 0.0 <= hit < ranges[ray]:
+                ranges[ray] = hit
+
+
 KEEP_CLEAR = 0.1
 """Metres a robot's navigator and motion check keep from another robot's outline.
 

@@ -1,0 +1,192 @@
+"""A simulated stereo camera with an object detector: what a ZED 2 and YOLO would report.
+
+The camera sits on the robot as on the Cyborg (:class:`CameraSpec`: facing forward, ahead of
+the axle and a metre up) and looks through a pinhole of the ZED 2's horizontal field of view
+(110°) onto an image of 672 x 376 pixels (the ZED's WVGA mode, the 2018 detector's input).
+For each thing in view (:mod:`cyborg.sim.sights`) it decides what a detector on that frame
+would report:
+
+* **in view**: its centre within the field of view, between ``range_min`` and ``range_max``
+  (0.3 to 20 m, the ZED 2's depth range);
+* **occlusion**: three rays from the camera (at the centre and at 70 % of the radius to each
+  side) against the walls of the occupancy grid and the other bodies (people, robots); the
+  share of rays that reach it scales the chance of a detection;
+* **misses**: detected with probability ``detect_near`` up to ``sure_range``, falling
+  linearly to ``detect_far`` at ``range_max``, times the visible share;
+* **noise**: the distance (along the optical axis, as the detector's depth median gives it)
+  with a standard deviation of ``distance_noise[0] d + distance_noise[1] d²`` (1 % at 1 m,
+  2 % at 5 m, 5 % at 20 m: stereo depth error grows with the square of the range), the
+  bearing with ``bearing_noise``, the box's size with ``size_noise``; the confidence falls with
+  range (0.95 near, 0.55 at ``range_max``, ± 0.05);
+* **no false positives**: nothing is reported that is not there (a real detector's rare false
+  boxes are not simulated);
+* **boxes** from the pinhole model: the centre column from the bearing, the width from the
+  body's diameter, the top from its height and the bottom from the floor, clipped to the
+  image (a box with nothing left inside the image is dropped).
+
+Everything random comes from one generator seeded by ``seed``: the same run sees the same.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from cyborg.sim.bodies import cast_onto, cast_onto_circles_at
+from cyborg.sim.laser import cast_rays
+from cyborg.sim.sights import Sights
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    """The camera's mount, optics, rate and detection model; lengths in m, angles in rad."""
+
+    width: int = 672  # pixels
+    height: int = 376
+    field_of_view: float = math.radians(110.0)  # horizontal; square pixels
+    mount_x: float = 0.15  # ahead of the robot's centre
+    mount_height: float = 1.0  # above the floor, looking level
+    range_min: float = 0.3
+    range_max: float = 20.0
+    rate: float = 10.0  # frames per simulated second (at most the simulator's sensor rate)
+    detect_near: float = 0.97
+    detect_far: float = 0.3
+    sure_range: float = 5.0
+    distance_noise: tuple[float, float] = (0.01, 0.002)
+    bearing_noise: float = math.radians(1.0)
+    size_noise: float = 0.05  # relative
+
+    @property
+    def focal(self) -> float:
+        """The focal length in pixels, from the width and the horizontal field of view."""
+        return self.width / 2 / math.tan(self.field_of_view / 2)
+
+    def distance_sigma(self, distance: np.ndarray) -> np.ndarray:
+        """The standard deviation (m) of a measured distance at ``distance`` m."""
+        linear, square = self.distance_noise
+        result: np.ndarray = linear * distance + square * distance ** 2
+        return result
+
+    def detection_chance(self, distance: np.ndarray) -> np.ndarray:
+        """The chance that a fully visible thing at ``distance`` m is detected."""
+        share = np.clip((distance - self.sure_range) / (self.range_max - self.sure_range),
+                        0.0, 1.0)
+        result: np.ndarray = self.detect_near + (self.detect_far - self.detect_near) * share
+        return result
+
+
+@dataclass(frozen=True)
+class SeenObject:
+    """One detection, as the real detector reports it.
+
+    A :class:`~cyborg.interfaces.detection_messages.BoxedObject`: label, confidence, box
+    ``x1, y1, x2, y2`` in pixels, distance along the optical axis (m).
+    """
+
+    label: str
+    confidence: float
+    box: tuple[float, float, float, float]
+    distance: float
+
+
+RAY_SPREAD = 0.7
+"""Where the side rays of the occlusion test aim: this share of the radius off the centre."""
+
+
+class SimCamera:
+    """Detects :class:`~cyborg.sim.sights.Sights` from a robot pose; see the module doc.
+
+    ``occupied`` is the world's wall grid (rows, columns; cell (0, 0)'s corner at ``origin``,
+    ``resolution`` m per cell), as the laser scans it.
+    """
+
+    def __init__(self, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
+                 spec: CameraSpec | None = None, seed: int = 0) -> None:
+        self.occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
+        self.origin, self.resolution = origin, resolution
+        self.spec = spec or CameraSpec()
+        self._random = np.random.default_rng(seed)
+
+    def where(self, x: float, y: float, theta: float) -> tuple[float, float]:
+        """The camera's position in the map for the robot at ``(x, y, theta)``."""
+        return (x + self.spec.mount_x * math.cos(theta),
+                y + self.spec.mount_x * math.sin(theta))
+
+    def observe(self, x: float, y: float, theta: float, sights: Sights,
+                bodies: Sequence[np.ndarray] = (),
+                circles: np.ndarray | None = None) -> list[SeenObject]:
+        """What the detector reports on a frame taken with the robot at ``(x, y, theta)``.
+
+        ``sights`` are the things that may be detected; ``bodies`` (outlines, K x 2) and
+        ``circles`` ((M, 3): x, y, radius) what may hide them besides the walls (the things
+        themselves may be among them: a thing does not hide itself).
+        """
+        spec = self.spec
+        if not sights.labels:
+            return []
+        cx, cy = self.where(x, y, theta)
+        offset = sights.positions - (cx, cy)
+        distance = np.hypot(offset[:, 0], offset[:, 1])
+        bearing = (np.arctan2(offset[:, 1], offset[:, 0]) - theta + math.pi) % (2 * math.pi) \
+            - math.pi
+        view = ((np.abs(bearing) <= spec.field_of_view / 2) & (distance >= spec.range_min)
+                & (distance <= spec.range_max))
+        chosen = np.flatnonzero(view)
+        if len(chosen) == 0:
+            return []
+        distance, bearing = distance[chosen], bearing[chosen]
+        radii = sights.radii[chosen]
+        visible = self._visible(cx, cy, theta + bearing, distance, radii, bodies, circles)
+        chance = spec.detection_chance(distance) * visible
+        detected = self._random.random(len(chosen)) < chance
+        seen = []
+        for index in np.flatnonzero(detected):
+            seen.append(self._report(sights.labels[chosen[index]], float(distance[index]),
+                                     float(bearing[index]), float(radii[index]),
+                                     float(sights.heights[chosen[index]])))
+        return [item for item in seen if item is not None]
+
+    def _visible(self, cx: float, cy: float, angles: np.ndarray, distance: np.ndarray,
+                 radii: np.ndarray, bodies: Sequence[np.ndarray],
+                 circles: np.ndarray | None) -> np.ndarray:
+        """The share (0, 1/3, 2/3, 1) of each thing's three rays that reach it."""
+        side = np.arctan2(RAY_SPREAD * radii, distance)
+        rays = np.concatenate([angles - side, angles, angles + side])
+        reach = np.full(len(rays), np.inf)
+        cast_rays(self.occupied, self.origin[0], self.origin[1], self.resolution, cx, cy,
+                  rays, float(distance.max()) + 1.0, reach)
+        for outline in bodies:
+            cast_onto(np.ascontiguousarray(outline, dtype=np.float64), cx, cy, rays, reach)
+        if circles is not None and len(circles):
+            cast_onto_circles_at(np.ascontiguousarray(circles, dtype=np.float64), cx, cy, rays,
+                                 reach)
+        # a thing's own body is hit at its near side: at least this far means "reached it"
+        needed = np.tile(distance - 1.2 * radii, 3)
+        share: np.ndarray = (reach >= needed).reshape(3, -1).mean(axis=0)
+        return share
+
+    def _report(self, label: str, distance: float, bearing: float, radius: float,
+                height: float) -> SeenObject | None:
+        """The noisy detection of a thing at ``distance`` and ``bearing``; None off the image."""
+        spec, random = self.spec, self._random
+        depth = distance * math.cos(bearing)  # along the optical axis
+        sigma = float(spec.distance_sigma(np.array(depth)))
+        measured = max(spec.range_min, depth + random.normal(0.0, sigma))
+        seen_bearing = bearing + random.normal(0.0, spec.bearing_noise)
+        scale = 1.0 + random.normal(0.0, spec.size_noise)
+        focal, middle_x, middle_y = spec.focal, spec.width / 2, spec.height / 2
+        column = middle_x - focal * math.tan(seen_bearing)
+        half_width = focal * radius * scale / depth
+        top = middle_y - focal * (height - spec.mount_height) * scale / depth
+        bottom = middle_y + focal * spec.mount_height * scale / depth
+        x1, x2 = max(0.0, column - half_width), min(float(spec.width), column + half_width)
+        y1, y2 = max(0.0, top), min(float(spec.height), bottom)
+        if x2 - x1 < 1.0 or y2 - y1 < 1.0:
+            return None
+        closeness = 1.0 - min(distance / spec.range_max, 1.0)
+        confidence = float(np.clip(0.55 + 0.4 * closeness + random.normal(0.0, 0.05),
+                                   0.5, 0.99))
+        return SeenObject(label, confidence, (x1, y1, x2, y2), measured)
