@@ -105,10 +105,15 @@ class SimCamera:
 
     def __init__(self, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
                  spec: CameraSpec | None = None, seed: int = 0) -> None:
-        self.occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
-        self.origin, self.resolution = origin, resolution
+        self.look_at(occupied, origin, resolution)
         self.spec = spec or CameraSpec()
         self._random = np.random.default_rng(seed)
+
+    def look_at(self, occupied: np.ndarray, origin: tuple[float, float],
+                resolution: float) -> None:
+        """See the walls of another grid from now on (the robot switched maps)."""
+        self.occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
+        self.origin, self.resolution = origin, resolution
 
     def where(self, x: float, y: float, theta: float) -> tuple[float, float]:
         """The camera's position in the map for the robot at ``(x, y, theta)``."""

@@ -50,13 +50,14 @@ MAX_PUBLISH_RATE = 100.0
 class SimCameraNode:
     """Publishes a simulated camera's detections on ``node``; see the module doc.
 
-    ``sights`` gives what there is to see at a frame (``loop``'s thread, lock held);
+    ``sights`` gives what there is to see around a simulator at a frame (``loop``'s thread,
+    lock held); the camera sees the walls of the simulator's laser grid (its map's);
     ``image``: whether to draw ``detection_image`` (when someone subscribes); ``clock`` gives
     wall-clock seconds for the publishing limit.
     """
 
     def __init__(self, node: Node, loop: RobotLoop, camera: SimCamera,
-                 sights: Callable[[], Sights], *, image: bool = False,
+                 sights: Callable[[Simulator], Sights], *, image: bool = False,
                  frame_id: str = CAMERA_FRAME, max_publish_rate: float = MAX_PUBLISH_RATE,
                  clock: Callable[[], float] = time.monotonic) -> None:
         self.node, self.camera, self.sights = node, camera, sights
@@ -64,6 +65,7 @@ class SimCameraNode:
         self._min_period = 1.0 / max_publish_rate
         self._published_at = -math.inf
         self._due = 0.0
+        self._walls: object = None
         self.frames = self.skipped = 0
         self.last: list[SeenObject] = []
         self.predictions = PREDICTIONS.publisher(node)
@@ -87,9 +89,12 @@ class SimCameraNode:
         if now - self._published_at < self._min_period:
             return
         self._published_at = now
-        pose = sim.pose
-        self.last = self.camera.observe(pose.x, pose.y, pose.theta, self.sights(), sim.others,
-                                        sim.people)
+        pose, laser = sim.pose, sim.laser
+        if laser.occupied is not self._walls:
+            self._walls = laser.occupied
+            self.camera.look_at(laser.occupied, laser.origin, laser.resolution)
+        self.last = self.camera.observe(pose.x, pose.y, pose.theta, self.sights(sim),
+                                        sim.others, sim.people)
         self.frames += 1
         stamp_ns = round(sim.time * 1e9)
         header = Header(stamp=Time(sec=stamp_ns // 1_000_000_000,

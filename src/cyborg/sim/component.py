@@ -22,6 +22,12 @@ parameter      meaning (default)
 ``labels``     label; read-only)
 =============  ========================================================================
 
+and those of the people walking on the map and the robots' simulated cameras (``people``,
+``people_seed``, ``camera``, ``camera_image``; :mod:`cyborg.sim.people_and_camera`): with
+``camera`` true each robot's camera publishes detections as the detector does, under the
+robot's detector namespace (``/cyborg/detector``), and while people walk their true poses are
+on ``sim/people`` under the (first) robot's namespace.
+
 With ``robots`` N > 1 it simulates a fleet on the map (:mod:`cyborg.sim.fleet`): one loop, one
 ``/clock``, and a node :data:`NAME` per robot under ``<namespace>/robot1`` …
 ``<namespace>/robotN`` (:func:`cyborg.interfaces.robot.fleet_namespaces`), each with these
@@ -34,6 +40,7 @@ robot's frames carry its name (``robot1/base_link``, ``robot1/laser``), see
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -46,6 +53,12 @@ from cyborg.sim.fleet import MAX_ROBOTS, Fleet, robot_loops
 from cyborg.sim.loop import REAL_TIME, PacedLoop, SimulationLoop
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.object_feed import follow_objects
+from cyborg.sim.people_and_camera import (
+    declare_extras,
+    make_crowd,
+    publish_people,
+    start_cameras,
+)
 from cyborg.sim.simulator import Simulator
 
 NAME = "arnl"
@@ -61,22 +74,29 @@ ROBOTS = 1
 
 
 class RunningSimulator:
-    """A started simulator: its node, its loop and the map it runs on."""
+    """A started simulator: its node, its loop, the map it runs on, its camera's node."""
 
-    def __init__(self, node: Node, loop: SimulationLoop, map_path: Path) -> None:
+    def __init__(self, node: Node, loop: SimulationLoop, map_path: Path,
+                 cameras: Sequence[Node] = ()) -> None:
         self.node, self.loop, self.map_path = node, loop, map_path
+        self.cameras = list(cameras)
 
     def describe(self) -> str:
         """The map, the pace, and where the robot's interface is."""
         speed = self.loop.speed
         pace = "as fast as possible" if math.isinf(speed) else f"{speed:g}x real time"
+        crowd = self.loop.simulator.crowd
+        people = f"; {len(crowd)} people walking" if crowd is not None else ""
+        camera = "; a simulated camera under " + ", ".join(
+            node.namespace for node in self.cameras) if self.cameras else ""
         return (f"simulator    {self.node.fq_name}: {self.map_path.name} at {pace}; "
-                f"ARNL-like interface under {self.node.namespace}, /clock")
+                f"ARNL-like interface under {self.node.namespace}, /clock{people}{camera}")
 
     def stop(self) -> None:
         """Stops the simulation and leaves the bus."""
         self.loop.stop()
-        self.node.destroy()
+        for node in [*self.cameras, self.node]:
+            node.destroy()
 
 
 def start(context: Context, spec: NodeSpec) -> RunningSimulator | RunningFleet:
@@ -91,23 +111,29 @@ def start(context: Context, spec: NodeSpec) -> RunningSimulator | RunningFleet:
     if count > 1:
         return _start_fleet(context, spec, count)
     node = Node(spec.name, spec.namespace, context=context, parameters=spec.parameters)
+    cameras: list[Node] = []
     try:
-        settings = _declare(node, spec)
+        settings, extras = _declare(node, spec), declare_extras(node, spec)
         try:
             arnl_map = read_map(settings.map_path)
             simulator = Simulator(arnl_map, start=settings.start or None,
                                   battery=Battery(charge_percent=settings.charge))
+            pose = simulator.pose
+            simulator.crowd = make_crowd(arnl_map, simulator.planner, extras, [(pose.x, pose.y)])
             loop = SimulationLoop(simulator, settings.speed)
+            _pace(node, loop)
+            SimulatorNode(node, loop)
+            cameras = start_cameras(context, [(node, loop)], simulator.crowd, extras)
         except (MapError, KeyError, ValueError) as exc:
             raise spec.error(str(exc).strip("\"'")) from exc
-        _pace(node, loop)
-        SimulatorNode(node, loop)
         follow_objects(node, loop, spec)
+        publish_people(node, loop, simulator.crowd)
         loop.start()
     except BaseException:
-        node.destroy()
+        for each in [*cameras, node]:
+            each.destroy()
         raise
-    return RunningSimulator(node, loop, settings.map_path)
+    return RunningSimulator(node, loop, settings.map_path, cameras)
 
 
 class _Settings(NamedTuple):
@@ -152,47 +178,63 @@ def _pace(node: Node, loop: PacedLoop[Any]) -> None:
 class RunningFleet:
     """A started fleet: its robots' nodes, its loop, the fleet and the map it runs on."""
 
-    def __init__(self, nodes: list[Node], loop: PacedLoop[Fleet], map_path: Path) -> None:
+    def __init__(self, nodes: list[Node], loop: PacedLoop[Fleet], map_path: Path,
+                 cameras: Sequence[Node] = ()) -> None:
         self.nodes, self.loop, self.map_path = nodes, loop, map_path
         self.fleet = loop.simulator
+        self.cameras = list(cameras)
 
     def describe(self) -> str:
         """The map, the pace, and where each robot's interface is."""
         speed = self.loop.speed
         pace = "as fast as possible" if math.isinf(speed) else f"{speed:g}x real time"
         names = ", ".join(node.namespace for node in self.nodes)
+        crowd = self.fleet.crowd
+        people = f"; {len(crowd)} people walking" if crowd is not None else ""
+        camera = "; simulated cameras" if self.cameras else ""
         return (f"simulator    {len(self.nodes)} robots on {self.map_path.name} at {pace}: "
-                f"ARNL-like interfaces under {names}; /clock")
+                f"ARNL-like interfaces under {names}; /clock{people}{camera}")
 
     def stop(self) -> None:
         """Stops the simulation and leaves the bus."""
         self.loop.stop()
-        for node in self.nodes:
+        for node in [*self.cameras, *self.nodes]:
             node.destroy()
 
 
 def _start_fleet(context: Context, spec: NodeSpec, count: int) -> RunningFleet:
     nodes: list[Node] = []
+    cameras: list[Node] = []
     try:
         for namespace in robot.fleet_namespaces(spec.namespace, count):
             nodes.append(Node(spec.name, namespace, context=context,
                               parameters=spec.parameters))
         settings = [_declare(node, spec) for node in nodes][-1]  # the same for each
+        extras = [declare_extras(node, spec) for node in nodes][-1]
         try:
-            fleet = Fleet(read_map(settings.map_path), count, settings.start or None,
+            arnl_map = read_map(settings.map_path)
+            fleet = Fleet(arnl_map, count, settings.start or None,
                           charges=[min(settings.charge + index * settings.step, 100.0)
                                    for index in range(count)])
+            planner = fleet.simulators[0].planner
+            fleet.crowd = make_crowd(arnl_map, planner, extras, [
+                (sim.pose.x, sim.pose.y) for sim in fleet.simulators])
+            loop = PacedLoop(fleet, settings.speed)
+            shares = robot_loops(loop)
+            for index, (node, share) in enumerate(zip(nodes, shares, strict=True)):
+                _pace(node, loop)
+                SimulatorNode(node, share, initial_pose=index == 0, publishes_clock=index == 0,
+                              frame_prefix=node.namespace.strip("/") + "/")
+            cameras = start_cameras(context, list(zip(nodes, shares, strict=True)), fleet.crowd,
+                                    extras)
         except (MapError, KeyError, ValueError) as exc:
             raise spec.error(str(exc).strip("\"'")) from exc
-        loop = PacedLoop(fleet, settings.speed)
-        for index, (node, share) in enumerate(zip(nodes, robot_loops(loop), strict=True)):
-            _pace(node, loop)
-            SimulatorNode(node, share, initial_pose=index == 0, publishes_clock=index == 0,
-                          frame_prefix=node.namespace.strip("/") + "/")
+        for node, share in zip(nodes, shares, strict=True):
             follow_objects(node, share, spec)
+        publish_people(nodes[0], shares[0], fleet.crowd)
         loop.start()
     except BaseException:
-        for node in nodes:
+        for node in [*cameras, *nodes]:
             node.destroy()
         raise
-    return RunningFleet(nodes, loop, settings.map_path)
+    return RunningFleet(nodes, loop, settings.map_path, cameras)

@@ -38,7 +38,7 @@ from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
 from cyborg.sim.bodies import KEEP_CLEAR, braking_poses, grown, outline_points, placed
 from cyborg.sim.loop import PacedLoop, SimulationLock
-from cyborg.sim.people import Crowd, Meeting
+from cyborg.sim.people import NOBODY, Crowd, Meeting
 from cyborg.sim.simulator import SimSettings, Simulator
 from cyborg.sim.start import START_MARGIN, StartChoice, choose_start
 
@@ -153,7 +153,8 @@ class Fleet:
             sim = self.simulators[0]
             self.crowd.advance(self.steps_per_sensor / sim.settings.physics_rate, outlines)
             self._met = [self.crowd.meeting(sim.pose.x, sim.pose.y, sim.laser.spec.range_max)
-                         for sim in self.simulators]
+                         if sim.planner is self.crowd.routes.planner else NOBODY
+                         for sim in self.simulators]  # people walk on the fleet's first map
         for index, sim in enumerate(self.simulators):
             near = self._near(index)
             points = None

@@ -152,6 +152,8 @@ class Meeting(NamedTuple):
     circles: np.ndarray
 
 
+NOBODY = Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
+"""What a robot meets where no one walks."""
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
@@ -199,7 +201,7 @@ class Crowd:
     def meeting(self, x: float, y: float, reach: float) -> Meeting:
         """What a robot at ``(x, y)`` meets of the crowd (see :class:`Meeting`)."""
         if not self.people:
-            return Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
+            return NOBODY
         circles = self.circles()
         distance = np.hypot(circles[:, 0] - x, circles[:, 1] - y)
         outlines = self.outlines()
@@ -207,6 +209,18 @@ class Crowd:
         near = tuple(outlines[index] for index in np.flatnonzero(close))
         points = (circles[close, None, :2] + self._samples[None, :, :]).reshape(-1, 2)
         return Meeting(near, points, circles[distance <= reach])
+
+    def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float) -> Meeting:
+        """Walk ``dt`` s around one robot (``outline``, K x 2) and say what it meets.
+
+        A robot whose ``planner`` is not the crowd's has switched maps: it meets nobody, and
+        nobody walks.
+        """
+        if planner is not self.routes.planner:
+            return NOBODY
+        self.advance(dt, [outline])
+        middle = outline.mean(axis=0)
+        return self.meeting(float(middle[0]), float(middle[1]), reach)
 
     # ------------------------------------------------------------------ walking
     def advance(self, dt: float, robots: Sequence[np.ndarray] = ()) -> None:

@@ -312,8 +312,8 @@ class Simulator:
         dt = 1.0 / self.settings.physics_rate
         if self._steps % self.steps_per_sensor == 0:
             if self.crowd is not None:
-                self.crowd.advance(self._period, [self.outline])
-                self.meet(*self.crowd.meeting(self.pose.x, self.pose.y, self.laser.spec.range_max))
+                self.meet(*self.crowd.beside(self.planner, self.outline, self._period,
+                                             self.laser.spec.range_max))
             self._sense()
             self._command = self._decide()
         self._steps += 1
