@@ -96,7 +96,7 @@ def test_the_people_cyborg_ups_video_camera_sees_are_not_in_the_simulated_robots
 
 def test_cyborg_up_wires_the_camera_to_the_detector_by_the_contract(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    args = build_parser().parse_args(["up"])
+    args = build_parser().parse_args(["up", "--camera", "real"])
     assert args.model == vision.MODEL
     monkeypatch.setattr(up_vision, "model_for_up", lambda name: Path(f"/models/{name}.onnx"))
     camera, found, tracker = up_vision.vision_nodes(args, robot.NAMESPACE)

@@ -57,7 +57,7 @@ def test_one_robot_is_as_before() -> None:
 
 
 def test_the_detector_serves_the_first_robot() -> None:
-    kinds = _description("--robots", "2")
+    kinds = _description("--robots", "2", "--camera", "real")
     vision = kinds["detector"] + kinds["camera"]
     assert vision and all(namespace.startswith("/robot1/") for _, namespace, _ in vision)
 

@@ -7,9 +7,11 @@ ARNL format) with its navigation services, the tree runner with the bundled miss
 ``data/campus_mission.b3.json``, behavior3editor format; docs/modes.md) on simulated
 time, the web monitor (http://127.0.0.1:8080/, ``--monitor-port``; this machine only unless
 ``--monitor-host 0.0.0.0``, see docs/security.md), with ``--foxglove`` a Foxglove server
-(ws://127.0.0.1:8765, :mod:`cyborg.app.foxglove_commands`), and a camera playing
-sample stereo frames into the object detector (:mod:`cyborg.app.up_vision`). ``--map``,
-``--tree``, ``--speed``, ``--camera`` and ``--model`` swap the inputs. ``--robots N`` simulates
+(ws://127.0.0.1:8765, :mod:`cyborg.app.foxglove_commands`), :data:`DEFAULT_PEOPLE` people
+walking on the map (``--people``) and the simulator's camera detecting them, or with
+``--camera real`` a camera playing sample stereo frames into the object detector
+(:mod:`cyborg.app.up_vision`). ``--map``, ``--tree``, ``--speed``, ``--camera`` and ``--model``
+swap the inputs. ``--robots N`` simulates
 N robots on the map (:mod:`cyborg.sim.fleet`), ``/robot1`` … ``/robotN``, each with its own
 tree runner (``/robot1/bt`` …) on the same mission; one monitor shows them all, and the camera and
 detector serve the first. Each next robot's battery starts :data:`FLEET_BATTERY_STEP` % fuller
@@ -45,7 +47,7 @@ from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_ro
 from cyborg.app.memory import keep_large_buffers
 from cyborg.app.system import run_system
 from cyborg.app.up_record import add_record_options, record_nodes
-from cyborg.app.up_vision import add_vision_options, vision_nodes
+from cyborg.app.up_vision import SIMULATED, add_vision_options, simulated_camera, vision_nodes
 from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.foxglove import component as foxglove
 from cyborg.interfaces.robot import fleet_namespaces
@@ -74,6 +76,8 @@ DEFAULT_SPEED = 30.0
 """Simulated seconds per wall-clock second: a patrol round in ~6 s, a full charge in ~4 min."""
 DEFAULT_BATTERY = 33.0
 """Start charge, percent: about 20 simulated minutes of patrol above the threshold."""
+DEFAULT_PEOPLE = 3
+"""People walking at random among the map's goals: a few, for the camera to see."""
 FLEET_BATTERY_STEP = 18.0
 """Percent each next robot of several starts fuller: two hours of patrol (9 % an hour), as long
 as a recharge takes, so the robots take turns at the map's charger instead of queueing."""
@@ -107,6 +111,9 @@ def add_parser(commands: Any) -> None:
                     help=f"how many robots to simulate (default {sim.ROBOTS}; several: "
                          f"/robot1 ... /robotN, each with its own tree runner; at most "
                          f"{MAX_ROBOTS})")
+    up.add_argument("--people", type=int, default=DEFAULT_PEOPLE, metavar="N",
+                    help=f"people walking at random among the map's goals (default "
+                         f"{DEFAULT_PEOPLE}; 0: only the map's own)")
     up.add_argument("--monitor-port", type=int, default=monitor.PORT, metavar="PORT",
                     help=f"port of the web monitor (default {monitor.PORT}; 0: any free port)")
     up.add_argument("--monitor-host", default=monitor.HOST, metavar="ADDRESS",
@@ -138,6 +145,8 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
         raise CommandError("--speed must be positive, or 0 for as fast as possible")
     if not 1 <= args.robots <= MAX_ROBOTS:
         raise CommandError(f"--robots must be from 1 to {MAX_ROBOTS}, not {args.robots}")
+    if args.people < 0:
+        raise CommandError(f"--people must be 0 or more, not {args.people}")
     if args.robots > 1 and args.namespace != sim.NAMESPACE:
         raise CommandError(f"--namespace names one robot; with --robots {args.robots} the "
                            f"robots are /robot1 ... /robot{args.robots}")
@@ -147,9 +156,10 @@ def up_description(args: argparse.Namespace) -> LaunchDescription:
     namespaces = fleet_namespaces(fleet, args.robots)
     trees = [under_robot(namespace, runner.NAMESPACE) for namespace in namespaces]
     robot: dict[str, Any] = {"map": str(map_path), "speed": args.speed, "battery": args.battery,
-                             # the camera plays a recorded video, not the simulated world:
-                             # the people it sees are not in the simulated robot's way
-                             "avoid_objects": False}
+                             "people": args.people, **simulated_camera(args),
+                             # with recorded frames the people seen are not in the simulated
+                             # world: the robot plans around what it sees only with --camera sim
+                             "avoid_objects": args.camera == SIMULATED}
     if args.start:
         robot["start"] = args.start
     if args.robots > 1:

@@ -148,10 +148,10 @@ def _free_points(planner: Planner, near: Point | None) -> np.ndarray:
 
 
 def _reachable_goals(arnl_map: ArnlMap, planner: Planner, free: np.ndarray) -> list[Point]:
-    """The map's goals a robot may stand on, in the region of ``free`` (cell centres)."""
+    """The map's goals (not docks) a robot may stand on, in the region of ``free`` (cells)."""
     goals = []
-    for item in arnl_map.goals():
-        if planner.check(Pose2D(item.x, item.y)) is not None or len(free) == 0:
+    for item in arnl_map.goals():  # not the docks: nobody stands on the robots' charger
+        if item.is_dock or planner.check(Pose2D(item.x, item.y)) is not None or len(free) == 0:
             continue
         if float(np.min(np.hypot(free[:, 0] - item.x, free[:, 1] - item.y))) <= 0.5:
             goals.append((item.x, item.y))
