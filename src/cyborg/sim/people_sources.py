@@ -15,7 +15,8 @@ standing inside a wall, or a description naming no waypoint is an error naming t
 
 **At random.** :func:`random_people` places ``count`` people (the simulator's ``people``
 parameter) at goals of the part of the map the robot can drive in, away from where the robots
-start, each with a few other goals as waypoints (on free points when the map has fewer than
+start (one person a goal; more people than goals start on free points apart from the others),
+each with a few other goals as waypoints (on free points when the map has fewer than
 two goals a robot can reach). So every leg is between two goals, planned once for everybody
 (:class:`~cyborg.sim.people.RouteBook`). The same ``seed`` gives the same people.
 """
@@ -39,6 +40,8 @@ WAYPOINT_SEPARATOR = ";"
 """What separates a ``Sim.Person``'s waypoints in its description."""
 KEEP_AWAY = 2.0
 """Metres a random person starts from every robot's start."""
+APART = 1.0
+"""Metres between the starts of two random people (but at distinct goals)."""
 WAYPOINTS = (3, 5)
 """How many waypoints a random person gets, at least and at most."""
 
@@ -118,12 +121,22 @@ def random_people(arnl_map: ArnlMap, planner: Planner, count: int, seed: int = 0
     if len(starts) == 0 and not far_goals:
         raise ValueError(f"people: {arnl_map.source} has no free point {KEEP_AWAY:g} m from "
                          "the robots for a person to start on")
-    plans = []
+    plans: list[PersonPlan] = []
+    at_goals = [far_goals[index] for index in random.permutation(len(far_goals))] \
+        if len(goals) >= 2 else []
     for number in range(count):
-        if len(goals) >= 2 and far_goals:  # at a goal: every leg is between goals, shared
-            start = far_goals[int(random.integers(len(far_goals)))]
-        else:
-            x, y = starts[random.integers(len(starts))]
+        if at_goals:  # at a goal: every leg is between goals, planned once for everybody
+            start = at_goals.pop()
+        else:  # at a free point, apart from the others
+            taken = np.array([plan.start for plan in plans]).reshape(-1, 2)
+            apart = np.ones(len(starts), bool)
+            for x, y in taken:
+                apart &= np.hypot(starts[:, 0] - x, starts[:, 1] - y) >= APART
+            if not apart.any():
+                raise ValueError(f"people: {arnl_map.source} has room for {len(plans)} "
+                                 f"people ({APART:g} m apart, {KEEP_AWAY:g} m from the "
+                                 f"robots), not {count}")
+            x, y = starts[apart][random.integers(int(apart.sum()))]
             start = (float(x), float(y))
         plans.append(PersonPlan(f"person {number + 1}", start,
                                 _random_waypoints(goals, start, random, free)))
