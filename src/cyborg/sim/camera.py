@@ -125,9 +125,10 @@ class SimCamera:
                 circles: np.ndarray | None = None) -> list[SeenObject]:
         """What the detector reports on a frame taken with the robot at ``(x, y, theta)``.
 
-        ``sights`` are the things that may be detected; ``bodies`` (outlines, K x 2) and
-        ``circles`` ((M, 3): x, y, radius) what may hide them besides the walls (the things
-        themselves may be among them: a thing does not hide itself).
+        ``sights`` are the things that may be detected, and they hide each other; ``bodies``
+        (outlines, K x 2) and ``circles`` ((M, 3): x, y, radius) what else may hide them
+        besides the walls (the things themselves may be among them: a thing does not hide
+        itself).
         """
         spec = self.spec
         if not sights.labels:
@@ -144,7 +145,10 @@ class SimCamera:
             return []
         distance, bearing = distance[chosen], bearing[chosen]
         radii = sights.radii[chosen]
-        visible = self._visible(cx, cy, theta + bearing, distance, radii, bodies, circles)
+        hiding = np.column_stack([sights.positions, sights.radii])
+        if circles is not None and len(circles):
+            hiding = np.concatenate([hiding, circles])
+        visible = self._visible(cx, cy, theta + bearing, distance, radii, bodies, hiding)
         chance = spec.detection_chance(distance) * visible
         detected = self._random.random(len(chosen)) < chance
         seen = []

@@ -94,7 +94,7 @@ class SimCameraNode:
             self._walls = laser.occupied
             self.camera.look_at(laser.occupied, laser.origin, laser.resolution)
         self.last = self.camera.observe(pose.x, pose.y, pose.theta, self.sights(sim),
-                                        sim.others, sim.people)
+                                        sim.others)
         self.frames += 1
         stamp_ns = round(sim.time * 1e9)
         header = Header(stamp=Time(sec=stamp_ns // 1_000_000_000,
