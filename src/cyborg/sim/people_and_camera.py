@@ -57,10 +57,11 @@ class Extras(NamedTuple):
 
 def declare_extras(node: Node, spec: NodeSpec) -> Extras:
     """Declares the parameters on ``node``; refuses a negative ``people`` naming the entry."""
+    given = spec.parameters.get("people", PEOPLE)
+    if isinstance(given, bool) or not isinstance(given, int) or given < 0:
+        raise spec.error(f"parameter `people` must be a whole number, 0 or more, not {given!r}")
     params = node.parameters
     people = params.declare("people", PEOPLE, "people walking at random", read_only=True)
-    if isinstance(people, bool) or not isinstance(people, int) or people < 0:
-        raise spec.error(f"parameter `people` must be a whole number, 0 or more, not {people!r}")
     seed = params.declare("people_seed", 0, "seed of the people", read_only=True)
     camera = params.declare("camera", CAMERA, "simulated camera with detections",
                             read_only=True)
