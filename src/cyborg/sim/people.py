@@ -7,12 +7,14 @@ then again from the first, and pauses of random length (:attr:`~PeopleSettings.m
 :attr:`~PeopleSettings.max_pause` s) at each. Between two waypoints they follow the route the
 navigation planner (:class:`cyborg.nav.planner.Planner`) finds on the map, which keeps the
 robot's clearance from walls and forbidden zones, so nobody ever walks into a wall; routes are
-planned once per pair of points and reused (:class:`RouteBook`).
+planned once per pair of points and reused (:mod:`cyborg.sim.people_routes`).
 
 Nobody walks into anybody: a person whose way ahead (:attr:`~PeopleSettings.look_ahead` m
 plus both bodies) is taken by a robot or another person stops and waits. Still blocked after
 :attr:`~PeopleSettings.patience` s, they turn back towards the waypoint they came from, as a
-person in a corridor does when a robot stands in it.
+person in a corridor does when a robot stands in it. Someone standing at their waypoint makes
+it reached (within :data:`ARRIVED_NEAR`). And people make room for robots: whoever is closer
+than :data:`ROOM` to a robot's body steps away from it, if walls and others let them.
 
 A person's body is a circle of :attr:`~PeopleSettings.radius` m, drawn as a regular octagon
 around it (:meth:`Crowd.outlines`): the shape the laser sees and the robot's drive cannot enter,
@@ -38,8 +40,7 @@ from numba import njit
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_points
-
-Point = tuple[float, float]
+from cyborg.sim.people_routes import Point, RouteBook
 
 
 @dataclass(frozen=True)
@@ -106,34 +107,6 @@ class Person:
         return Pose2D(self.x, self.y, self.heading)
 
 
-class RouteBook:
-    """Routes between points on the map, planned once each and kept (people repeat their legs).
-
-    A route is the planner's path from one point to another, (K, 2) metres, its first point
-    the start; None when the planner finds none (kept too: it would not find one again). The
-    way back is the way there reversed, not planned again.
-    """
-
-    def __init__(self, planner: Planner) -> None:
-        self.planner = planner
-        self._routes: dict[tuple[float, float, float, float], np.ndarray | None] = {}
-        self.planned = 0
-
-    def route(self, start: Point, goal: Point) -> np.ndarray | None:
-        """The way from ``start`` to ``goal`` (rounded to the centimetre), or None."""
-        key = (round(start[0], 2), round(start[1], 2), round(goal[0], 2), round(goal[1], 2))
-        if key not in self._routes:
-            reverse = (key[2], key[3], key[0], key[1])
-            if reverse in self._routes:  # the way back is the way there, reversed
-                back = self._routes[reverse]
-                self._routes[key] = None if back is None else back[::-1].copy()
-            else:
-                self.planned += 1
-                result = self.planner.plan(Pose2D(*start), Pose2D(*goal))
-                self._routes[key] = None if result.path is None else result.path.points.copy()
-        return self._routes[key]
-
-
 NEAR = 3.0
 """Metres from a robot within which people are bodies its drive cannot enter, and points its
 navigator keeps clear of even behind it (further off, only its laser sees them)."""
@@ -154,6 +127,9 @@ class Meeting(NamedTuple):
 
 NOBODY = Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
 """What a robot meets where no one walks."""
+ROOM = 0.3
+"""Metres people keep between their bodies and a robot's when they can: closer, they step
+away from it (the robot's body counted as the circle around its outline)."""
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
@@ -241,9 +217,48 @@ class Crowd:
             if (ahead[0], ahead[1]) != (person.x, person.y):
                 person.heading = math.atan2(ahead[1] - person.y, ahead[0] - person.x)
             walking.append(person)
+        circles = np.empty((len(robots), 3))
+        for index, outline in enumerate(robots):
+            middle = outline.mean(axis=0)
+            circles[index] = middle[0], middle[1], np.max(np.hypot(*(outline - middle).T))
         if walking:
-            for person, blocked in zip(walking, self._blocked(walking, robots), strict=True):
+            for person, blocked in zip(walking, self._blocked(walking, circles), strict=True):
                 self._walk(person, dt, bool(blocked))
+        if len(circles):
+            self._make_room(dt, circles)
+
+    def _make_room(self, dt: float, robots: np.ndarray) -> None:
+        """Everyone closer to a robot than :data:`ROOM` steps away from it, where they can.
+
+        As far as walls, other people and the way on allow: a robot stuck beside a person
+        would be stuck for good.
+        """
+        s = self.settings
+        for person in self.people:
+            for cx, cy, radius in robots:
+                dx, dy = person.x - cx, person.y - cy
+                distance = math.hypot(dx, dy)
+                need = radius + s.radius + ROOM
+                if distance >= need:
+                    continue
+                if distance < 1e-9:
+                    dx, dy, distance = -math.cos(person.heading), -math.sin(person.heading), 1.0
+                step = min(need - distance, person.speed * dt)
+                to = (person.x + dx / distance * step, person.y + dy / distance * step)
+                if self._free(person, to):
+                    person.trail.append((person.x, person.y))  # the way back passes here
+                    person.x, person.y = to
+
+    def _free(self, person: Person, to: Point) -> bool:
+        """Whether ``person`` may stand at ``to``: clear of walls and bodies, the way on clear."""
+        s = self.settings
+        grid = self.routes.planner.grid
+        if grid.clearance_at(self._clearance, *to) < s.radius + 0.05:
+            return False
+        if any(other is not person and math.hypot(other.x - to[0], other.y - to[1]) < 2 * s.radius
+               for other in self.people):
+            return False
+        return len(person.route) == 0 or self._clear(to, person.route[0])
 
     def _walk(self, person: Person, dt: float, blocked: bool) -> None:
         if blocked:
@@ -272,22 +287,19 @@ class Crowd:
         if len(person.route) == 0:
             self._arrive(person)
 
-    def _blocked(self, walking: list[Person], robots: Sequence[np.ndarray]) -> np.ndarray:
+    def _blocked(self, walking: list[Person], robots: np.ndarray) -> np.ndarray:
         """For each of ``walking``: whether a robot or another person stands in the way ahead.
 
-        In the way means ahead of them (along their heading) by at most both bodies and
-        :attr:`~PeopleSettings.look_ahead`, and less than both bodies (and 10 cm) aside.
+        ``robots`` are (M, 3): x, y, radius. In the way means ahead of them (along their
+        heading) by at most both bodies and :attr:`~PeopleSettings.look_ahead`, and less than
+        both bodies (and 10 cm) aside.
         """
         s = self.settings
-        count = len(self.people) + len(robots)
-        others = np.empty((count, 3))
+        others = np.empty((len(self.people), 3))
         for index, person in enumerate(self.people):
             others[index] = person.x, person.y, s.radius
-        for index, outline in enumerate(robots, start=len(self.people)):
-            middle = outline.mean(axis=0)
-            others[index] = middle[0], middle[1], np.max(np.hypot(*(outline - middle).T))
         here = np.array([(p.x, p.y, p.heading) for p in walking])
-        return _in_the_way(here, others, s.radius, s.look_ahead)
+        return _in_the_way(here, np.concatenate([others, robots]), s.radius, s.look_ahead)
 
     def _arrive(self, person: Person) -> None:
         """Pause at the waypoint (or as near it as they got), then go on to the next."""
@@ -300,9 +312,10 @@ class Crowd:
     def _leave(self, person: Person) -> bool:
         """Set off for waypoint ``then``, or the next one that can be reached; whether any.
 
-        The leg is the route between the two points (planned once, :class:`RouteBook`),
-        joined from where the person stands: straight to its second corner when nothing is in
-        the way, else back along what is left of the way they came.
+        The leg is the route between the two points (planned once,
+        :class:`~cyborg.sim.people_routes.RouteBook`), joined from where the person stands:
+        straight to its second corner when nothing is in the way, else back along what is left
+        of the way they came.
         """
         count = len(person.waypoints)
         here = (person.x, person.y)
@@ -332,12 +345,16 @@ class Crowd:
         return bool(np.all(self._clearance[rows, columns] >= self.settings.radius + 0.05))
 
     def _turn_back(self, person: Person) -> None:
-        """Blocked for too long: walk back the way they came, to try again after a pause."""
+        """Blocked for too long: walk back the way they came, to try again after a pause.
+
+        Blocked where they set off, they have no way back: they go on to the next waypoint.
+        """
         back = [(person.x, person.y), *reversed(person.trail)]
         person.route = np.array(back[1:], dtype=np.float64).reshape(-1, 2)
         person.trail = [back[0]]
         person.leg_from, person.goal = back[0], back[-1]
-        person.then = (person.then - 1) % len(person.waypoints)  # the waypoint not reached
+        if math.dist(back[0], back[-1]) > 0.01:  # back, then the waypoint not reached again
+            person.then = (person.then - 1) % len(person.waypoints)
         person.gait, person.waited = Gait.WALKING, 0.0
 
 

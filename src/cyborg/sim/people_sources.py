@@ -18,7 +18,7 @@ parameter) at goals of the part of the map the robot can drive in, away from whe
 start (one person a goal; more people than goals start on free points apart from the others),
 each with a few other goals as waypoints (on free points when the map has fewer than
 two goals a robot can reach). So every leg is between two goals, planned once for everybody
-(:class:`~cyborg.sim.people.RouteBook`). The same ``seed`` gives the same people.
+(:class:`~cyborg.sim.people_routes.RouteBook`). The same ``seed`` gives the same people.
 """
 
 from __future__ import annotations
@@ -32,7 +32,8 @@ from cyborg.nav.arnl_map import ArnlMap, MapError
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.map_objects import MapObject
 from cyborg.nav.planner import Planner
-from cyborg.sim.people import PeopleSettings, PersonPlan, Point
+from cyborg.sim.people import PeopleSettings, PersonPlan
+from cyborg.sim.people_routes import Point
 
 PERSON_KIND = "Sim.Person"
 """The map object kind of a simulated person."""
