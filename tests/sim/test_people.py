@@ -17,8 +17,9 @@ from cyborg.nav.arnl_map import ArnlMap, MapError, parse_map, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_at
-from cyborg.sim.people import Crowd, Gait, PeopleSettings, PersonPlan
+from cyborg.sim.people import Crowd
 from cyborg.sim.people_sources import people_on_map, random_people
+from cyborg.sim.person import Gait, PeopleSettings, PersonPlan
 from cyborg.sim.simulator import Simulator
 from tests.small_maps import room_map
 
@@ -159,10 +160,23 @@ def test_the_laser_sees_a_person_in_front_of_the_robot() -> None:
     sim = Simulator(arnl_map, Pose2D(1.5, 3.0, 0.0))
     ahead = sim.laser.spec.beams // 2
     empty = float(sim.ranges[ahead])
-    sim.crowd = Crowd(sim.planner, [PersonPlan("still", (3.5, 3.0), ((3.5, 3.0),))],
+    sim.crowd = Crowd(sim.planner, [PersonPlan("still", (4.3, 3.0), ((4.3, 3.0),))],
                       settings=PeopleSettings(radius=0.3))
     sim.run(0.5)
-    expected = 3.5 - 0.3 - (1.5 + sim.laser.spec.mount_x)
+    expected = 4.3 - 0.3 - (1.5 + sim.laser.spec.mount_x)
     assert empty > 3.0, "the wall is further"
     assert float(sim.ranges[ahead]) == pytest.approx(expected, abs=0.03)
     assert sim.others, "near: a body the drive cannot enter"
+
+
+def test_a_person_steps_out_of_the_way_of_a_robot_coming_at_them() -> None:
+    _map, planner = room()
+    crowd = Crowd(planner, [PersonPlan("cy", (2.0, 4.2), ((2.0, 4.2),))], seed=1)
+    person = crowd.people[0]
+    pose = Pose2D(2.0, 3.2, math.pi / 2)
+    robot = outline_at(Simulator(parse_map(room_map(GOALS), "room.map"),
+                                 pose).base.footprint.polygon(), pose)
+    for _ in range(20):
+        crowd.advance(0.1, [robot], [pose.theta])
+    assert abs(person.x - 2.0) >= 0.4 + crowd.settings.radius, "aside, out of its way"
+    assert planner.grid.clearance_at(planner.wall_clearance, person.x, person.y) >= 0.25

@@ -30,82 +30,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from enum import Enum
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_points
 from cyborg.sim.people_routes import Point, RouteBook
-
-
-@dataclass(frozen=True)
-class PeopleSettings:
-    """How people walk: body (m), speeds (m/s), pauses and patience (s), look-ahead (m)."""
-
-    radius: float = 0.25  # metres: a person's body, seen from above
-    height: float = 1.7  # metres: what the camera's box spans
-    min_speed: float = 0.5
-    max_speed: float = 1.5
-    min_pause: float = 2.0
-    max_pause: float = 8.0
-    look_ahead: float = 0.6  # metres of free way a walking person wants beyond the bodies
-    patience: float = 3.0  # seconds blocked before turning back
-
-
-@dataclass(frozen=True)
-class PersonPlan:
-    """Who walks where: a name, a start point and waypoints (m); ``line`` of the map, if any."""
-
-    name: str
-    start: Point
-    waypoints: tuple[Point, ...]
-    line: int = 0
-
-
-class Gait(Enum):
-    """What a person is doing now."""
-
-    WALKING = "walking"
-    PAUSING = "pausing"  # at a waypoint, for a while
-    WAITING = "waiting"  # blocked on the way
-    STANDING = "standing"  # no waypoint can be reached: stays where they are
-
-
-@dataclass
-class Person:
-    """One person: where they are and head (m, rad), how fast they walk, where they go next.
-
-    ``leg_from`` is the point they last left (a waypoint, their start, or where they turned
-    back), ``goal`` the point they walk to now, ``then`` the index of the waypoint they set off
-    for after the next pause; ``route`` the rest of the way to ``goal`` ((K, 2), m), ``trail``
-    the corners they passed on it (the way back).
-    """
-
-    name: str
-    x: float
-    y: float
-    speed: float
-    waypoints: tuple[Point, ...]
-    heading: float = 0.0
-    gait: Gait = Gait.WALKING
-    leg_from: Point = (0.0, 0.0)
-    goal: Point = (0.0, 0.0)
-    then: int = 0
-    route: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    trail: list[Point] = field(default_factory=list)
-    until: float = 0.0  # when a pause ends, simulated seconds
-    waited: float = 0.0  # seconds blocked so far
-
-    @property
-    def pose(self) -> Pose2D:
-        """Where the person stands, facing where they walk."""
-        return Pose2D(self.x, self.y, self.heading)
-
+from cyborg.sim.person import Gait, PeopleSettings, Person, PersonPlan
 
 NEAR = 3.0
 """Metres from a robot within which people are bodies its drive cannot enter, and points its
@@ -130,6 +63,10 @@ NOBODY = Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
 ROOM = 0.3
 """Metres people keep between their bodies and a robot's when they can: closer, they step
 away from it (the robot's body counted as the circle around its outline)."""
+SIDESTEPS = (0.0, math.pi / 4, -math.pi / 4, math.pi / 2, -math.pi / 2)
+"""Turns (rad) from straight away from a robot that a person making room for it tries."""
+AHEAD = 2.5
+"""Metres ahead of a robot within which people step out of its way."""
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
@@ -187,20 +124,28 @@ class Crowd:
         return Meeting(near, points, circles[distance <= reach])
 
     def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float) -> Meeting:
-        """Walk ``dt`` s around one robot (``outline``, K x 2) and say what it meets.
+        """Walk ``dt`` s around one robot and say what it meets.
+
+        ``outline`` is K x 2, its first and last corners the front edge's, as
+        :meth:`~cyborg.nav.footprint.Footprint.polygon` gives them.
 
         A robot whose ``planner`` is not the crowd's has switched maps: it meets nobody, and
         nobody walks.
         """
         if planner is not self.routes.planner:
             return NOBODY
-        self.advance(dt, [outline])
         middle = outline.mean(axis=0)
+        front = (outline[0] + outline[-1]) / 2 - middle  # the middle of the front edge
+        self.advance(dt, [outline], [math.atan2(front[1], front[0])])
         return self.meeting(float(middle[0]), float(middle[1]), reach)
 
     # ------------------------------------------------------------------ walking
-    def advance(self, dt: float, robots: Sequence[np.ndarray] = ()) -> None:
-        """Walk everyone ``dt`` seconds, keeping clear of ``robots`` (outlines, K x 2 each)."""
+    def advance(self, dt: float, robots: Sequence[np.ndarray] = (),
+                headings: Sequence[float] = ()) -> None:
+        """Walk everyone ``dt`` seconds, keeping clear of ``robots`` (outlines, K x 2 each).
+
+        With the robots' ``headings`` (rad), people out of their way ahead too.
+        """
         self.time += dt
         walking = []
         for person in self.people:
@@ -225,40 +170,63 @@ class Crowd:
             for person, blocked in zip(walking, self._blocked(walking, circles), strict=True):
                 self._walk(person, dt, bool(blocked))
         if len(circles):
-            self._make_room(dt, circles)
+            self._make_room(dt, circles, headings)
 
-    def _make_room(self, dt: float, robots: np.ndarray) -> None:
-        """Everyone closer to a robot than :data:`ROOM` steps away from it, where they can.
+    def _make_room(self, dt: float, robots: np.ndarray, headings: Sequence[float]) -> None:
+        """People step out of robots' way, where walls and other people let them.
 
-        As far as walls, other people and the way on allow: a robot stuck beside a person
+        Whoever is closer than :data:`ROOM` to a robot's body steps away from it; whoever is
+        ahead of it (within :data:`AHEAD` along its heading, and its body and ours and
+        :data:`ROOM` aside) steps aside, else further ahead. A robot stuck beside a person
         would be stuck for good.
         """
         s = self.settings
         for person in self.people:
-            for cx, cy, radius in robots:
+            for index, (cx, cy, radius) in enumerate(robots):
                 dx, dy = person.x - cx, person.y - cy
                 distance = math.hypot(dx, dy)
                 need = radius + s.radius + ROOM
+                turns: tuple[float, ...] = SIDESTEPS
+                if index < len(headings):
+                    ux, uy = math.cos(headings[index]), math.sin(headings[index])
+                    along, across = dx * ux + dy * uy, uy * dx - ux * dy
+                    if 0.0 < along <= AHEAD and abs(across) < need:
+                        side = headings[index] + (-math.pi / 2 if across >= 0 else math.pi / 2)
+                        self._step_away(person, side, person.speed * dt, (0.0, math.pi / 4,
+                                                                          math.pi / 2))
+                        continue
                 if distance >= need:
                     continue
                 if distance < 1e-9:
                     dx, dy, distance = -math.cos(person.heading), -math.sin(person.heading), 1.0
-                step = min(need - distance, person.speed * dt)
-                to = (person.x + dx / distance * step, person.y + dy / distance * step)
+                self._step_away(person, math.atan2(dy, dx), min(need - distance,
+                                                                person.speed * dt), turns)
+
+    def _step_away(self, person: Person, away: float, step: float,
+                   turns: tuple[float, ...]) -> None:
+        """Step ``step`` m towards ``away`` (rad), or the first of ``turns`` from it that is free.
+
+        Each turn is tried to the left and then to the right.
+        """
+        for turn in turns:
+            for sign in ((1.0, -1.0) if turn else (1.0,)):
+                to = (person.x + step * math.cos(away + sign * turn),
+                      person.y + step * math.sin(away + sign * turn))
                 if self._free(person, to):
-                    person.trail.append((person.x, person.y))  # the way back passes here
+                    here = (person.x, person.y)
+                    person.trail.append(here)  # the way back passes here
+                    if len(person.route) and not self._clear(to, person.route[0]):
+                        person.route = np.vstack([here, person.route])  # and the way on
                     person.x, person.y = to
+                    return
 
     def _free(self, person: Person, to: Point) -> bool:
-        """Whether ``person`` may stand at ``to``: clear of walls and bodies, the way on clear."""
+        """Whether ``person`` may step to ``to``: clear of walls and other people."""
         s = self.settings
-        grid = self.routes.planner.grid
-        if grid.clearance_at(self._clearance, *to) < s.radius + 0.05:
+        if not self._clear((person.x, person.y), np.array(to)):
             return False
-        if any(other is not person and math.hypot(other.x - to[0], other.y - to[1]) < 2 * s.radius
-               for other in self.people):
-            return False
-        return len(person.route) == 0 or self._clear(to, person.route[0])
+        return not any(other is not person and math.hypot(other.x - to[0], other.y - to[1])
+                       < 2 * s.radius for other in self.people)
 
     def _walk(self, person: Person, dt: float, blocked: bool) -> None:
         if blocked:
@@ -329,6 +297,7 @@ class Crowd:
                 rest = np.vstack([person.route, route[:1], rest]) if len(person.route) else \
                     np.vstack([route[:1], rest])
             person.then, person.goal = (person.then + tried + 1) % count, goal
+            person.returning = False
             person.route, person.gait, person.waited = rest, Gait.WALKING, 0.0
             person.trail = [here]
             return True
@@ -347,14 +316,23 @@ class Crowd:
     def _turn_back(self, person: Person) -> None:
         """Blocked for too long: walk back the way they came, to try again after a pause.
 
+        The way they gave up becomes the way back should they turn again, so a person going to
+        and fro on a leg always ends at one of its two ends (where routes are planned already).
         Blocked where they set off, they have no way back: they go on to the next waypoint.
         """
-        back = [(person.x, person.y), *reversed(person.trail)]
+        here = (person.x, person.y)
+        back = [here, *reversed(person.trail)]
+        given_up = [(float(x), float(y)) for x, y in person.route]
         person.route = np.array(back[1:], dtype=np.float64).reshape(-1, 2)
-        person.trail = [back[0]]
-        person.leg_from, person.goal = back[0], back[-1]
-        if math.dist(back[0], back[-1]) > 0.01:  # back, then the waypoint not reached again
-            person.then = (person.then - 1) % len(person.waypoints)
+        person.trail = [*reversed(given_up), here]
+        near = math.dist(back[-1], person.leg_from) <= ARRIVED_NEAR
+        person.leg_from, person.goal = person.goal, person.leg_from if near else back[-1]
+        count = len(person.waypoints)
+        if math.dist(back[0], back[-1]) <= 0.01:  # nowhere to go back to
+            person.returning = False
+        else:
+            person.returning = not person.returning
+            person.then = (person.then + (-1 if person.returning else 1)) % count
         person.gait, person.waited = Gait.WALKING, 0.0
 
 

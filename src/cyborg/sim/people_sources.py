@@ -32,8 +32,8 @@ from cyborg.nav.arnl_map import ArnlMap, MapError
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.map_objects import MapObject
 from cyborg.nav.planner import Planner
-from cyborg.sim.people import PeopleSettings, PersonPlan
 from cyborg.sim.people_routes import Point
+from cyborg.sim.person import PeopleSettings, PersonPlan
 
 PERSON_KIND = "Sim.Person"
 """The map object kind of a simulated person."""
