@@ -151,11 +151,13 @@ class SimCamera:
         visible = self._visible(cx, cy, theta + bearing, distance, radii, bodies, hiding)
         chance = spec.detection_chance(distance) * visible
         detected = self._random.random(len(chosen)) < chance
+        found = np.flatnonzero(detected)
+        noise = self._random.standard_normal((len(found), 4))  # distance, bearing, size, score
         seen = []
-        for index in np.flatnonzero(detected):
+        for row, index in enumerate(found):
             seen.append(self._report(sights.labels[chosen[index]], float(distance[index]),
                                      float(bearing[index]), float(radii[index]),
-                                     float(sights.heights[chosen[index]])))
+                                     float(sights.heights[chosen[index]]), noise[row]))
         return [item for item in seen if item is not None]
 
     def _visible(self, cx: float, cy: float, angles: np.ndarray, distance: np.ndarray,
@@ -178,14 +180,18 @@ class SimCamera:
         return share
 
     def _report(self, label: str, distance: float, bearing: float, radius: float,
-                height: float) -> SeenObject | None:
-        """The noisy detection of a thing at ``distance`` and ``bearing``; None off the image."""
-        spec, random = self.spec, self._random
+                height: float, noise: np.ndarray) -> SeenObject | None:
+        """The detection of a thing at ``distance`` and ``bearing``; None off the image.
+
+        ``noise`` holds four standard normal draws: distance, bearing, size and confidence.
+        """
+        spec = self.spec
         depth = distance * math.cos(bearing)  # along the optical axis
-        sigma = float(spec.distance_sigma(np.array(depth)))
-        measured = max(spec.range_min, depth + random.normal(0.0, sigma))
-        seen_bearing = bearing + random.normal(0.0, spec.bearing_noise)
-        scale = 1.0 + random.normal(0.0, spec.size_noise)
+        linear, square = spec.distance_noise
+        measured = max(spec.range_min,
+                       depth + float(noise[0]) * (linear * depth + square * depth * depth))
+        seen_bearing = bearing + float(noise[1]) * spec.bearing_noise
+        scale = 1.0 + float(noise[2]) * spec.size_noise
         focal, middle_x, middle_y = spec.focal, spec.width / 2, spec.height / 2
         column = middle_x - focal * math.tan(seen_bearing)
         half_width = focal * radius * scale / depth
@@ -196,6 +202,5 @@ class SimCamera:
         if x2 - x1 < 1.0 or y2 - y1 < 1.0:
             return None
         closeness = 1.0 - min(distance / spec.range_max, 1.0)
-        confidence = float(np.clip(0.55 + 0.4 * closeness + random.normal(0.0, 0.05),
-                                   0.5, 0.99))
+        confidence = min(max(0.55 + 0.4 * closeness + 0.05 * float(noise[3]), 0.5), 0.99)
         return SeenObject(label, confidence, (x1, y1, x2, y2), measured)

@@ -151,8 +151,9 @@ class Fleet:
         outlines = [sim.outline for sim in self.simulators]  # set_pose may have moved one
         if sensing and self.crowd is not None:
             sim = self.simulators[0]
-            self.crowd.advance(self.steps_per_sensor / sim.settings.physics_rate, outlines,
-                               [sim.pose.theta for sim in self.simulators])
+            walked = self.crowd.due(self.steps_per_sensor / sim.settings.physics_rate)
+            if walked:
+                self.crowd.advance(walked, outlines, [sim.pose.theta for sim in self.simulators])
             self._met = [self.crowd.meeting(sim.pose.x, sim.pose.y, sim.laser.spec.range_max)
                          if sim.planner is self.crowd.routes.planner else NOBODY
                          for sim in self.simulators]  # people walk on the fleet's first map

@@ -1,0 +1,112 @@
+"""Simulation speed with people walking and the simulated camera on (columbia.map in ../shared).
+
+    python3 benchmarks/sim_people.py [--quick] [--markdown] [--map PATH] [--people N]
+
+The robot patrols the map's goals, as in benchmarks/sim_nav.py (laser 541 beams, physics 50 Hz,
+laser and navigation 10 Hz), with 10 people walking at random among the goals (0.5 to 1.5 m/s,
+pausing, keeping out of the robot's way; the laser sees them) and the simulated camera taking
+a frame every 0.1 simulated seconds of the people in view (occlusion rays, noise, misses,
+boxes), as its bus node does. Result in simulated seconds per wall second. Baseline in the same
+run: the same patrol with nobody walking and no camera. Goal: >= 200x real time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import time
+from pathlib import Path
+
+from cyborg.nav.arnl_map import ArnlMap, read_map
+from cyborg.sim.camera import SimCamera
+from cyborg.sim.people import Crowd
+from cyborg.sim.people_sources import random_people
+from cyborg.sim.sights import crowd_sights
+from cyborg.sim.simulator import Simulator
+
+SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
+
+
+class Result:
+    """What one patrol measured: its speed, goals reached, camera frames and detections."""
+
+    def __init__(self, speed: float, reached: int, frames: int, detections: int,
+                 routes: int) -> None:
+        self.speed, self.reached, self.frames = speed, reached, frames
+        self.detections, self.routes = detections, routes
+
+
+def patrol(arnl_map: ArnlMap, minutes: float, people: int) -> Result:
+    """The robot patrols for ``minutes`` with ``people`` walking and the camera on (if any)."""
+    sim = Simulator(arnl_map)
+    camera = None
+    if people:
+        pose = sim.pose
+        sim.crowd = Crowd(sim.planner, random_people(arnl_map, sim.planner, people, seed=1,
+                                                     keep_away=[(pose.x, pose.y)]), seed=1)
+        laser = sim.laser
+        camera = SimCamera(laser.occupied, laser.origin, laser.resolution, seed=1)
+    counts = {"frames": 0, "detections": 0}
+    due = [0.0]
+
+    def step() -> None:
+        sim.step()
+        if camera is not None and sim.time >= due[0]:
+            due[0] += 1.0 / camera.spec.rate
+            pose = sim.pose
+            seen = camera.observe(pose.x, pose.y, pose.theta, crowd_sights(sim.crowd),
+                                  sim.others)
+            counts["frames"] += 1
+            counts["detections"] += len(seen)
+
+    names = [item.name for item in arnl_map.goals()]
+    reached = 0
+    for _ in range(50):
+        step()  # compiled kernels loaded, caches warm
+    started, begin = time.perf_counter(), sim.time
+    end = begin + minutes * 60
+    for name in itertools.cycle(names):
+        if sim.time >= end:
+            break
+        if sim.go_to(name).found:
+            while not sim.navigator.state.finished and sim.time < end:
+                step()
+            reached += sim.navigator.state.value == "REACHED_GOAL"
+    speed = (sim.time - begin) / (time.perf_counter() - started)
+    routes = sim.crowd.routes.planned if sim.crowd is not None else 0
+    return Result(speed, reached, counts["frames"], counts["detections"], routes)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="2 simulated minutes, not 10")
+    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    parser.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
+    parser.add_argument("--people", type=int, default=10, help="people walking (default 10)")
+    args = parser.parse_args()
+    arnl_map = read_map(args.map)
+    minutes = 2.0 if args.quick else 10.0
+    ours = patrol(arnl_map, minutes, args.people)
+    base = patrol(arnl_map, minutes, 0)
+    rows = [
+        (f"simulation, {args.people} people, laser and camera (x real time)",
+         f"{ours.speed:.0f}x", f"{ours.speed / base.speed:.2f}x baseline",
+         f"{ours.reached} goals in {minutes:g} min; {ours.frames} frames, "
+         f"{ours.detections} detections; {ours.routes} routes planned"),
+        ("simulation, nobody, laser only (baseline)", f"{base.speed:.0f}x", "1.00x baseline",
+         f"{base.reached} goals in {minutes:g} min"),
+    ]
+    if args.markdown:
+        print("| measurement | value | ratio | note |\n| --- | --: | --: | --- |")
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+    else:
+        for name, value, ratio, note in rows:
+            print(f"{name:52} {value:>7} {ratio:>16}  {note}")
+    print(f"\nsimulation with {args.people} people and the camera {ours.speed:.0f}x real time "
+          f"(goal >= 200x: {'met' if ours.speed >= 200 else 'NOT met'})")
+
+
+if __name__ == "__main__":
+    main()
