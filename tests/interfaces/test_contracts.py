@@ -16,7 +16,7 @@ from cyborg.bus import BusConfig, Context, MessageTypes, Node, Qos
 from cyborg.bus.component import NodeSpec
 from cyborg.bus.graph import Graph, GraphEntity
 from cyborg.bus.wire import Durability, EntityKind
-from cyborg.interfaces import detector, modes, perception, player, robot, tree_runner
+from cyborg.interfaces import detector, modes, perception, player, robot, simulation, tree_runner
 from cyborg.interfaces.contract import Action, Service, Topic, resolve
 from cyborg.interfaces.help import HELP
 from cyborg.monitor.monitor import Monitor
@@ -30,14 +30,17 @@ from cyborg.record.playback_source import open_recording
 from cyborg.record.player import Player
 from cyborg.robot.bus_robot import BusRobot
 from cyborg.runner.tree_runner import TreeRunnerNode
+from cyborg.sim import component as sim_component
 from cyborg.sim.loop import SimulationLoop
 from cyborg.sim.node import SimulatorNode
 from cyborg.sim.object_feed import ObjectFeed
+from cyborg.sim.people_and_camera import CAMERA_NAME
 from cyborg.sim.simulator import Simulator
 from cyborg.vision import CameraNode, CameraTopics, DetectionPipeline, Detector, DetectorNode
 from cyborg.vision.samples import SampleSource
 from tests.conftest import shared_dir
 from tests.running_system import write_tree
+from tests.small_maps import room_map
 
 SERVING = (EntityKind.PUBLISHER, EntityKind.SERVICE_SERVER)
 USING = (EntityKind.SUBSCRIPTION, EntityKind.SERVICE_CLIENT)
@@ -240,6 +243,25 @@ def test_the_camera_serves_everything_the_detector_uses(bus: Context) -> None:
         camera.stop()
 
 
+def test_the_simulated_camera_serves_the_detectors_topics_and_the_simulator_its_people(
+        bus: Context, tmp_path: Path) -> None:
+    """Under the robot's detector namespace, exactly where the detector would; people too."""
+    path = tmp_path / "room.map"
+    path.write_text(room_map(['RobotHome 1000 1500 0 "" ICON "home"',
+                              'Goal 4000 1500 0 "" ICON "spot"']))
+    running = sim_component.start(bus, NodeSpec("simulator", "arnl", robot.NAMESPACE, {
+        "map": str(path), "camera": True, "people": 1}))
+    graph = bus.graph
+    camera = f"{detector.DETECTOR_NAMESPACE}/{CAMERA_NAME}"
+    try:
+        settle(graph, lambda: len(endpoints(graph, camera, SERVING)) >= 3)
+        assert detector.detector_of_robot(robot.NAMESPACE) == detector.DETECTOR_NAMESPACE
+        assert_serves(graph, camera, detector.DETECTOR_NAMESPACE, detector.DETECTOR_TOPICS)
+        assert_serves(graph, f"{robot.NAMESPACE}/arnl", robot.NAMESPACE, simulation.TOPICS)
+    finally:
+        running.stop()
+
+
 # ---------------------------------------------------------------------- the descriptors
 def test_the_player_serves_its_state_and_services_under_its_namespace_to_the_monitor(
         bus: Context, tmp_path: Path) -> None:
@@ -326,7 +348,7 @@ def test_every_type_in_the_contracts_is_known() -> None:
     types = MessageTypes()
     for topic in (*robot.TOPICS, *robot.COMMANDS, *tree_runner.TOPICS,
                   *detector.CAMERA_STREAMS.values(), *detector.DETECTOR_TOPICS, *player.TOPICS,
-                  *modes.TOPICS):
+                  *modes.TOPICS, *simulation.TOPICS):
         assert types.message_class(topic.type_name) is topic.message_type, topic
     for service in (*robot.SERVICES, *tree_runner.SERVICES, *player.SERVICES,
                     *modes.SERVICES):

@@ -22,5 +22,7 @@ from cyborg.interfaces.contract import Topic
 
 PEOPLE = Topic("sim/people", PoseArray, latched=True)
 """The simulated people's true poses (see the module doc)."""
+TOPICS: tuple[Topic, ...] = (PEOPLE,)
+"""Every topic of the contract."""
 PERSON_LABEL = "person"
 """The class a person is detected as: COCO's, as the real detector names it."""
