@@ -322,8 +322,8 @@ def _free_port() -> int:
 def test_cyborg_up_detects_the_motorcycle_in_the_sample_stereo_frames() -> None:
     port = _free_port()
     process = subprocess.Popen(
-        [sys.executable, "-m", "cyborg", "up", "--no-monitor", "--duration", "15",
-         "--listen", f"tcp/127.0.0.1:{port}"],
+        [sys.executable, "-m", "cyborg", "up", "--no-monitor", "--camera", "real",
+         "--duration", "15", "--listen", f"tcp/127.0.0.1:{port}"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         env=dict(os.environ, PYTHONUNBUFFERED="1"))
     assert process.stdout is not None
