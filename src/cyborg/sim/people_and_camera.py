@@ -21,13 +21,14 @@ poses under the first robot's namespace.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from typing import NamedTuple
 
 from cyborg.bus import Context, Node
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces.detector import detector_of_robot
-from cyborg.nav.arnl_map import ArnlMap
+from cyborg.nav.arnl_map import ArnlMap, MapError
 from cyborg.nav.planner import Planner
 from cyborg.sim.camera import SimCamera
 from cyborg.sim.camera_node import SimCameraNode
@@ -37,6 +38,8 @@ from cyborg.sim.people_node import PeoplePublisher
 from cyborg.sim.people_sources import people_on_map, random_people
 from cyborg.sim.sights import Sights, crowd_sights, placed_objects
 from cyborg.sim.simulator import Simulator
+
+log = logging.getLogger("cyborg.sim")
 
 PEOPLE = 0
 """How many people walk at random unless told otherwise (the map's own walk anyway)."""
@@ -96,8 +99,13 @@ def start_cameras(context: Context, robots: Sequence[tuple[Node, RobotLoop]],
 
     def sights(sim: Simulator) -> Sights:
         known = placed.get(id(sim.map))
-        if known is None or known[0] is not sim.map:
-            known = placed[id(sim.map)] = (sim.map, placed_objects(sim.map))
+        if known is None or known[0] is not sim.map:  # a map loaded while running
+            try:
+                objects = placed_objects(sim.map)
+            except MapError as exc:  # the simulation goes on; the camera sees no objects
+                log.warning("%s: the camera sees no objects: %s", sim.map.source, exc)
+                objects = Sights.none()
+            known = placed[id(sim.map)] = (sim.map, objects)
         on_map = crowd is not None and crowd.routes.planner is sim.planner
         return crowd_sights(crowd if on_map else None).joined(known[1])
 
