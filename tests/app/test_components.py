@@ -88,10 +88,18 @@ def test_cyborg_up_takes_its_defaults_from_the_components() -> None:
     assert moved["tree_runner"].parameters["robot_namespace"] == "/robot1"
 
 
-def test_the_people_cyborg_ups_video_camera_sees_are_not_in_the_simulated_robots_way() -> None:
-    specs = {spec.kind: spec for spec in up_description(build_parser().parse_args(
-        ["up", "--no-detector"])).nodes}
-    assert specs["simulator"].parameters["avoid_objects"] is False
+def test_only_the_simulated_cameras_people_are_in_the_simulated_robots_way() -> None:
+    def specs(*flags: str) -> dict[str, NodeSpec]:
+        return {spec.kind: spec for spec in up_description(build_parser().parse_args(
+            ["up", *flags])).nodes}
+    simulated = specs()
+    assert simulated["simulator"].parameters["avoid_objects"] is True
+    assert simulated["simulator"].parameters["camera"] is True
+    assert simulated["tracker"].parameters["use_sim_time"] is True  # it stamps as the sim does
+    assert "detector" not in simulated and "camera" not in simulated
+    # a recorded video's people are not in the simulated world
+    assert specs("--camera", "real", "--no-detector")["simulator"].parameters[
+        "avoid_objects"] is False
 
 
 def test_cyborg_up_wires_the_camera_to_the_detector_by_the_contract(
