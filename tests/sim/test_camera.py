@@ -102,6 +102,19 @@ def test_distance_noise_is_small_near_and_grows_with_range() -> None:
     assert len(errors[2.0]) > 0.9 * 400
 
 
+def test_a_reported_distance_stays_within_the_cameras_depth_range() -> None:
+    spec = CameraSpec()
+    sights = Sights(("person",), np.array([[spec.range_max - 0.05 + spec.mount_x, 0.0]]),
+                    np.array([0.25]), np.array([1.7]))
+    long = MapGrid.from_map(parse_map(room_map([], lines=[(0, -3000, 30000, -3000)])
+                                      .replace("10000 0 10000 6000\n", ""), "long.map"), 0.1)
+    cam = SimCamera(np.zeros_like(long.walls), (long.origin_x, long.origin_y), long.resolution,
+                    spec, seed=5)
+    found = [f[0].distance for f in frames(cam, (0.0, 0.0, 0.0), sights, 400) if f]
+    assert found and max(found) <= spec.range_max, "noise never reports beyond the range"
+    assert min(found) < spec.range_max - 0.2, "the noise is still there"
+
+
 def test_the_same_seed_sees_the_same() -> None:
     sights = people((4.0, 1.5), (3.5, 2.0))
     first = frames(camera(seed=7), (1.0, 1.5, 0.0), sights, 20)

@@ -188,8 +188,9 @@ class SimCamera:
         spec = self.spec
         depth = distance * math.cos(bearing)  # along the optical axis
         linear, square = spec.distance_noise
-        measured = max(spec.range_min,
-                       depth + float(noise[0]) * (linear * depth + square * depth * depth))
+        measured = min(max(spec.range_min,  # the depth a ZED reports stays within its range
+                           depth + float(noise[0]) * (linear * depth + square * depth * depth)),
+                       spec.range_max)
         seen_bearing = bearing + float(noise[1]) * spec.bearing_noise
         scale = 1.0 + float(noise[2]) * spec.size_noise
         focal, middle_x, middle_y = spec.focal, spec.width / 2, spec.height / 2
