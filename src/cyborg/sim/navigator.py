@@ -48,6 +48,7 @@ class NavigatorSettings:
     replan_interval: float = 2.0  # seconds between replans around a blocking obstacle
     blocked_patience: float = 2.0  # seconds stopped before an obstacle ahead before replanning
     look_ahead: float = 3.0  # metres of path checked against the laser
+    blocked_persistence: float = 1.0  # seconds the laser must see the path blocked to replan
     sensed_range: float = 6.0  # laser returns within this distance become obstacles
     follower: FollowerSettings = field(default_factory=FollowerSettings)
     obstacles: ObstacleSettings = field(default_factory=ObstacleSettings)
@@ -84,6 +85,7 @@ class Navigator:
         self._progress_at = 0.0
         self._replanned_at = -math.inf
         self._blocked_since: float | None = None
+        self._ahead_since: float | None = None  # since when the laser sees the path blocked
 
     def go_to(self, start: Pose2D, goal: Pose2D, use_heading: bool, now: float) -> PlanResult:
         """Plan and start moving; the result says whether a path was found."""
@@ -165,7 +167,8 @@ class Navigator:
             self._obstacle_replan_at = now
             self._replan(now, pose, hits, discs)
         elif (now - self._replanned_at >= self.settings.replan_interval
-                and (stuck or self._path_blocked(pose, hits))):
+                and (stuck or self._blocked_for(now, pose, hits)
+                     >= self.settings.blocked_persistence)):
             self._replan(now, pose, hits, discs)
         if self.waiting:  # the replan found no way past the objects
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
@@ -229,6 +232,19 @@ class Navigator:
         return self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near,
                                  discs=discs)
 
+    def _blocked_for(self, now: float, pose: Pose2D, hits: np.ndarray) -> float:
+        """Seconds the laser has seen the path ahead blocked without a break (0: clear now).
+
+        Someone crossing the path or stepping out of the way clears it within a second: only
+        what stays in the way is worth a plan around it.
+        """
+        if not self._path_blocked(pose, hits):
+            self._ahead_since = None
+            return 0.0
+        if self._ahead_since is None:
+            self._ahead_since = now
+        return now - self._ahead_since
+
     def _path_blocked(self, pose: Pose2D, hits: np.ndarray) -> bool:
         assert self.follower is not None
         path = self.follower.path
@@ -236,11 +252,11 @@ class Navigator:
         ahead = path.sample(along + 0.3, along + self.settings.look_ahead, 0.1)
         if len(ahead) == 0 or len(hits) == 0:
             return False
-        return bool(closest_gap(hits, ahead) < self.planner.footprint.inscribed_radius + 0.05)
+        return bool(any_within(hits, ahead, self.planner.footprint.inscribed_radius + 0.05))
 
     def _replan(self, now: float, pose: Pose2D, hits: np.ndarray, discs: np.ndarray) -> None:
         """Plan past what the laser sees and the discs; wait if only the discs are in the way."""
-        self._replanned_at = now
+        self._replanned_at, self._ahead_since = now, None
         result = self._plan_around(pose, hits, discs)
         if result.path is not None:  # a detour may be longer: progress counts from here on,
             self.replans += 1           # but the stall clock keeps running
@@ -251,12 +267,21 @@ class Navigator:
 
 
 @njit(cache=True)
-def closest_gap(points: np.ndarray, others: np.ndarray) -> float:  # pragma: no cover - jit
-    """The smallest distance between a point of ``points`` and one of ``others``."""
-    best = np.inf
+def any_within(points: np.ndarray, others: np.ndarray,
+               limit: float) -> bool:  # pragma: no cover - jit
+    """Whether a point of ``points`` lies closer than ``limit`` to one of ``others``.
+
+    Points outside the box around ``others`` grown by ``limit`` are passed over at once: of a
+    scan's returns, only the few near the path ahead are measured against it.
+    """
+    low_x, high_x = others[:, 0].min() - limit, others[:, 0].max() + limit
+    low_y, high_y = others[:, 1].min() - limit, others[:, 1].max() + limit
+    squared = limit * limit
     for i in range(points.shape[0]):
+        px, py = points[i, 0], points[i, 1]
+        if px < low_x or px > high_x or py < low_y or py > high_y:
+            continue
         for j in range(others.shape[0]):
-            gap = (points[i, 0] - others[j, 0]) ** 2 + (points[i, 1] - others[j, 1]) ** 2
-            if gap < best:
-                best = gap
-    return float(np.sqrt(best))
+            if (px - others[j, 0]) ** 2 + (py - others[j, 1]) ** 2 < squared:
+                return True
+    return False

@@ -119,13 +119,14 @@ class Crowd:
         """What a robot at ``(x, y)`` meets of the crowd (see :class:`Meeting`)."""
         if not self.people:
             return NOBODY
-        circles = self.circles()
-        distance = np.hypot(circles[:, 0] - x, circles[:, 1] - y)
-        outlines = self.outlines()
-        close = distance <= NEAR
-        near = tuple(outlines[index] for index in np.flatnonzero(close))
-        points = (circles[close, None, :2] + self._samples[None, :, :]).reshape(-1, 2)
-        return Meeting(near, points, circles[distance <= reach])
+        positions = self.positions
+        distance = np.hypot(positions[:, 0] - x, positions[:, 1] - y)
+        close = np.flatnonzero(distance <= NEAR)
+        near = tuple(positions[index] + self._octagon for index in close)
+        points = (positions[close, None, :] + self._samples[None, :, :]).reshape(-1, 2)
+        seen = positions[distance <= reach]
+        circles = np.column_stack([seen, np.full(len(seen), self.settings.radius)])
+        return Meeting(near, points, circles)
 
     def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float) -> Meeting:
         """Walk ``dt`` s around one robot and say what it meets.
@@ -198,26 +199,40 @@ class Crowd:
         would be stuck for good.
         """
         s = self.settings
-        for person in self.people:
-            for index, (cx, cy, radius) in enumerate(robots):
-                dx, dy = person.x - cx, person.y - cy
-                distance = math.hypot(dx, dy)
-                need = radius + s.radius + ROOM
-                turns: tuple[float, ...] = SIDESTEPS
-                if index < len(headings):
-                    ux, uy = math.cos(headings[index]), math.sin(headings[index])
-                    along, across = dx * ux + dy * uy, uy * dx - ux * dy
-                    if 0.0 < along <= AHEAD and abs(across) < need:
-                        side = headings[index] + (-math.pi / 2 if across >= 0 else math.pi / 2)
-                        self._step_away(person, side, person.speed * dt, (0.0, math.pi / 4,
-                                                                          math.pi / 2))
-                        continue
-                if distance >= need:
-                    continue
-                if distance < 1e-9:
-                    dx, dy, distance = -math.cos(person.heading), -math.sin(person.heading), 1.0
-                self._step_away(person, math.atan2(dy, dx), min(need - distance,
-                                                                person.speed * dt), turns)
+        for index, (cx, cy, radius) in enumerate(robots):
+            positions = self.positions  # as the robots before this one left them
+            dx, dy = positions[:, 0] - cx, positions[:, 1] - cy
+            need = radius + s.radius + ROOM
+            touched = np.hypot(dx, dy) < need
+            if index < len(headings):  # ahead of it: within AHEAD along, and need aside
+                ux, uy = math.cos(headings[index]), math.sin(headings[index])
+                along, across = dx * ux + dy * uy, uy * dx - ux * dy
+                touched |= (along > 0.0) & (along <= AHEAD) & (np.abs(across) < need)
+            for person in (self.people[k] for k in np.flatnonzero(touched)):
+                self._room_for(person, cx, cy, need,
+                               headings[index] if index < len(headings) else None, dt)
+
+    def _room_for(self, person: Person, cx: float, cy: float, need: float,
+                  heading: float | None, dt: float) -> None:
+        """``person`` steps out of the way of a robot at ``(cx, cy)`` heading ``heading``.
+
+        ``need`` is the gap (m, centre to centre) the person keeps from the robot.
+        """
+        dx, dy = person.x - cx, person.y - cy
+        distance = math.hypot(dx, dy)
+        if heading is not None:
+            ux, uy = math.cos(heading), math.sin(heading)
+            along, across = dx * ux + dy * uy, uy * dx - ux * dy
+            if 0.0 < along <= AHEAD and abs(across) < need:
+                side = heading + (-math.pi / 2 if across >= 0 else math.pi / 2)
+                self._step_away(person, side, person.speed * dt, (0.0, math.pi / 4, math.pi / 2))
+                return
+        if distance >= need:
+            return
+        if distance < 1e-9:
+            dx, dy, distance = -math.cos(person.heading), -math.sin(person.heading), 1.0
+        self._step_away(person, math.atan2(dy, dx), min(need - distance, person.speed * dt),
+                        SIDESTEPS)
 
     def _step_away(self, person: Person, away: float, step: float,
                    turns: tuple[float, ...]) -> None:

@@ -68,6 +68,12 @@ class RobotBase:
     bumps: int = 0  # contacts since start
     others: tuple[np.ndarray, ...] = ()  # other robots' outlines, map coordinates
 
+    def __post_init__(self) -> None:
+        """The body's outline and the bounding circles of ``others`` (redone as they change)."""
+        self._polygon = self.footprint.polygon()
+        self._bounds: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray] = (
+            (), np.zeros((0, 2)), np.zeros(0))
+
     def command(self, speed: float, turn_rate: float, dt: float) -> None:
         """Move for ``dt`` seconds towards the commanded speed and turn rate."""
         limits = self.limits
@@ -100,16 +106,30 @@ class RobotBase:
         offsets, radius = self.footprint.circles()
         walls = float(body_gap(pose.x, pose.y, pose.theta, offsets, radius, self.clearance,
                                self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
-        return min(walls, self.robots_gap(pose)) if self.others else walls
+        return min(walls, self.robots_gap(pose, below=walls)) if self.others else walls
 
-    def robots_gap(self, pose: Pose2D) -> float:
+    def robots_gap(self, pose: Pose2D, below: float = math.inf) -> float:
         """Smallest gap (m, negative when overlapping) to the other robots' outlines.
 
-        The body is at ``pose``; the gap is inf without other robots.
+        The body is at ``pose``; the gap is inf without other robots. Outlines whose bounding
+        circle is ``below`` m or further from the body's are not measured: the gap is exact
+        when it is less than ``below``, and at least ``below`` otherwise (may be inf).
         """
         if not self.others:
             return math.inf
-        return nearest_gap(outline_at(self.footprint.polygon(), pose), self.others)
+        if self._bounds[0] is not self.others:
+            outlines = self.others
+            middles = np.array([outline.mean(axis=0) for outline in outlines])
+            radii = np.array([np.max(np.hypot(*(outline - middle).T))
+                              for outline, middle in zip(outlines, middles, strict=True)])
+            self._bounds = (outlines, middles, radii)
+        _, middles, radii = self._bounds
+        reach = np.hypot(middles[:, 0] - pose.x, middles[:, 1] - pose.y) - radii \
+            - self.footprint.circumscribed_radius
+        near = [self.others[index] for index in np.flatnonzero(reach < below)]
+        if not near:
+            return math.inf
+        return nearest_gap(outline_at(self._polygon, pose), near)
 
     def collides(self, pose: Pose2D) -> bool:
         """Whether the body at ``pose`` overlaps a wall."""
