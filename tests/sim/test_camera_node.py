@@ -18,6 +18,7 @@ from cyborg.bus.msgs.sensor_msgs.msg import Image
 from cyborg.bus.msgs.vision_msgs.msg import Detection2DArray
 from cyborg.interfaces import detection_messages, detector, simulation
 from cyborg.sim import component
+from cyborg.sim.camera import CameraSpec
 from cyborg.sim.people_and_camera import CAMERA_NAME
 from cyborg.vision import detector_node
 from tests.running_system import wait_until
@@ -81,7 +82,7 @@ def test_the_camera_publishes_what_the_detector_would_and_people_are_on_sim_peop
         assert found.bbox.center.position.x == pytest.approx((x1 + x2) / 2)
         assert found.bbox.size_y == pytest.approx(y2 - y1)
     person = next(p for p in predictions.predictions if p.label == "person")
-    assert person.distance == pytest.approx(3.0 - 0.15, abs=0.2)
+    assert person.distance == pytest.approx(3.0 - CameraSpec().mount_x, abs=0.2)
     image: Image = got["image"][-1]
     assert (image.encoding, image.width, image.height) == ("bgr8", 672, 376)
     people: PoseArray = got["people"][-1]

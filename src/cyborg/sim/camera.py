@@ -3,6 +3,9 @@
 The camera sits on the robot as on the Cyborg (:class:`CameraSpec`: facing forward, ahead of
 the axle and a metre up) and looks through a pinhole of the ZED 2's horizontal field of view
 (110°) onto an image of 672 x 376 pixels (the ZED's WVGA mode, the 2018 detector's input).
+Mount and optics default to the contract's (:data:`cyborg.interfaces.perception.CAMERA_MOUNT`
+and :data:`~cyborg.interfaces.perception.CAMERA`), which the tracker places detections with:
+a camera mounted elsewhere than the tracker believes puts every person off by the difference.
 For each thing in view (:mod:`cyborg.sim.sights`) it decides what a detector on that frame
 would report:
 
@@ -35,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cyborg.interfaces.perception import CAMERA, CAMERA_MOUNT
 from cyborg.sim.bodies import cast_onto, cast_onto_circles_at
 from cyborg.sim.laser import cast_rays
 from cyborg.sim.sights import Sights
@@ -44,13 +48,13 @@ from cyborg.sim.sights import Sights
 class CameraSpec:
     """The camera's mount, optics, rate and detection model; lengths in m, angles in rad."""
 
-    width: int = 672  # pixels
-    height: int = 376
-    field_of_view: float = math.radians(110.0)  # horizontal; square pixels
-    mount_x: float = 0.15  # ahead of the robot's centre
-    mount_height: float = 1.0  # above the floor, looking level
-    range_min: float = 0.3
-    range_max: float = 20.0
+    width: int = CAMERA.width  # pixels
+    height: int = CAMERA.height
+    field_of_view: float = CAMERA.horizontal_fov  # horizontal; square pixels
+    mount_x: float = CAMERA_MOUNT.x  # ahead of the robot's centre
+    mount_height: float = CAMERA_MOUNT.z  # above the floor, looking level
+    range_min: float = CAMERA.min_range
+    range_max: float = CAMERA.max_range
     rate: float = 10.0  # frames per simulated second (at most the simulator's sensor rate)
     detect_near: float = 0.97
     detect_far: float = 0.3
