@@ -151,6 +151,11 @@ class Planner:
         _rows, columns = self.grid.shape
         start_cell = self.grid.cell(start.x, start.y)
         goal_cell = self.grid.cell(goal.x, goal.y)
+        if goal_cell != start_cell and not np.isfinite(cost[goal_cell]):
+            # what was sensed covers the goal: no search would reach it, however long
+            return PlanResult(None, GOAL_OCCUPIED,
+                              f"goal ({goal.x:.2f}, {goal.y:.2f}) is taken by an obstacle "
+                              f"seen there", time.perf_counter() - began)
         cells = astar(cost, start_cell[0] * columns + start_cell[1],
                       goal_cell[0] * columns + goal_cell[1])
         if len(cells) == 0:

@@ -33,10 +33,10 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_points
+from cyborg.sim.crowd_geometry import in_the_way, line_clear
 from cyborg.sim.people_routes import Point, RouteBook
 from cyborg.sim.person import Gait, PeopleSettings, Person, PersonPlan
 
@@ -295,11 +295,10 @@ class Crowd:
         both bodies (and 10 cm) aside.
         """
         s = self.settings
-        others = np.empty((len(self.people), 3))
-        for index, person in enumerate(self.people):
-            others[index] = person.x, person.y, s.radius
+        positions = self.positions
+        others = np.column_stack([positions, np.full(len(positions), s.radius)])
         here = np.array([(p.x, p.y, p.heading) for p in walking])
-        return _in_the_way(here, np.concatenate([others, robots]), s.radius, s.look_ahead)
+        return in_the_way(here, np.concatenate([others, robots]), s.radius, s.look_ahead)
 
     def _arrive(self, person: Person) -> None:
         """Pause at the waypoint (or as near it as they got), then go on to the next."""
@@ -338,12 +337,10 @@ class Crowd:
 
     def _clear(self, start: Point, end: np.ndarray) -> bool:
         """Whether a person walks from ``start`` to ``end`` in a straight line clear of walls."""
-        steps = max(2, math.ceil(math.hypot(end[0] - start[0], end[1] - start[1]) / 0.1))
-        share = np.linspace(0.0, 1.0, steps)
         grid = self.routes.planner.grid
-        rows, columns = grid.cells_of(np.column_stack([start[0] + share * (end[0] - start[0]),
-                                                       start[1] + share * (end[1] - start[1])]))
-        return bool(np.all(self._clearance[rows, columns] >= self.settings.radius + 0.05))
+        return bool(line_clear(self._clearance, grid.origin_x, grid.origin_y, grid.resolution,
+                                float(start[0]), float(start[1]), float(end[0]), float(end[1]),
+                                self.settings.radius + 0.05))
 
     def _turn_back(self, person: Person) -> None:
         """Blocked for too long: walk back the way they came, to try again after a pause.
@@ -366,25 +363,3 @@ class Crowd:
             person.returning = not person.returning
             person.then = (person.then + (-1 if person.returning else 1)) % count
         person.gait, person.waited = Gait.WALKING, 0.0
-
-
-@njit(cache=True)
-def _in_the_way(here: np.ndarray, others: np.ndarray, radius: float,
-                look_ahead: float) -> np.ndarray:  # pragma: no cover - jit
-    """For each walker (x, y, heading): whether one of ``others`` (x, y, radius) is ahead.
-
-    Ahead: along the heading by more than nothing and at most both radii plus ``look_ahead``,
-    and less than both radii plus 10 cm aside. A walker never blocks itself (distance 0).
-    """
-    result = np.zeros(here.shape[0], np.bool_)
-    for walker in range(here.shape[0]):
-        ux, uy = math.cos(here[walker, 2]), math.sin(here[walker, 2])
-        for other in range(others.shape[0]):
-            rx, ry = others[other, 0] - here[walker, 0], others[other, 1] - here[walker, 1]
-            along = rx * ux + ry * uy
-            across = abs(rx * uy - ry * ux)
-            reach = radius + others[other, 2]
-            if 1e-9 < along <= reach + look_ahead and across < reach + 0.1:
-                result[walker] = True
-                break
-    return result

@@ -71,6 +71,7 @@ class RobotBase:
     def __post_init__(self) -> None:
         """The body's outline and the bounding circles of ``others`` (redone as they change)."""
         self._polygon = self.footprint.polygon()
+        self._circles = self.footprint.circles()
         self._bounds: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray] = (
             (), np.zeros((0, 2)), np.zeros(0))
 
@@ -103,7 +104,7 @@ class RobotBase:
     # ------------------------------------------------------------------ contact
     def body_clearance(self, pose: Pose2D) -> float:
         """Smallest gap (metres, negative when overlapping) to a wall or another robot."""
-        offsets, radius = self.footprint.circles()
+        offsets, radius = self._circles
         walls = float(body_gap(pose.x, pose.y, pose.theta, offsets, radius, self.clearance,
                                self.origin[0], self.origin[1], self.resolution, _NO_POINTS))
         return min(walls, self.robots_gap(pose, below=walls)) if self.others else walls
@@ -118,11 +119,7 @@ class RobotBase:
         if not self.others:
             return math.inf
         if self._bounds[0] is not self.others:
-            outlines = self.others
-            middles = np.array([outline.mean(axis=0) for outline in outlines])
-            radii = np.array([np.max(np.hypot(*(outline - middle).T))
-                              for outline, middle in zip(outlines, middles, strict=True)])
-            self._bounds = (outlines, middles, radii)
+            self._bounds = (self.others, *_bounding_circles(self.others))
         _, middles, radii = self._bounds
         reach = np.hypot(middles[:, 0] - pose.x, middles[:, 1] - pose.y) - radii \
             - self.footprint.circumscribed_radius
@@ -138,6 +135,19 @@ class RobotBase:
     def _worse(self, moved: Pose2D) -> bool:
         """Moves that increase the gap are allowed even in contact (backing off a wall)."""
         return self.body_clearance(moved) <= self.body_clearance(self.pose)
+
+
+def _bounding_circles(outlines: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ((N, 2), m: the corners' mean) and radii (N) of circles around ``outlines``."""
+    if len({len(outline) for outline in outlines}) == 1:  # alike (people): all at once
+        stacked = np.stack(outlines)
+        middles = stacked.mean(axis=1)
+        radii = np.hypot(*(stacked - middles[:, None, :]).transpose(2, 0, 1)).max(axis=1)
+        return middles, radii
+    middles = np.array([outline.mean(axis=0) for outline in outlines])
+    radii = np.array([np.max(np.hypot(*(outline - middle).T))
+                      for outline, middle in zip(outlines, middles, strict=True)])
+    return middles, radii
 
 
 def _limited(change: float, most: float) -> float:
