@@ -95,3 +95,14 @@ def test_columbia_impossible_and_forbidden_goals(shared: FilePath) -> None:
     for x, y in results["Hallway 2"].path.sample(0.0, results["Hallway 2"].length, 0.02):  # type: ignore[union-attr]
         row, column = planner.grid.cell(x, y)
         assert not planner.grid.forbidden[row, column]
+
+
+def test_a_goal_covered_by_sensed_obstacles_is_occupied_and_a_free_one_is_planned() -> None:
+    planner = Planner(parse_map(room_map([])))
+    ring = np.array([(RIGHT.x + 0.1 * math.cos(a), RIGHT.y + 0.1 * math.sin(a))
+                     for a in np.linspace(0, 2 * math.pi, 16, endpoint=False)])
+    covered = planner.plan(LEFT, RIGHT, obstacles=ring)
+    assert (covered.found, covered.code) == (False, GOAL_OCCUPIED)
+    assert "(8.00, 3.00)" in covered.reason and "obstacle" in covered.reason
+    aside = planner.plan(LEFT, RIGHT, obstacles=ring + np.array([0.0, 2.0]))  # 2 m off the goal
+    assert aside.found and aside.code == "NONE"

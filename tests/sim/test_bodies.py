@@ -102,3 +102,16 @@ def test_an_outline_grown_by_a_margin_keeps_its_shape() -> None:
     ahead = outline_at(body, Pose2D(5.0 + 0.32 + 0.1 + 0.32, 0.0, 0.0))
     assert polygon_gap(outline_at(around, Pose2D(5.0, 0.0, 0.0)), ahead) == pytest.approx(
         0.0, abs=1e-9)
+
+
+def test_far_outlines_are_not_measured_but_near_ones_are_exactly() -> None:
+    clearance = np.full((200, 200), 10.0)
+    base = RobotBase(clearance, (0.0, 0.0), 0.05, pose=Pose2D(2.0, 5.0, 0.0))
+    near, far = square(3.0, 5.0), square(9.0, 5.0)
+    base.others = (far, near)
+    exact = nearest_gap(outline_at(PIONEER_LX.polygon(), base.pose), [near])
+    assert base.robots_gap(base.pose) == pytest.approx(exact)
+    assert base.robots_gap(base.pose, below=exact + 0.01) == pytest.approx(exact)
+    assert base.robots_gap(base.pose, below=0.1) >= 0.1  # both are further: none measured
+    base.others = (far,)  # a new tuple: the bounding circles follow
+    assert base.robots_gap(base.pose) > 5.0

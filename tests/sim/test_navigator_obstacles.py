@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from cyborg.nav.arnl_map import parse_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.sim.navigator import NavigatorSettings, PathState
@@ -113,3 +115,29 @@ def test_cancelling_a_wait_ends_the_goal() -> None:
     sim.go_to(Pose2D(13.0, 1.0))
     sim.cancel()
     assert sim.navigator.state is PathState.ABORTED_PATHPLAN
+
+
+def laser_sees_for(sim: Simulator, where: tuple[float, float], seconds: float) -> int:
+    """Someone the laser sees at ``where`` for ``seconds``, then gone; the replans meanwhile."""
+    sim.meet((), people=np.array([[where[0], where[1], 0.25]]))
+    sim.run(seconds)
+    sim.meet((), people=np.zeros((0, 3)))
+    return sim.navigator.replans
+
+
+def test_someone_crossing_the_path_briefly_is_not_planned_around() -> None:
+    sim = corridor(3.6)
+    assert sim.go_to(Pose2D(13.0, 1.8)).found
+    sim.run(1.0)
+    assert laser_sees_for(sim, (sim.pose.x + 2.0, 1.8), 0.5) == 0
+    sim.run_until(lambda: sim.navigator.state.finished, timeout=60)
+    assert sim.navigator.state is PathState.REACHED_GOAL and sim.navigator.replans == 0
+
+
+def test_someone_who_stays_on_the_path_is_planned_around() -> None:
+    sim = corridor(3.6)
+    assert sim.go_to(Pose2D(13.0, 1.8)).found
+    sim.run(1.0)
+    settings = sim.navigator.settings
+    stays = settings.blocked_persistence + settings.replan_interval + 0.5
+    assert laser_sees_for(sim, (sim.pose.x + 2.0, 1.8), stays) >= 1
