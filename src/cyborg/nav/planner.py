@@ -167,6 +167,31 @@ class Planner:
         return PlanResult(Path(path, goal.theta if use_heading else None),
                           planning_time=time.perf_counter() - began)
 
+    def passable_near(self, start: Pose2D, goal: Pose2D, obstacles: np.ndarray,
+                      margin: float) -> bool:
+        """Whether a path from ``start`` to a near ``goal`` passes ``obstacles`` close by.
+
+        The search keeps to the box around the two poses grown by ``margin`` m, so it costs
+        little whatever the map's size; a way that must leave the box is not found. This
+        tells whether sensed obstacles (N x 2 points) close the way ahead, before a search of
+        the whole map that would only fail after visiting every cell it can reach.
+        """
+        if self.check(start, "start") or self.check(goal, "goal"):
+            return False
+        grid = self.grid
+        _clearance, cost = self._around(obstacles) if len(obstacles) else (self.clearance,
+                                                                           self.cost.copy())
+        for pose in (start, goal):
+            self._open_escape(cost, self.clearance, pose)
+        corners = np.array([(start.x, start.y), (goal.x, goal.y)])
+        rows, columns = grid.cells_of(np.vstack([corners.min(axis=0) - margin,
+                                                 corners.max(axis=0) + margin]))
+        window = np.ascontiguousarray(cost[rows[0]:rows[1] + 1, columns[0]:columns[1] + 1])
+        width = window.shape[1]
+        (r0, c0), (r1, c1) = grid.cell(start.x, start.y), grid.cell(goal.x, goal.y)
+        return len(astar(window, (r0 - rows[0]) * width + c0 - columns[0],
+                         (r1 - rows[0]) * width + c1 - columns[0])) > 0
+
     def stamp_discs(self, clearance: np.ndarray, cost: np.ndarray, discs: np.ndarray) -> None:
         """Stamp (N, 3) discs into a clearance grid and its cost grid, in place.
 

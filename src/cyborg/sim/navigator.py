@@ -49,6 +49,7 @@ class NavigatorSettings:
     blocked_patience: float = 2.0  # seconds stopped before an obstacle ahead before replanning
     look_ahead: float = 3.0  # metres of path checked against the laser
     blocked_persistence: float = 1.0  # seconds the laser must see the path blocked to replan
+    detour_margin: float = 3.0  # metres around the way ahead searched for a way past (cheap)
     sensed_range: float = 6.0  # laser returns within this distance become obstacles
     follower: FollowerSettings = field(default_factory=FollowerSettings)
     obstacles: ObstacleSettings = field(default_factory=ObstacleSettings)
@@ -169,7 +170,10 @@ class Navigator:
         elif (now - self._replanned_at >= self.settings.replan_interval
                 and (stuck or self._blocked_for(now, pose, hits)
                      >= self.settings.blocked_persistence)):
-            self._replan(now, pose, hits, discs)
+            if stuck or self._way_ahead_open(pose, hits):
+                self._replan(now, pose, hits, discs)
+            else:  # closed near by: asked again after the interval, if still blocked
+                self._replanned_at, self._ahead_since = now, None
         if self.waiting:  # the replan found no way past the objects
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
         return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
@@ -231,6 +235,22 @@ class Navigator:
                     < self.settings.sensed_range]
         return self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near,
                                  discs=discs)
+
+    def _way_ahead_open(self, pose: Pose2D, hits: np.ndarray) -> bool:
+        """Whether a way past what the laser sees on the path ahead opens near the robot.
+
+        Searched in a box around the robot and the path a little beyond the part checked
+        (``look_ahead``), with ``detour_margin`` m to spare: cheap. When someone stands
+        across a corridor there is none, and a search of the whole map would visit every cell
+        it reaches before saying so; the robot waits in front instead, and searches the whole
+        map once it has stood blocked for ``blocked_patience`` s (a way round elsewhere).
+        """
+        assert self.follower is not None
+        path, settings = self.follower.path, self.settings
+        along, _gap = path.project(pose.x, pose.y)
+        beyond = Pose2D(*path.point_at(along + settings.look_ahead + 1.0))
+        near = hits[np.hypot(hits[:, 0] - pose.x, hits[:, 1] - pose.y) < settings.sensed_range]
+        return self.planner.passable_near(pose, beyond, near, settings.detour_margin)
 
     def _blocked_for(self, now: float, pose: Pose2D, hits: np.ndarray) -> float:
         """Seconds the laser has seen the path ahead blocked without a break (0: clear now).
