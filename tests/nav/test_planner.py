@@ -106,3 +106,17 @@ def test_a_goal_covered_by_sensed_obstacles_is_occupied_and_a_free_one_is_planne
     assert "(8.00, 3.00)" in covered.reason and "obstacle" in covered.reason
     aside = planner.plan(LEFT, RIGHT, obstacles=ring + np.array([0.0, 2.0]))  # 2 m off the goal
     assert aside.found and aside.code == "NONE"
+
+
+def test_a_way_near_by_is_found_in_a_small_box_and_a_closed_door_has_none() -> None:
+    planner = Planner(parse_map(room_map([])))
+    before, after = Pose2D(4.0, 3.0), Pose2D(6.0, 3.0)
+    nothing = np.zeros((0, 2))
+    assert planner.passable_near(before, after, nothing, margin=1.0)
+    door = np.column_stack([np.full(13, 5.0), np.linspace(2.4, 3.6, 13)])  # someone in it
+    assert not planner.passable_near(before, after, door, margin=1.0)
+    aside = door + np.array([0.0, 1.5])  # by the wall beside the door: the door is free
+    assert planner.passable_near(before, after, aside, margin=1.0)
+    # the room's far side is only reached round a wall the small box leaves out
+    assert not planner.passable_near(Pose2D(4.0, 1.0), Pose2D(6.0, 1.0), nothing, margin=0.5)
+    assert planner.passable_near(Pose2D(4.0, 1.0), Pose2D(6.0, 1.0), nothing, margin=2.5)

@@ -55,6 +55,50 @@ def nearest_gap(outline: np.ndarray, others: Sequence[np.ndarray]) -> float:
 
 
 @njit(cache=True)
+def outline_bounds(corners: np.ndarray,
+                   starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
+    """Centres ((N, 2): the corners' mean) and radii (N) of circles around N outlines.
+
+    The outlines lie one after the other in ``corners``; outline ``n`` is rows
+    ``starts[n]`` to ``starts[n + 1]`` (``starts`` has N + 1 entries).
+    """
+    count = starts.shape[0] - 1
+    middles, radii = np.zeros((count, 2)), np.zeros(count)
+    for n in range(count):
+        size = starts[n + 1] - starts[n]
+        for k in range(starts[n], starts[n + 1]):
+            middles[n, 0] += corners[k, 0] / size
+            middles[n, 1] += corners[k, 1] / size
+        for k in range(starts[n], starts[n + 1]):
+            radii[n] = max(radii[n], math.hypot(corners[k, 0] - middles[n, 0],
+                                                corners[k, 1] - middles[n, 1]))
+    return middles, radii
+
+
+@njit(cache=True)
+def gap_below(body: np.ndarray, reach: float, corners: np.ndarray, starts: np.ndarray,
+              middles: np.ndarray, radii: np.ndarray,
+              below: float) -> float:  # pragma: no cover - jit
+    """The smallest :func:`polygon_gap` from ``body`` to outlines nearer than ``below`` m.
+
+    Inf when none may be nearer. ``body`` is K x 2 map corners whose circle of radius
+    ``reach`` around their mean holds them; the outlines are as :func:`outline_bounds` takes
+    them, with its circles: an outline whose circle is ``below`` or further from the body's
+    circle is not measured.
+    """
+    cx, cy = 0.0, 0.0
+    for k in range(body.shape[0]):
+        cx += body[k, 0] / body.shape[0]
+        cy += body[k, 1] / body.shape[0]
+    lowest = np.inf
+    for n in range(starts.shape[0] - 1):
+        if math.hypot(middles[n, 0] - cx, middles[n, 1] - cy) - radii[n] - reach >= below:
+            continue
+        lowest = min(lowest, polygon_gap(body, corners[starts[n]:starts[n + 1]]))
+    return lowest
+
+
+@njit(cache=True)
 def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover - jit
     """The gap (m) between convex polygons ``a`` and ``b`` (K x 2 corners, in order).
 

@@ -19,7 +19,7 @@ from numba import njit
 
 from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Pose2D, normalize_angle
-from cyborg.sim.bodies import nearest_gap, outline_at
+from cyborg.sim.bodies import gap_below, outline_at, outline_bounds
 
 
 @dataclass(frozen=True)
@@ -72,8 +72,11 @@ class RobotBase:
         """The body's outline and the bounding circles of ``others`` (redone as they change)."""
         self._polygon = self.footprint.polygon()
         self._circles = self.footprint.circles()
-        self._bounds: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray] = (
-            (), np.zeros((0, 2)), np.zeros(0))
+        # the circle around the outline's corners, about their mean (the body's circle)
+        self._reach = float(np.max(np.hypot(*(self._polygon - self._polygon.mean(axis=0)).T)))
+        self._bounds: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray, np.ndarray,
+                            np.ndarray] = ((), np.zeros((0, 2)), np.zeros(1, np.int64),
+                                           np.zeros((0, 2)), np.zeros(0))
 
     def command(self, speed: float, turn_rate: float, dt: float) -> None:
         """Move for ``dt`` seconds towards the commanded speed and turn rate."""
@@ -119,14 +122,12 @@ class RobotBase:
         if not self.others:
             return math.inf
         if self._bounds[0] is not self.others:
-            self._bounds = (self.others, *_bounding_circles(self.others))
-        _, middles, radii = self._bounds
-        reach = np.hypot(middles[:, 0] - pose.x, middles[:, 1] - pose.y) - radii \
-            - self.footprint.circumscribed_radius
-        near = [self.others[index] for index in np.flatnonzero(reach < below)]
-        if not near:
-            return math.inf
-        return nearest_gap(outline_at(self._polygon, pose), near)
+            starts = np.cumsum([0, *(len(outline) for outline in self.others)])
+            corners = np.ascontiguousarray(np.concatenate(self.others), dtype=np.float64)
+            self._bounds = (self.others, corners, starts, *outline_bounds(corners, starts))
+        _, corners, starts, middles, radii = self._bounds
+        return float(gap_below(outline_at(self._polygon, pose), self._reach, corners, starts,
+                               middles, radii, below))
 
     def collides(self, pose: Pose2D) -> bool:
         """Whether the body at ``pose`` overlaps a wall."""
@@ -135,19 +136,6 @@ class RobotBase:
     def _worse(self, moved: Pose2D) -> bool:
         """Moves that increase the gap are allowed even in contact (backing off a wall)."""
         return self.body_clearance(moved) <= self.body_clearance(self.pose)
-
-
-def _bounding_circles(outlines: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Centres ((N, 2), m: the corners' mean) and radii (N) of circles around ``outlines``."""
-    if len({len(outline) for outline in outlines}) == 1:  # alike (people): all at once
-        stacked = np.stack(outlines)
-        middles = stacked.mean(axis=1)
-        radii = np.hypot(*(stacked - middles[:, None, :]).transpose(2, 0, 1)).max(axis=1)
-        return middles, radii
-    middles = np.array([outline.mean(axis=0) for outline in outlines])
-    radii = np.array([np.max(np.hypot(*(outline - middle).T))
-                      for outline, middle in zip(outlines, middles, strict=True)])
-    return middles, radii
 
 
 def _limited(change: float, most: float) -> float:
