@@ -2,10 +2,12 @@
 
 States are rosarnl's ``arnl_path_state`` strings (:class:`cyborg.interfaces.robot.PathState`).
 A goal that cannot be planned ends at once in ``FAILED_PLAN``; while moving, an obstacle the
-map does not know about (a box, a person) that blocks the path ahead triggers a replan that
-treats the laser's returns as walls; when the distance still to go *along the path* has not
-shrunk for ``stall_timeout`` seconds the goal ends in ``FAILED_MOVE``. Cancelling ends it in
-``ABORTED_PATHPLAN`` and stops the robot.
+map does not know about (a box, a person) that blocks the path ahead for ``blocked_persistence``
+seconds (someone crossing it does not) triggers a replan that treats the laser's returns as
+walls, once a cheap search near the path ahead finds a way past them (else the robot waits in
+front, and plans on the whole map once stopped for ``blocked_patience`` seconds); when the
+distance still to go *along the path* has not shrunk for ``stall_timeout`` seconds the goal
+ends in ``FAILED_MOVE``. Cancelling ends it in ``ABORTED_PATHPLAN`` and stops the robot.
 
 Objects seen lately (:attr:`Navigator.obstacles`, fed from the tracker's ``objects``) are
 temporary obstacles (:mod:`cyborg.nav.temporary_obstacles`): those within ``obstacle_range``
