@@ -123,4 +123,6 @@ def test_a_person_in_a_narrow_corridor_is_waited_for_until_they_are_gone(tmp_pat
         assert states.count(PathState.WAITING_FOR_PATH) == 1
         assert not {PathState.FAILED_MOVE, PathState.FAILED_PLAN} & set(states)
         assert closest >= 0.8, "it waited short of the person"
-        assert system.sim.navigator.waits == 1 and system.sim.base.bumps == 0
+        # one wait, as the path states say (the navigator's own count is per goal, and MoveTo
+        # may send its goal again while the robot waits); it never touched anyone
+        assert system.sim.base.bumps == 0
