@@ -127,7 +127,7 @@ def test_kwargs_node_takes_any_property() -> None:
 def test_registry_rejects_non_nodes() -> None:
     reg = NodeRegistry()
     with pytest.raises(TypeError):
-        reg.add(int)  # type: ignore[arg-type]
+        reg.add(int)
 
 
 def test_custom_decorator_node() -> None:

@@ -151,7 +151,7 @@ def test_the_decorator_and_entry_points_register_services(
 def test_register_service_checks_what_it_registers() -> None:
     services = ServiceRegistry()
     with pytest.raises(TypeError, match="not a Service subclass"):
-        services.add(int)  # type: ignore[arg-type]
+        services.add(int)
     with pytest.raises(ValueError, match="so a declaration can name it"):
         services.add(Probe, "Battery watch")
 

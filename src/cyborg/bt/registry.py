@@ -28,7 +28,6 @@ import inspect
 import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 from typing import Any, TypeVar, overload
 
 from cyborg.bt import (
@@ -40,6 +39,7 @@ from cyborg.bt import (
     v1_data,
     v1_math,
 )
+from cyborg.bt.named_registry import NamedRegistry
 from cyborg.bt.node import Category, Node
 from cyborg.bt.properties import Signature, signature_of
 
@@ -64,13 +64,12 @@ class NodeType:
         return self.cls.category
 
 
-class NodeRegistry:
+class NodeRegistry(NamedRegistry[NodeType]):
     """Maps editor node names to node classes."""
 
-    def __init__(self) -> None:
-        self._types: dict[str, NodeType] = {}
+    kind = Node
 
-    def add(self, cls: type[Node], name: str | None = None, *, origin: str = "") -> NodeType:
+    def add(self, cls: type, name: str | None = None, *, origin: str = "") -> NodeType:
         """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
 
         Returns the entry. Raises :class:`TypeError` for a class that is not a node of one of
@@ -89,49 +88,17 @@ class NodeRegistry:
         self._types[key] = node_type
         return node_type
 
-    def get(self, name: str) -> NodeType | None:
-        """The node registered under ``name``, or ``None``."""
-        return self._types.get(name)
-
-    def __contains__(self, name: object) -> bool:
-        return name in self._types
-
-    def names(self) -> list[str]:
-        """All registered names, sorted."""
-        return sorted(self._types)
-
     def types(self) -> list[NodeType]:
         """All registered nodes, sorted by name."""
         return [self._types[name] for name in self.names()]
 
-    def copy(self) -> NodeRegistry:
-        """An independent registry with the same entries (for adding nodes locally)."""
-        other = NodeRegistry()
-        other._types = dict(self._types)
-        return other
+    def registered(self) -> NodeRegistry:
+        """Where :func:`register` puts nodes."""
+        return _REGISTERED
 
     def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> list[str]:
-        """Registers the nodes of every installed entry point in ``group``.
-
-        Returns a message for each entry point that could not be loaded (they are skipped).
-        """
-        problems = []
-        for entry in entry_points(group=group):
-            try:
-                loaded = entry.load()
-            except Exception as exc:
-                problems.append(f"entry point {entry.name!r} ({entry.value}): "
-                                f"{type(exc).__name__}: {exc}")
-                continue
-            if inspect.isclass(loaded) and issubclass(loaded, Node):
-                self.add(loaded, entry.name, origin=f"entry point {entry.name}")
-            elif not inspect.ismodule(loaded):
-                problems.append(f"entry point {entry.name!r} ({entry.value}) is neither a "
-                                "module nor a Node subclass")
-        if self is not _REGISTERED:
-            self._types.update({k: v for k, v in _REGISTERED._types.items()
-                                if k not in self._types})
-        return problems
+        """Registers the nodes of every installed entry point in ``group`` (see the base)."""
+        return super().load_entry_points(group)
 
     def import_modules(self, modules: Iterable[str]) -> None:
         """Imports modules whose ``@register`` lines add nodes (``--nodes my_pkg.nodes``).

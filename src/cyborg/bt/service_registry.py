@@ -24,9 +24,9 @@ import inspect
 import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 from typing import Any, TypeVar, overload
 
+from cyborg.bt.named_registry import NamedRegistry
 from cyborg.bt.properties import Signature, signature_of
 from cyborg.bt.services import Service
 
@@ -47,14 +47,12 @@ class ServiceType:
     """Where it came from: a module name, or ``entry point <name>``."""
 
 
-class ServiceRegistry:
+class ServiceRegistry(NamedRegistry[ServiceType]):
     """Maps editor service names to service classes."""
 
-    def __init__(self) -> None:
-        self._types: dict[str, ServiceType] = {}
+    kind = Service
 
-    def add(self, cls: type[Service], name: str | None = None, *,
-            origin: str = "") -> ServiceType:
+    def add(self, cls: type, name: str | None = None, *, origin: str = "") -> ServiceType:
         """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
 
         Raises :class:`TypeError` for a class that is not a :class:`Service`,
@@ -71,44 +69,13 @@ class ServiceRegistry:
         self._types[key] = service_type
         return service_type
 
-    def get(self, name: str) -> ServiceType | None:
-        """The service registered under ``name``, or ``None``."""
-        return self._types.get(name)
-
-    def __contains__(self, name: object) -> bool:
-        return name in self._types
-
-    def names(self) -> list[str]:
-        """All registered names, sorted."""
-        return sorted(self._types)
-
-    def copy(self) -> ServiceRegistry:
-        """An independent registry with the same entries (for adding services locally)."""
-        other = ServiceRegistry()
-        other._types = dict(self._types)
-        return other
+    def registered(self) -> ServiceRegistry:
+        """Where :func:`register_service` puts services."""
+        return _REGISTERED
 
     def load_entry_points(self, group: str = SERVICE_ENTRY_POINT_GROUP) -> list[str]:
-        """Registers the services of every installed entry point in ``group``.
-
-        Returns a message for each entry point that could not be loaded (they are skipped).
-        Services that a loaded module registers with the decorator are added too.
-        """
-        problems = []
-        for entry in entry_points(group=group):
-            try:
-                loaded = entry.load()
-            except Exception as exc:
-                problems.append(f"entry point {entry.name!r} ({entry.value}): "
-                                f"{type(exc).__name__}: {exc}")
-                continue
-            if inspect.isclass(loaded) and issubclass(loaded, Service):
-                self.add(loaded, entry.name, origin=f"entry point {entry.name}")
-            elif not inspect.ismodule(loaded):
-                problems.append(f"entry point {entry.name!r} ({entry.value}) is neither a "
-                                "module nor a Service subclass")
-        self._take_registered()
-        return problems
+        """Registers the services of every installed entry point in ``group`` (see the base)."""
+        return super().load_entry_points(group)
 
     def import_modules(self, modules: Iterable[str]) -> None:
         """Imports modules whose ``@register_service`` lines add services.
@@ -121,12 +88,7 @@ class ServiceRegistry:
             except Exception as exc:
                 raise ImportError(f"cannot import service module {module!r}: "
                                   f"{type(exc).__name__}: {exc}") from exc
-        self._take_registered()
-
-    def _take_registered(self) -> None:
-        if self is not _REGISTERED:
-            self._types.update({key: value for key, value in _REGISTERED._types.items()
-                                if key not in self._types})
+        self.take_registered()
 
 
 _REGISTERED = ServiceRegistry()
