@@ -91,6 +91,33 @@ ROWS: list[Row] = [
     Row("MemSequence fails when the resumed child fails",
         N("MemSequence", leaf("a", "S"), leaf("b", "RF"), leaf("c", "S")), "RF",
         ("a:start a:tick a:end:success b:start b:tick", "b:tick b:end:failure")),
+    Row("MemSequence halted by a higher branch starts again at its first child",
+        N("Priority", leaf("g", "FSF"),
+          N("MemSequence", leaf("a", "S"), leaf("b", "R"), id="m")), "RSR",
+        ("g:start g:tick g:end:failure a:start a:tick a:end:success b:start b:tick",
+         "g:start g:tick g:end:success b:halt",
+         "g:start g:tick g:end:failure a:start a:tick a:end:success b:start b:tick"),
+        halted=("", "b m", "")),
+    # ----------------------------------------------------------------- ResumingSequence
+    Row("ResumingSequence halted by a higher branch resumes at the child it was running",
+        N("Priority", leaf("g", "FSF"),
+          N("ResumingSequence", leaf("a", "S"), leaf("b", "RRS"), leaf("c", "S"), id="m")),
+        "RSRS",
+        ("g:start g:tick g:end:failure a:start a:tick a:end:success b:start b:tick",
+         "g:start g:tick g:end:success b:halt",
+         "g:start g:tick g:end:failure b:start b:tick",
+         "g:start g:tick g:end:failure b:tick b:end:success c:start c:tick c:end:success"),
+        halted=("", "b m", "", "")),
+    Row("ResumingSequence starts at its first child again once it completes",
+        N("ResumingSequence", leaf("a", "S"), leaf("b", "RSR")), "RSR",
+        ("a:start a:tick a:end:success b:start b:tick",
+         "b:tick b:end:success",
+         "a:start a:tick a:end:success b:start b:tick")),
+    Row("ResumingSequence that fails starts at its first child again",
+        N("ResumingSequence", leaf("a", "S"), leaf("b", "RFR")), "RFR",
+        ("a:start a:tick a:end:success b:start b:tick",
+         "b:tick b:end:failure",
+         "a:start a:tick a:end:success b:start b:tick")),
     # ----------------------------------------------------------------- MemPriority
     Row("MemPriority resumes at the running child and restarts when done",
         N("MemPriority", leaf("a", "F"), leaf("b", "RF"), leaf("c", "S")), "RSS",
@@ -281,7 +308,8 @@ def test_stock_node(row: Row) -> None:
 
 
 def test_every_stock_node_is_in_the_table() -> None:
-    names = {"Sequence", "Priority", "MemSequence", "MemPriority", "Parallel", "Inverter",
+    names = {"Sequence", "Priority", "MemSequence", "MemPriority", "ResumingSequence",
+             "Parallel", "Inverter",
              "ForceSuccess", "ForceFailure", "Repeater", "RepeatUntilFailure",
              "RepeatUntilSuccess", "Retry", "Limiter", "MaxTime", "Timeout", "Delay", "RunOnce",
              "Wait", "Failer", "Succeeder", "Runner", "Error"}

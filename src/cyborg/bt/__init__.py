@@ -18,7 +18,14 @@ imports nothing else of cyborg.
 from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.builder import Subtree
 from cyborg.bt.clock import Clock, ManualClock, MonotonicClock
-from cyborg.bt.composites import MemPriority, MemSequence, Parallel, Priority, Sequence
+from cyborg.bt.composites import (
+    MemPriority,
+    MemSequence,
+    Parallel,
+    Priority,
+    ResumingSequence,
+    Sequence,
+)
 from cyborg.bt.decorators import (
     Delay,
     ForceFailure,
@@ -90,6 +97,7 @@ __all__ = [
     "RepeatUntilFailure",
     "RepeatUntilSuccess",
     "Repeater",
+    "ResumingSequence",
     "Retry",
     "RunOnce",
     "Runner",

@@ -3,7 +3,10 @@
 Without memory (Sequence, Priority) the composite restarts from its first child on every tick,
 so a higher-priority child can take over at any time; the child it replaces is halted at the
 end of that tick. With memory (MemSequence, MemPriority) it resumes at the child that was
-RUNNING, and starts from the first child only when a new activation begins.
+RUNNING, and starts from the first child only when a new activation begins. A
+ResumingSequence goes one step further: halted while a child runs, it resumes at that child in
+its next activation too (a patrol interrupted by a greeting goes on to the goal it was driving
+to, not back to its first one).
 """
 
 from __future__ import annotations
@@ -66,6 +69,33 @@ class MemSequence(Composite):
                     memory["running_child"] = index
                 return status
         return go_on
+
+
+class ResumingSequence(MemSequence):
+    """A MemSequence that keeps its place when it is halted.
+
+    A MemSequence halted by a higher branch of a Priority (or by a mode change) starts again
+    at its first child when it is ticked again; a ResumingSequence starts again at the child
+    that was RUNNING when it was halted, which starts afresh (a ``MoveTo`` sends its goal
+    again, a ``Wait`` waits its whole time). Only completing — every child succeeded, or one
+    failed or raised — brings it back to its first child. Under a Repeater it is a round that
+    interruptions do not restart: ``Priority[greet, Repeater[ResumingSequence[MoveTo A,
+    MoveTo B, ...]]]`` drives on to the goal it was driving to after each greeting.
+
+    The place is node memory, so it lasts as long as the tree's blackboard: a reloaded tree
+    starts at its first child.
+    """
+
+    def on_start(self) -> None:
+        """Starts a new activation where the last one was halted (the first child if none)."""
+        self.memory.setdefault("running_child", 0)
+
+    def tick(self) -> Status:
+        """Ticks as a MemSequence; on completion the next activation starts at the first child."""
+        status = super().tick()
+        if status is not RUNNING:
+            self.memory["running_child"] = 0
+        return status
 
 
 class MemPriority(MemSequence):

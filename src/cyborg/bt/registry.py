@@ -141,7 +141,7 @@ def register(name: Any = None, /) -> Any:
 
 STOCK_NODES: tuple[type[Node], ...] = (
     composites.Sequence, composites.Priority, composites.MemSequence, composites.MemPriority,
-    composites.Parallel,
+    composites.Parallel, composites.ResumingSequence,
     decorators.Inverter, decorators.Repeater, decorators.RepeatUntilFailure,
     decorators.RepeatUntilSuccess, decorators.MaxTime, decorators.Limiter, decorators.Retry,
     decorators.Timeout, decorators.ForceSuccess, decorators.ForceFailure, decorators.Delay,

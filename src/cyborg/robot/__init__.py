@@ -27,6 +27,8 @@ ApproachObject{label,     action      drive up to it, stop ``stopDistance`` m aw
 stopDistance}
 Say{text}                 action      speak a sentence; ``{closest.label}`` fills in
                                       blackboard values
+OncePerObject{key,        decorator   tick the child for the object ``ClosestObject``
+seconds,gap}                          wrote, unless done for it (or anyone) lately
 ========================  ==========  =====================================================
 
 The perception nodes (:mod:`~cyborg.robot.object_nodes`, :mod:`~cyborg.robot.object_motion`,
@@ -54,6 +56,7 @@ from cyborg.robot import (
     move_to,
     object_motion,
     object_nodes,
+    once_per_object,
     safety,
     say,
     watch_services,
@@ -61,5 +64,5 @@ from cyborg.robot import (
 from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
 
 __all__ = ["ROBOT", "Robot", "RobotError", "battery", "battery_board", "blackboard_compare",
-           "docking", "goals", "move_to", "object_motion", "object_nodes", "robot_of", "safety",
-           "say", "watch_services"]
+           "docking", "goals", "move_to", "object_motion", "object_nodes", "once_per_object",
+           "robot_of", "safety", "say", "watch_services"]
