@@ -245,9 +245,10 @@ def test_cyborg_up_runs_the_bundled_system() -> None:
     assert process.wait(timeout=120) == 0, rest + (process.stderr.read() if process.stderr else "")
     out = "".join(lines) + rest
     assert "simulator    /cyborg/arnl: campus.map at 20x real time" in out
-    assert ("tree runner  /cyborg/bt/tree_runner: 4 modes, in 'normal' ('Patrol', 16 nodes) "
+    assert ("tree runner  /cyborg/bt/tree_runner: 4 modes, in 'normal' ('Patrol', 24 nodes) "
             "from campus.modes.toml") in out
-    assert "Patrol > Sequence > Repeat -1x > MemSequence > MoveTo Lecture hall" in out
+    assert ("Patrol > Sequence > Repeat -1x > Greet or patrol > Patrol round > "
+            "MoveTo Lecture hall") in out
     assert "MoveTo Library" in out, "the robot got to the lecture hall and went on"
 
 
