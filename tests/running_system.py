@@ -13,6 +13,7 @@ from typing import Any
 
 from cyborg.app.launch import Launch, LaunchDescription
 from cyborg.bus import BusConfig, Context, Node, new_message
+from cyborg.bus.actions import ActionServer, GoalStatus
 from cyborg.bus.component import NodeSpec
 from cyborg.runner.component import RunningTree
 from cyborg.runner.tree_runner import TreeRunnerNode
@@ -60,6 +61,15 @@ class System:
         self.launch.running.append(new)
         return new
 
+    def goals(self) -> list[tuple[str, GoalStatus]]:
+        """Every goal the simulator's navigator was given, in order: its name and status."""
+        simulator = self._simulator()
+        with simulator.loop.lock:
+            server = next(entity for entity in simulator.node._entities
+                          if isinstance(entity, ActionServer))
+            return [(str(goal.request.goal_name), goal.status)
+                    for goal in server._goals.values()]
+
     def uid(self, label: str) -> str:
         """The id of the one node with this label."""
         found = [node.uid for node in self.runner.tree if node.label == label]
@@ -80,11 +90,19 @@ def wait_until(predicate: Callable[[], object], timeout: float = 30.0,
 def running_system(map_path: Path, tree_path: Path, *, speed: float = 20.0,
                    battery: float = 100.0, start: str = "", rate: float = 10.0,
                    registry_modules: list[str] | None = None,
-                   simulator: bool = True) -> Iterator[System]:
+                   simulator: bool = True,
+                   sim_parameters: dict[str, Any] | None = None,
+                   tracker: bool = False) -> Iterator[System]:
     """The simulator (unless not ``simulator``: then the tree runs on wall-clock time, its robot
-    missing) and a tree runner under ``/cyborg``, on an isolated bus."""
+    missing) and a tree runner under ``/cyborg``, on an isolated bus.
+
+    ``sim_parameters`` adds to the simulator's (``people``, ``camera`` ...); with ``tracker``
+    the tracker runs beside them on simulated time, as ``cyborg up`` starts it with the
+    simulated camera.
+    """
     with Context(BusConfig.isolated()) as context:
-        sim: dict[str, Any] = {"map": str(map_path), "speed": speed, "battery": battery}
+        sim: dict[str, Any] = {"map": str(map_path), "speed": speed, "battery": battery,
+                               **(sim_parameters or {})}
         if start:
             sim["start"] = start
         tree: dict[str, Any] = {"tree_file": str(tree_path), "use_sim_time": simulator,
@@ -93,7 +111,9 @@ def running_system(map_path: Path, tree_path: Path, *, speed: float = 20.0,
             tree["nodes"] = registry_modules
         launch = Launch(LaunchDescription([
             *([NodeSpec("simulator", "arnl", "/cyborg", sim)] if simulator else []),
-            NodeSpec("tree_runner", "tree_runner", "/cyborg/bt", tree)]), context)
+            NodeSpec("tree_runner", "tree_runner", "/cyborg/bt", tree),
+            *([NodeSpec("tracker", "tracker", "/cyborg", {"use_sim_time": True})]
+              if tracker else [])]), context)
         launch.start()
         try:
             yield System(context, launch, Node("tester", "/test", context=context))

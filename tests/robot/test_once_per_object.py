@@ -37,7 +37,7 @@ def test_each_person_is_greeted_once_within_the_cooldown() -> None:
     for _ in range(5):  # the person stays in front of the robot
         clock.advance(1.0)
         assert tree.tick().status is FAILURE
-    robot.seen = [person(2)]  # someone else, 5 s after the first greeting: too soon
+    robot.seen = [person(2, x=4.5)]  # someone else, 5 s after the first greeting: too soon
     assert tree.tick().status is FAILURE
     clock.advance(5.0)
     assert tree.tick().status is SUCCESS
@@ -54,7 +54,33 @@ def test_without_a_gap_people_are_greeted_one_after_the_other() -> None:
     robot, clock = FakeRobot(pose=Pose2D(0.0, 0.0, 0.0), seen=[person(1)]), ManualClock()
     tree = robot_tree(greeting(gap=0), robot, clock)
     assert tree.tick().status is SUCCESS
-    robot.seen = [person(2)]
+    robot.seen = [person(2, x=4.5)]
+    assert tree.tick().status is SUCCESS
+    assert robot.said == ["Hello 1!", "Hello 2!"]
+
+
+def test_a_new_id_where_someone_greeted_was_last_seen_is_that_someone() -> None:
+    robot, clock = FakeRobot(pose=Pose2D(0.0, 0.0, 0.0), seen=[person(1)]), ManualClock()
+    tree = robot_tree(greeting(gap=0), robot, clock)
+    assert tree.tick().status is SUCCESS
+    for step in range(1, 4):  # they walk away, seen, 1.5 m a second
+        clock.advance(1.0)
+        robot.seen = [person(1, x=1.5 + 1.5 * step)]
+        assert tree.tick().status is FAILURE
+    clock.advance(3.0)  # lost, and found again as a new object near where last seen
+    robot.seen = [person(5, x=7.0)]
+    assert tree.tick().status is FAILURE, "5.5 m from the greeting, 1 m from where last seen"
+    assert robot.said == ["Hello 1!"]
+    clock.advance(54.0)  # 60 s after the greeting of the person they are
+    assert tree.tick().status is SUCCESS
+    assert robot.said == ["Hello 1!", "Hello 5!"]
+
+
+def test_with_near_0_only_ids_count() -> None:
+    robot, clock = FakeRobot(pose=Pose2D(0.0, 0.0, 0.0), seen=[person(1)]), ManualClock()
+    tree = robot_tree(greeting(gap=0, near=0), robot, clock)
+    assert tree.tick().status is SUCCESS
+    robot.seen = [person(2)]  # a new id at the same place
     assert tree.tick().status is SUCCESS
     assert robot.said == ["Hello 1!", "Hello 2!"]
 
@@ -115,7 +141,7 @@ def test_a_clock_that_goes_back_forgets_who_was_greeted() -> None:
 
 
 @pytest.mark.parametrize("properties", [{"key": ""}, {"seconds": -1}, {"gap": math.nan},
-                                        {"gap": "soon"}])
+                                        {"gap": "soon"}, {"near": -0.5}])
 def test_bad_properties_are_refused_at_load_naming_them(properties: dict[str, Any]) -> None:
     with pytest.raises(TreeLoadError, match=next(iter(properties))):
         robot_tree(N("OncePerObject", N("Succeeder"), **properties), FakeRobot())

@@ -20,7 +20,7 @@ import pytest
 
 from cyborg.app.up import CAMPUS_MAP, CAMPUS_MODES, DATA
 from cyborg.bt.snapshot import TickSnapshot
-from cyborg.bus.actions import ActionServer, GoalStatus
+from cyborg.bus.actions import GoalStatus
 from cyborg.bus.msgs.cyborg_msgs.msg import ModeTransition
 from cyborg.bus.msgs.cyborg_msgs.srv import SetMode
 from cyborg.bus.msgs.std_msgs.msg import String
@@ -30,7 +30,6 @@ from cyborg.interfaces.modes import ModeAction
 from cyborg.modes import ModeMachine, Transition
 from cyborg.robot.settling_robot import SettlingBusRobot
 from cyborg.runner.component import RunningTree
-from cyborg.sim.component import RunningSimulator
 from tests.running_system import System, running_system, wait_until
 
 TREES = "/cyborg/bt"
@@ -70,16 +69,6 @@ class Watch:
             return machine.mode == until
 
         wait_until(taken, WAIT, f"the event {event!r} to lead to {until}")
-
-
-def _goals(system: System) -> list[tuple[str, GoalStatus]]:
-    """Every goal the simulator's navigator was given: its name and how it ended."""
-    simulator = next(item for item in system.launch.running
-                     if isinstance(item, RunningSimulator))
-    with simulator.loop.lock:
-        server = next(entity for entity in simulator.node._entities
-                      if isinstance(entity, ActionServer))
-        return [(str(goal.request.goal_name), goal.status) for goal in server._goals.values()]
 
 
 @pytest.mark.heavy
@@ -135,7 +124,7 @@ def test_the_bundled_mission_goes_through_every_mode() -> None:
         wait_until(lambda: bool(watch.help), WAIT, "a call for help")
         stopped_at = system.sim.time
         wait_until(lambda: system.sim.time > stopped_at + 60.0, WAIT, "a simulated minute")
-        goals_in_critical = _goals(system)
+        goals_in_critical = system.goals()
         watch.fire(machine, "help_arrived", "normal")
         wait_until(lambda: len(watch.transitions) >= 6, WAIT, "every transition on the bus")
 
