@@ -7,7 +7,8 @@ import json
 import re
 from pathlib import Path
 
-from cyborg.app.up import CAMPUS_MODES, DATA
+from cyborg.app.cli import build_parser
+from cyborg.app.up import CAMPUS_MODES, DATA, up_notes
 from cyborg.bt import Blackboard, ManualClock
 from cyborg.modes import load_machine, read_mode_file
 from cyborg.nav.geometry import Pose2D
@@ -84,3 +85,15 @@ def test_the_patrol_greets_a_person_once_and_drives_on_to_the_goal_it_was_drivin
     assert [move.goal for move in robot.moves] == ["Lecture hall", "Library", "Library"], \
         "the round resumes at the goal it was driving to"
     assert not robot.moves[-1].cancelled
+
+
+def test_cyborg_up_says_where_to_hear_the_greetings_when_people_and_the_camera_are_there(
+) -> None:
+    def notes(*options: str) -> str:
+        return "\n".join(up_notes(build_parser().parse_args(["up", *options])))
+
+    assert "`cyborg topic echo /cyborg/say`" in notes()
+    assert "/robotN/say" in notes("--robots", "2")
+    for options in (["--people", "0"], ["--no-detector"], ["--camera", "real"],
+                    ["--tree", "x.b3.json"]):
+        assert "/say" not in notes(*options), options

@@ -192,7 +192,8 @@ def up_notes(args: argparse.Namespace) -> list[str]:
 
     On the bundled mission at the defaults they say too when its modes change, how to see
     the demo and critical modes, and how to choose otherwise (a recharge is seven hours away
-    at real time on a full battery).
+    at real time on a full battery); with people and the simulated camera, where to hear the
+    patrol greet them.
     """
     pace = "as fast as possible" if args.speed == 0 else f"{args.speed:g}x real time"
     lines = [f"pace         {pace} (--speed), battery at {args.battery:g} % (--battery)"]
@@ -214,6 +215,10 @@ def up_notes(args: argparse.Namespace) -> list[str]:
                   "ended by",
                   "             `help_arrived` (docs/modes.md)",
                   f"             --speed {sim.SPEED:g} --battery {sim.BATTERY:g}: real time"]
+    if args.tree is None and args.people > 0 and simulated_camera(args)["camera"]:
+        speaker = args.namespace if args.robots == 1 else "/robotN"
+        lines += ["greeting     the patrol turns to people within 2 m and says hello:",
+                  f"             `cyborg topic echo {speaker.rstrip('/')}/say`"]
     return lines
 
 
