@@ -21,6 +21,7 @@ class FakeMove:
     message: str = ""
     remaining: float = math.inf
     cancelled: bool = False
+    waiting: bool = False
 
     @property
     def done(self) -> bool:

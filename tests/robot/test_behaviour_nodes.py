@@ -95,6 +95,21 @@ def test_stall_cancels_and_retries_then_fails(caplog: pytest.LogCaptureFixture) 
     assert "no progress along the path for 10 s; tried 3 times" in caplog.text
 
 
+def test_a_robot_waiting_for_someone_to_make_way_is_not_stalled() -> None:
+    robot, clock = FakeRobot(), ManualClock()
+    tree = robot_tree(N("MoveTo", location="home", retries=0), robot, clock)
+    tick = tree.tick()
+    robot.moves[0].remaining = 20.0
+    run(tree, clock, 1.0)
+    robot.moves[0].waiting = True  # a person stands in the only way
+    statuses = run(tree, clock, 60.0)
+    assert set(statuses) == {RUNNING} and not robot.moves[0].cancelled
+    robot.moves[0].waiting = False  # the way is open again, yet nothing moves
+    statuses = run(tree, clock, 16.0)
+    assert FAILURE in statuses and robot.moves[0].cancelled, "the stall timer runs again"
+    assert tick.status is RUNNING
+
+
 def test_a_failed_move_is_retried_but_no_path_fails_at_once() -> None:
     robot, clock = FakeRobot(no_path_to={"kitchen"}), ManualClock()
     tree = robot_tree(N("MoveTo", location="home", retries=1), robot, clock)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
@@ -38,8 +39,10 @@ limited = RateLimitedLog(log)
 class BusMove:
     """A move_to_goal goal in progress."""
 
-    def __init__(self, handle: ClientGoal | None, goal: str, error: str = "") -> None:
+    def __init__(self, handle: ClientGoal | None, goal: str, error: str = "",
+                 path_state: Callable[[], str] = str) -> None:
         self.goal = goal
+        self._path_state = path_state
         self._handle = handle
         self._error = error
         self._remaining = math.inf
@@ -88,6 +91,11 @@ class BusMove:
         """Metres left along the planned path, from the last feedback (inf before any)."""
         return self._remaining
 
+    @property
+    def waiting(self) -> bool:
+        """Whether the robot's path state says it waits for people or objects to make way."""
+        return not self.done and self._path_state() == robot.PathState.WAITING_FOR_PATH
+
     def cancel(self) -> None:
         """Sends a cancel request once, on the bus's call pool; a failure is only logged."""
         handle = self._handle
@@ -118,6 +126,8 @@ class BusRobot:
         self._lock = threading.Lock()
         robot.POSE.subscription(node, self._on_pose, namespace)
         robot.BATTERY_STATUS.subscription(node, self._on_battery, namespace)
+        self._path_state = ""
+        robot.PATH_STATE.subscription(node, self._on_path_state, namespace)
         self._clients = {service.name: service.client(node, namespace) for service in (
             robot.AVAILABLE_GOALS, robot.DISTANCE_TO_GOAL, robot.CLOSEST_GOAL, robot.DOCK,
             robot.UNDOCK, robot.STOP)}
@@ -128,6 +138,9 @@ class BusRobot:
     # ------------------------------------------------------------------ state
     def _on_pose(self, message: Any) -> None:
         self._pose = Pose2D.from_message(message)
+
+    def _on_path_state(self, message: Any) -> None:
+        self._path_state = str(message.data)
 
     def _on_battery(self, message: Any) -> None:
         try:
@@ -182,7 +195,7 @@ class BusRobot:
         """Sends a move_to_goal goal; raises RobotError if it cannot be sent or is rejected."""
         message = robot.MOVE_TO_GOAL.action_type.Goal(
             goal_name=goal, pose=Pose2D().to_message(), use_heading=False)
-        move = BusMove(None, goal)
+        move = BusMove(None, goal, path_state=lambda: self._path_state)
         try:
             move._handle = self._action.send_goal(message, feedback=move.on_feedback,
                                                   timeout=self.timeout)

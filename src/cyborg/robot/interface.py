@@ -70,6 +70,13 @@ class Move(Protocol):
     def remaining(self) -> float:
         """Metres left along the planned path, from the last feedback (inf before any)."""
         ...
+    @property
+    def waiting(self) -> bool:
+        """Whether the robot stands waiting for people or objects to make way.
+
+        Its path state is ``WAITING_FOR_PATH``; no progress is due meanwhile.
+        """
+        ...
     def cancel(self) -> None:
         """Ask the robot to stop this move (in the background); harmless when done."""
         ...

@@ -10,8 +10,9 @@ the move_to_goal action (the robot turns to the goal's heading when the map give
   feedback) must get shorter. A detour around an obstacle therefore still counts as
   progress. Without progress for ``start_timeout`` seconds after a start, or
   ``progress_timeout`` seconds after the last progress, the move is cancelled and sent again,
-  at most ``retries`` times, and then the node fails. While the robot is docking or undocking
-  the timer waits;
+  at most ``retries`` times, and then the node fails. While the robot is docking or undocking,
+  or waits for people or objects to make way (path state ``WAITING_FOR_PATH``: the robot's
+  navigator gives up on its own after its wait limit), the timer waits;
 * fails at once when the goal does not exist or cannot be reached (no path);
 * **backs off when the robot is not reachable** — the move_to_goal action server or the map's
   goal service is not there (the simulator was killed, the robot's computer restarts): it stays
@@ -143,6 +144,8 @@ class MoveTo(Action):
         if battery is not None and battery.dock_state not in (DockState.UNDOCKED,
                                                               DockState.UNKNOWN):
             self._deadline = max(self._deadline, self.now + self.start_timeout)
+        if move.waiting:  # for someone to make way: the robot's own wait limit applies
+            self._deadline = max(self._deadline, self.now + self.progress_timeout)
         if self.now > self._deadline:
             waited = self.progress_timeout if self._best < float("inf") else self.start_timeout
             return self._retry(f"no progress along the path for {waited:g} s")
