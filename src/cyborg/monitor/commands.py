@@ -63,6 +63,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections.abc import Awaitable
 from typing import Any
 
 from cyborg.monitor.client import Client
@@ -144,10 +145,12 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         await _robot_command(hub, client, kind, command)
         return
     if kind in PLAYER_COMMANDS:
-        await _player_command(hub, client, kind, command)
+        await _link_command(client, kind, command, hub.player.handle(client, kind, command),
+                            PlayerCommandError, PlayerError)
         return
     if kind in MODE_COMMANDS:
-        await _mode_command(hub, client, kind, command)
+        await _link_command(client, kind, command, hub.modes.handle(client, kind, command),
+                            ModeCommandError, ModeError)
         return
     if kind == "hello":
         secret = command.get("seat")
@@ -208,30 +211,22 @@ async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str,
         client.send({**answer, "ok": True, **done})
 
 
-async def _player_command(hub: Hub, client: Client, kind: str,
-                          command: dict[str, Any]) -> None:
-    """A command to the player (:mod:`cyborg.monitor.player_link`), answered with ``result``."""
+async def _link_command(client: Client, kind: str, command: dict[str, Any],
+                        handled: Awaitable[str],
+                        refused: type[PlayerCommandError | ModeCommandError],
+                        failed: type[Exception]) -> None:
+    """A command to a link (the player's, a mode machine's), answered with ``result``.
+
+    ``handled`` is the link's handling of it; ``refused`` is the link's error for a bad field
+    (named in the answer), ``failed`` its error when the bus side refused or did not answer.
+    """
     answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
     try:
-        message = await hub.player.handle(client, kind, command)
-    except PlayerCommandError as exc:
+        message = await handled
+    except refused as exc:
         client.send({**answer, "ok": False, "field": exc.field,
                      "message": located_error(client, command, exc)["message"]})
-    except PlayerError as exc:
-        client.send({**answer, "ok": False, "field": None, "message": str(exc)})
-    else:
-        client.send({**answer, "ok": True, "message": message})
-
-
-async def _mode_command(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
-    """A command to a mode machine (:mod:`cyborg.monitor.mode_link`), answered with ``result``."""
-    answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
-    try:
-        message = await hub.modes.handle(client, kind, command)
-    except ModeCommandError as exc:
-        client.send({**answer, "ok": False, "field": exc.field,
-                     "message": located_error(client, command, exc)["message"]})
-    except ModeError as exc:
+    except failed as exc:
         client.send({**answer, "ok": False, "field": None, "message": str(exc)})
     else:
         client.send({**answer, "ok": True, "message": message})
