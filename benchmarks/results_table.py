@@ -8,17 +8,27 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+COLUMNS = ("measure", "result", "ratio", "goal")
+"""The four columns' names, in the Markdown table's header."""
+
 
 def print_results(header: str, rows: Sequence[tuple[str, str, str, str]], *, markdown: bool,
-                  widths: tuple[int, int, int]) -> None:
-    """Prints ``header`` and ``rows``; ``widths``: the measure's, the result's, the ratio's."""
+                  widths: tuple[int, int, int],
+                  columns: tuple[str, str, str, str] = COLUMNS) -> None:
+    """Prints ``header`` (nothing when empty) and ``rows``.
+
+    ``widths``: the measure's, the result's and the ratio's in plain text; ``columns`` names
+    the Markdown table's columns.
+    """
     if markdown:
-        print(header + "\n")
-        print("| measure | result | ratio | goal |\n| --- | --: | --: | --- |")
+        if header:
+            print(header + "\n")
+        print("| " + " | ".join(columns) + " |\n| --- | --: | --: | --- |")
         for row in rows:
             print("| " + " | ".join(row) + " |")
         return
-    print(header)
+    if header:
+        print(header)
     name_width, value_width, ratio_width = widths
     for name, value, ratio, goal in rows:
         print(f"  {name:<{name_width}} {value:>{value_width}}  {ratio:<{ratio_width}} {goal}")

@@ -1,6 +1,6 @@
 """Simulation speed and planning time on columbia.map (an ARNL map in ../shared/maps).
 
-    python3 benchmarks/sim_nav.py [--quick] [--markdown] [--map PATH]
+    python3 -m benchmarks.sim_nav [--quick] [--markdown] [--map PATH]
 
 * **simulation**: the robot patrols the map's goals with the laser on (541 beams, 270°, 30 m;
   physics 50 Hz, laser and navigation 10 Hz); result in simulated seconds per wall second.
@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
@@ -161,13 +162,8 @@ def main() -> None:
         ("planning, three people on each path: worst ms", f"{max(with_people) * 1000:.1f}", "",
          ""),
     ]
-    if args.markdown:
-        print("| measurement | value | ratio | note |\n| --- | --: | --: | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
-    else:
-        for name, value, ratio, note in rows:
-            print(f"{name:58} {value:>9} {ratio:>30}  {note}")
+    print_results("", rows, markdown=args.markdown, widths=(58, 9, 30),
+                  columns=("measurement", "value", "ratio", "note"))
     print(f"\nsimulation {ours:.0f}x real time (goal >= 200x: {'met' if ours >= 200 else 'NOT met'}"
           f"); worst plan {max(times) * 1000:.1f} ms (goal <= 50 ms: "
           f"{'met' if max(times) <= 0.05 else 'NOT met'}); with three people on the path "

@@ -1,6 +1,6 @@
 """Simulation speed with people walking and the simulated camera on (columbia.map in ../shared).
 
-    python3 benchmarks/sim_people.py [--quick] [--markdown] [--map PATH] [--people N]
+    python3 -m benchmarks.sim_people [--quick] [--markdown] [--map PATH] [--people N]
 
 The robot patrols the map's goals, as in benchmarks/sim_nav.py (laser 541 beams, physics 50 Hz,
 laser and navigation 10 Hz), with 10 people walking at random among the goals (0.5 to 1.5 m/s,
@@ -21,6 +21,7 @@ import os
 import time
 from pathlib import Path
 
+from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from cyborg.sim.camera import SimCamera
 from cyborg.sim.people import Crowd
@@ -105,13 +106,8 @@ def main() -> None:
         ("the same, per CPU second", f"{base.cpu_speed:.0f}x", "1.00x baseline",
          "sim time / process CPU time"),
     ]
-    if args.markdown:
-        print("| measurement | value | ratio | note |\n| --- | --: | --: | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
-    else:
-        for name, value, ratio, note in rows:
-            print(f"{name:52} {value:>7} {ratio:>16}  {note}")
+    print_results("", rows, markdown=args.markdown, widths=(52, 7, 16),
+                  columns=("measurement", "value", "ratio", "note"))
     print(f"\nsimulation with {args.people} people and the camera {ours.speed:.0f}x real time, "
           f"{ours.cpu_speed:.0f}x per CPU second "
           f"(goal >= 200x: {'met' if ours.cpu_speed >= 200 else 'NOT met'}; load average "
