@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cyborg.nav.footprint import PIONEER_LX
 from cyborg.nav.geometry import Pose2D
@@ -115,3 +117,27 @@ def test_far_outlines_are_not_measured_but_near_ones_are_exactly() -> None:
     assert base.robots_gap(base.pose, below=0.1) >= 0.1  # both are further: none measured
     base.others = (far,)  # a new tuple: the bounding circles follow
     assert base.robots_gap(base.pose) > 5.0
+
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.floats(0.5, 9.5), y=st.floats(0.5, 9.5), theta=st.floats(-math.pi, math.pi),
+       below=st.floats(0.05, 3.0), others=st.lists(
+           st.tuples(st.floats(0.0, 10.0), st.floats(0.0, 10.0), st.floats(-math.pi, math.pi)),
+           min_size=1, max_size=4))
+def test_the_gap_to_others_is_exact_below_the_limit_wherever_the_body_moved_since(
+        x: float, y: float, theta: float, below: float,
+        others: list[tuple[float, float, float]]) -> None:
+    """The base keeps a bound from where it first measured the others (it skips measuring
+    while the nearest is surely further than asked); after a move anywhere, what it returns
+    is still the exact gap when that is below the limit, and at least the limit otherwise."""
+    clearance = np.full((200, 200), 10.0)
+    base = RobotBase(clearance, (0.0, 0.0), 0.05, pose=Pose2D(5.0, 5.0, 0.0))
+    base.others = tuple(square(*other) for other in others)
+    base.robots_gap(base.pose, below=below)  # the bound is taken here
+    moved = Pose2D(x, y, theta)
+    exact = nearest_gap(outline_at(PIONEER_LX.polygon(), moved), list(base.others))
+    gap = base.robots_gap(moved, below=below)
+    if exact < below:
+        assert gap == pytest.approx(exact)
+    else:
+        assert gap >= below

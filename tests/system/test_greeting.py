@@ -73,7 +73,9 @@ class Watch:
         leaf = self._labels.get(snapshot.active[-1], "") if snapshot.active else ""
         greeted = (self._say, SUCCESS) in snapshot.visited
         sim = self.system.sim
-        pose, people, now = sim.pose, sim.people, sim.time
+        crowd = sim.crowd
+        assert crowd is not None
+        pose, people, now = sim.pose, crowd.positions, sim.time
         x, y = float(people[0][0]), float(people[0][1])
         distance = math.hypot(x - pose.x, y - pose.y)
         with self.lock:

@@ -39,8 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cyborg.interfaces.perception import CAMERA, CAMERA_MOUNT
-from cyborg.sim.bodies import cast_onto, cast_onto_circles_at
-from cyborg.sim.laser import cast_rays
+from cyborg.sim.camera_view import frame_view
 from cyborg.sim.sights import Sights
 
 
@@ -98,6 +97,8 @@ class SeenObject:
 
 RAY_SPREAD = 0.7
 """Where the side rays of the occlusion test aim: this share of the radius off the centre."""
+NO_OUTLINES, NO_STARTS, NO_CIRCLES = np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros((0, 3))
+"""No other bodies: no outlines' corners, the start of none, no round bodies."""
 
 
 class SimCamera:
@@ -138,50 +139,30 @@ class SimCamera:
         if not sights.labels:
             return []
         cx, cy = self.where(x, y, theta)
-        offset = sights.positions - (cx, cy)
-        distance = np.hypot(offset[:, 0], offset[:, 1])
-        bearing = (np.arctan2(offset[:, 1], offset[:, 0]) - theta + math.pi) % (2 * math.pi) \
-            - math.pi
-        view = ((np.abs(bearing) <= spec.field_of_view / 2) & (distance >= spec.range_min)
-                & (distance <= spec.range_max))
-        chosen = np.flatnonzero(view)
+        outlines, starts = NO_OUTLINES, NO_STARTS
+        if bodies:
+            corners = [np.asarray(outline, dtype=np.float64).reshape(-1, 2) for outline in bodies]
+            outlines = np.concatenate(corners)
+            starts = np.cumsum([0] + [len(outline) for outline in corners])
+        chosen, distance, bearing, visible = frame_view(
+            np.ascontiguousarray(sights.positions, dtype=np.float64),
+            np.ascontiguousarray(sights.radii, dtype=np.float64), cx, cy, theta,
+            spec.field_of_view / 2, spec.range_min, spec.range_max, RAY_SPREAD,
+            self.occupied, self.origin[0], self.origin[1], self.resolution, outlines, starts,
+            NO_CIRCLES if circles is None else np.ascontiguousarray(circles, dtype=np.float64))
         if len(chosen) == 0:
             return []
-        distance, bearing = distance[chosen], bearing[chosen]
-        radii = sights.radii[chosen]
-        hiding = np.column_stack([sights.positions, sights.radii])
-        if circles is not None and len(circles):
-            hiding = np.concatenate([hiding, circles])
-        visible = self._visible(cx, cy, theta + bearing, distance, radii, bodies, hiding)
         chance = spec.detection_chance(distance) * visible
         detected = self._random.random(len(chosen)) < chance
         found = np.flatnonzero(detected)
         noise = self._random.standard_normal((len(found), 4))  # distance, bearing, size, score
         seen = []
         for row, index in enumerate(found):
-            seen.append(self._report(sights.labels[chosen[index]], float(distance[index]),
-                                     float(bearing[index]), float(radii[index]),
-                                     float(sights.heights[chosen[index]]), noise[row]))
+            thing = chosen[index]
+            seen.append(self._report(sights.labels[thing], float(distance[index]),
+                                     float(bearing[index]), float(sights.radii[thing]),
+                                     float(sights.heights[thing]), noise[row]))
         return [item for item in seen if item is not None]
-
-    def _visible(self, cx: float, cy: float, angles: np.ndarray, distance: np.ndarray,
-                 radii: np.ndarray, bodies: Sequence[np.ndarray],
-                 circles: np.ndarray | None) -> np.ndarray:
-        """The share (0, 1/3, 2/3, 1) of each thing's three rays that reach it."""
-        side = np.arctan2(RAY_SPREAD * radii, distance)
-        rays = np.concatenate([angles - side, angles, angles + side])
-        reach = np.full(len(rays), np.inf)
-        cast_rays(self.occupied, self.origin[0], self.origin[1], self.resolution, cx, cy,
-                  rays, float(distance.max()) + 1.0, reach)
-        for outline in bodies:
-            cast_onto(np.ascontiguousarray(outline, dtype=np.float64), cx, cy, rays, reach)
-        if circles is not None and len(circles):
-            cast_onto_circles_at(np.ascontiguousarray(circles, dtype=np.float64), cx, cy, rays,
-                                 reach)
-        # a thing's own body is hit at its near side: at least this far means "reached it"
-        needed = np.tile(distance - 1.2 * radii, 3)
-        share: np.ndarray = (reach >= needed).reshape(3, -1).mean(axis=0)
-        return share
 
     def _report(self, label: str, distance: float, bearing: float, radius: float,
                 height: float, noise: np.ndarray) -> SeenObject | None:

@@ -13,24 +13,52 @@ from numba import njit
 
 
 @njit(cache=True)
-def in_the_way(here: np.ndarray, others: np.ndarray, radius: float,
-                look_ahead: float) -> np.ndarray:  # pragma: no cover - jit
-    """For each walker (x, y, heading): whether one of ``others`` (x, y, radius) is ahead.
+def in_the_way(here: np.ndarray, people: np.ndarray, radius: float, robots: np.ndarray,
+               look_ahead: float) -> np.ndarray:  # pragma: no cover - jit
+    """For each walker (x, y, heading): whether a person or a robot is ahead of them.
 
-    Ahead: along the heading by more than nothing and at most both radii plus ``look_ahead``,
-    and less than both radii plus 10 cm aside. A walker never blocks itself (distance 0).
+    ``people`` are (N, 2) positions of bodies of ``radius`` m (the walkers among them),
+    ``robots`` (M, 3) rows of x, y, radius. Ahead: along the heading by more than nothing and
+    at most both radii plus ``look_ahead``, and less than both radii plus 10 cm aside. A
+    walker never blocks itself (distance 0).
     """
     result = np.zeros(here.shape[0], np.bool_)
+    count = people.shape[0]
     for walker in range(here.shape[0]):
         ux, uy = math.cos(here[walker, 2]), math.sin(here[walker, 2])
-        for other in range(others.shape[0]):
-            rx, ry = others[other, 0] - here[walker, 0], others[other, 1] - here[walker, 1]
+        for other in range(count + robots.shape[0]):
+            if other < count:
+                ox, oy, reach = people[other, 0], people[other, 1], 2 * radius
+            else:
+                row = other - count
+                ox, oy, reach = robots[row, 0], robots[row, 1], radius + robots[row, 2]
+            rx, ry = ox - here[walker, 0], oy - here[walker, 1]
             along = rx * ux + ry * uy
             across = abs(rx * uy - ry * ux)
-            reach = radius + others[other, 2]
             if 1e-9 < along <= reach + look_ahead and across < reach + 0.1:
                 result[walker] = True
                 break
+    return result
+
+
+@njit(cache=True)
+def in_robots_way(people: np.ndarray, x: float, y: float, need: float, heading: float,
+                  ahead: float) -> np.ndarray:  # pragma: no cover - jit
+    """Which of ``people`` ((N, 2) positions) must make room for a robot at ``(x, y)``.
+
+    Those closer than ``need`` m (centre to centre), and, with a finite ``heading`` (rad; nan
+    for none), those ahead of it: along the heading by more than nothing and at most
+    ``ahead`` m, and less than ``need`` aside.
+    """
+    result = np.zeros(people.shape[0], np.bool_)
+    ux, uy = math.cos(heading), math.sin(heading)
+    for index in range(people.shape[0]):
+        dx, dy = people[index, 0] - x, people[index, 1] - y
+        if math.hypot(dx, dy) < need:
+            result[index] = True
+        elif not math.isnan(heading):
+            along, across = dx * ux + dy * uy, uy * dx - ux * dy
+            result[index] = 0.0 < along <= ahead and abs(across) < need
     return result
 
 

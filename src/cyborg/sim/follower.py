@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from cyborg.nav.geometry import Path, Pose2D, normalize_angle
 
@@ -161,15 +162,24 @@ def front_ranges(ranges: np.ndarray, angles: np.ndarray, half_widths: tuple[floa
     One projection of the scan serves all of them; inf where a corridor is clear. Returns
     beyond ``range_max`` count as nothing seen.
     """
-    valid = ranges <= range_max
-    ahead = valid & (np.abs(angles) < math.pi / 2)
-    if not ahead.any():
-        return tuple(math.inf for _ in half_widths)
-    x = ranges[ahead] * np.cos(angles[ahead])
-    side = np.abs(ranges[ahead] * np.sin(angles[ahead]))
-    found = []
-    for half_width in half_widths:
-        inside = side <= half_width
-        found.append(float(x[inside].min()) if inside.any() else math.inf)
-    return tuple(found)
+    found = _nearest_ahead(np.ascontiguousarray(ranges, dtype=np.float64),
+                           np.ascontiguousarray(angles, dtype=np.float64),
+                           np.array(half_widths, dtype=np.float64), range_max)
+    return tuple(float(value) for value in found)
+
+
+@njit(cache=True)
+def _nearest_ahead(ranges: np.ndarray, angles: np.ndarray, half_widths: np.ndarray,
+                   range_max: float) -> np.ndarray:  # pragma: no cover - jit
+    """:func:`front_ranges` on arrays: the nearest return ahead within each half width."""
+    found = np.full(half_widths.shape[0], np.inf)
+    for beam in range(ranges.shape[0]):
+        if not ranges[beam] <= range_max or abs(angles[beam]) >= math.pi / 2:
+            continue
+        along = ranges[beam] * math.cos(angles[beam])
+        side = abs(ranges[beam] * math.sin(angles[beam]))
+        for corridor in range(half_widths.shape[0]):
+            if side <= half_widths[corridor] and along < found[corridor]:
+                found[corridor] = along
+    return found
 

@@ -86,6 +86,24 @@ def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution
         out[beam] = hit * resolution if hit <= limit else np.inf
 
 
+@njit(cache=True)
+def beam_points(ranges: np.ndarray, relative: np.ndarray, x: float, y: float, theta: float,
+                range_max: float) -> np.ndarray:  # pragma: no cover - jit
+    """The (N, 2) points where beams from ``(x, y)`` with a range of at most ``range_max`` end.
+
+    Beam ``k`` leaves at ``theta + relative[k]``; the points keep the beams' order.
+    """
+    points = np.empty((ranges.shape[0], 2))
+    count = 0
+    for beam in range(ranges.shape[0]):
+        if ranges[beam] <= range_max:
+            angle = theta + relative[beam]
+            points[count, 0] = x + ranges[beam] * math.cos(angle)
+            points[count, 1] = y + ranges[beam] * math.sin(angle)
+            count += 1
+    return points[:count].copy()
+
+
 class Laser:
     """Scans an occupancy grid from a robot pose.
 
@@ -134,9 +152,5 @@ class Laser:
     def points(self, x: float, y: float, theta: float, ranges: np.ndarray) -> np.ndarray:
         """The (N, 2) map points where beams with a valid range hit."""
         spec = self.spec
-        valid = ranges <= spec.range_max
-        sx = x + spec.mount_x * math.cos(theta)
-        sy = y + spec.mount_x * math.sin(theta)
-        angles = self._relative[valid] + theta
-        return np.column_stack([sx + ranges[valid] * np.cos(angles),
-                                sy + ranges[valid] * np.sin(angles)])
+        return beam_points(ranges, self._relative, x + spec.mount_x * math.cos(theta),
+                           y + spec.mount_x * math.sin(theta), theta, spec.range_max)

@@ -36,7 +36,7 @@ import numpy as np
 
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_points
-from cyborg.sim.crowd_geometry import in_the_way, line_clear
+from cyborg.sim.crowd_geometry import in_robots_way, in_the_way, line_clear
 from cyborg.sim.people_routes import Point, RouteBook
 from cyborg.sim.person import Gait, PeopleSettings, Person, PersonPlan
 
@@ -49,8 +49,9 @@ class Meeting(NamedTuple):
     """What one robot meets of a crowd: bodies near it, points along them, circles further off.
 
     ``bodies`` are the octagons (8 x 2 each, m) of the people within :data:`NEAR`, ``points``
-    (N x 2) lie along them, and ``circles`` ((M, 3): x, y, radius) are everybody within the
-    laser's reach.
+    (N x 2) lie along them, and ``circles`` ((M, 3): x, y, radius) are everybody else within
+    the laser's reach. (An octagon holds its person's circle: a beam reaches the octagon
+    first, so the laser that sees the bodies needs no circles of the same people.)
     """
 
     bodies: tuple[np.ndarray, ...]
@@ -121,11 +122,14 @@ class Crowd:
             return NOBODY
         positions = self.positions
         distance = np.hypot(positions[:, 0] - x, positions[:, 1] - y)
+        seen = positions[(distance <= reach) & (distance > NEAR)]
+        circles = np.empty((len(seen), 3))
+        circles[:, :2], circles[:, 2] = seen, self.settings.radius
         close = np.flatnonzero(distance <= NEAR)
+        if len(close) == 0:
+            return Meeting((), NOBODY.points, circles)
         near = tuple(positions[index] + self._octagon for index in close)
         points = (positions[close, None, :] + self._samples[None, :, :]).reshape(-1, 2)
-        seen = positions[distance <= reach]
-        circles = np.column_stack([seen, np.full(len(seen), self.settings.radius)])
         return Meeting(near, points, circles)
 
     def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float) -> Meeting:
@@ -139,10 +143,10 @@ class Crowd:
         """
         if planner is not self.routes.planner:
             return NOBODY
-        middle = outline.mean(axis=0)
-        front = (outline[0] + outline[-1]) / 2 - middle  # the middle of the front edge
+        middle = outline.sum(axis=0) / len(outline)
         walked = self.due(dt)
         if walked:
+            front = (outline[0] + outline[-1]) / 2 - middle  # the middle of the front edge
             self.advance(walked, [outline], [math.atan2(front[1], front[0])])
         return self.meeting(float(middle[0]), float(middle[1]), reach)
 
@@ -182,8 +186,9 @@ class Crowd:
             walking.append(person)
         circles = np.empty((len(robots), 3))
         for index, outline in enumerate(robots):
-            middle = outline.mean(axis=0)
-            circles[index] = middle[0], middle[1], np.max(np.hypot(*(outline - middle).T))
+            middle = outline.sum(axis=0) / len(outline)
+            circles[index, :2] = middle
+            circles[index, 2] = math.sqrt(float(np.max(np.sum((outline - middle) ** 2, axis=1))))
         if walking:
             for person, blocked in zip(walking, self._blocked(walking, circles), strict=True):
                 self._walk(person, dt, bool(blocked))
@@ -200,14 +205,11 @@ class Crowd:
         """
         s = self.settings
         for index, (cx, cy, radius) in enumerate(robots):
-            positions = self.positions  # as the robots before this one left them
-            dx, dy = positions[:, 0] - cx, positions[:, 1] - cy
             need = radius + s.radius + ROOM
-            touched = np.hypot(dx, dy) < need
-            if index < len(headings):  # ahead of it: within AHEAD along, and need aside
-                ux, uy = math.cos(headings[index]), math.sin(headings[index])
-                along, across = dx * ux + dy * uy, uy * dx - ux * dy
-                touched |= (along > 0.0) & (along <= AHEAD) & (np.abs(across) < need)
+            touched = in_robots_way(self.positions,  # as the robots before this one left them
+                                    cx, cy, need,
+                                    headings[index] if index < len(headings) else math.nan,
+                                    AHEAD)
             for person in (self.people[k] for k in np.flatnonzero(touched)):
                 self._room_for(person, cx, cy, need,
                                headings[index] if index < len(headings) else None, dt)
@@ -295,10 +297,8 @@ class Crowd:
         both bodies (and 10 cm) aside.
         """
         s = self.settings
-        positions = self.positions
-        others = np.column_stack([positions, np.full(len(positions), s.radius)])
         here = np.array([(p.x, p.y, p.heading) for p in walking])
-        return in_the_way(here, np.concatenate([others, robots]), s.radius, s.look_ahead)
+        return in_the_way(here, self.positions, s.radius, robots, s.look_ahead)
 
     def _arrive(self, person: Person) -> None:
         """Pause at the waypoint (or as near it as they got), then go on to the next."""

@@ -74,6 +74,8 @@ class RobotBase:
         self._circles = self.footprint.circles()
         # the circle around the outline's corners, about their mean (the body's circle)
         self._reach = float(np.max(np.hypot(*(self._polygon - self._polygon.mean(axis=0)).T)))
+        self._span = float(np.max(np.hypot(*self._polygon.T)))  # the body's reach from the pose
+        self._far: tuple[float, float, float] | None = None  # see robots_gap
         self._bounds: tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray, np.ndarray,
                             np.ndarray] = ((), np.zeros((0, 2)), np.zeros(1, np.int64),
                                            np.zeros((0, 2)), np.zeros(0))
@@ -125,7 +127,15 @@ class RobotBase:
             starts = np.cumsum([0, *(len(outline) for outline in self.others)])
             corners = np.ascontiguousarray(np.concatenate(self.others), dtype=np.float64)
             self._bounds = (self.others, corners, starts, *outline_bounds(corners, starts))
+            self._far = None
         _, corners, starts, middles, radii = self._bounds
+        if self._far is None:  # the others' nearest circle, from here: a bound for later poses
+            nearest = np.hypot(middles[:, 0] - pose.x, middles[:, 1] - pose.y) - radii
+            self._far = (pose.x, pose.y, float(nearest.min()) - self._span)
+        x, y, far = self._far
+        at_least = far - math.hypot(pose.x - x, pose.y - y)
+        if at_least >= below:  # nobody within reach: no need to measure (see the doc)
+            return at_least
         return float(gap_below(outline_at(self._polygon, pose), self._reach, corners, starts,
                                middles, radii, below))
 
