@@ -197,12 +197,15 @@ def test_calls_to_a_busy_service_are_refused_beyond_a_bound(
     now at most ``max_pending`` wait and the rest get "busy" at once, and the server serves
     again once the handler is free."""
     victim, attacker = pair
-    gate = threading.Event()
+    gate, started = threading.Event(), threading.Event()
     node = Node("slow_server", context=victim)
-    server = node.create_service("slow", "std_srvs/srv/Trigger",
-                                 lambda request: (gate.wait(20), new_message(
-                                     victim.types, "std_srvs/srv/Trigger_Response",
-                                     {"success": True}))[1])
+
+    def stuck(request: Any) -> Any:
+        started.set()
+        gate.wait(20)
+        return new_message(victim.types, "std_srvs/srv/Trigger_Response", {"success": True})
+
+    server = node.create_service("slow", "std_srvs/srv/Trigger", stuck)
     server.max_pending = 8
     until_served(attacker, "/slow")
     key = data_key(attacker.domain, "/slow", "std_srvs/srv/Trigger",
@@ -210,8 +213,11 @@ def test_calls_to_a_busy_service_are_refused_beyond_a_bound(
     payload = bytes(attacker.types.serialize(new_message(
         attacker.types, "std_srvs/srv/Trigger_Request", {}), "std_srvs/srv/Trigger_Request"))
     try:
-        pending = [attacker.session.get(key, payload=payload, attachment=forged(index + 1),
-                                        timeout=30) for index in range(40)]
+        first = attacker.session.get(key, payload=payload, attachment=forged(1), timeout=30)
+        assert started.wait(10), "the first call reaches the handler"  # it runs, none waits
+        pending = [first] + [attacker.session.get(key, payload=payload,
+                                                  attachment=forged(index + 1), timeout=30)
+                             for index in range(1, 40)]
         busy: list[str] = []
         deadline = time.monotonic() + 5
         while len(busy) < 31 and time.monotonic() < deadline:

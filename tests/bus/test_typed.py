@@ -24,6 +24,7 @@ from cyborg.bus import (
     ServerGoal,
     ServiceClient,
     Subscription,
+    action_client,
 )
 from cyborg.bus.codegen import TypesFromFiles
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
@@ -168,3 +169,30 @@ def test_a_typed_action(bus: Context) -> None:
     assert wait_for(lambda: feedback)
     assert isinstance(feedback[0], MoveToGoal_Feedback)
     assert np.isclose(feedback[0].current_pose.y, 2.0)
+
+
+def test_a_result_whose_request_was_lost_is_asked_for_again(
+        bus: Context, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The server holds a get_result request open until the goal ends; one lost on the way
+    (here: the server drops the first) no longer leaves the goal without a result for an hour:
+    the client asks again after RESULT_WAIT seconds and gets the kept result."""
+    monkeypatch.setattr(action_client, "RESULT_WAIT", 0.5)
+    answer, dropped = ActionServer._on_get_result, list[Any]()
+
+    def lose_the_first(server: Any, request: Any, responder: Any) -> None:
+        if not dropped:
+            dropped.append(responder)  # never answered
+            return
+        answer(server, request, responder)
+
+    monkeypatch.setattr(ActionServer, "_on_get_result", lose_the_first)
+    robot, user = Node("robot", context=bus), Node("user", context=bus)
+    robot.create_action_server("move", MoveToGoal, lambda goal: MoveToGoal.Result(
+        outcome=MoveToGoal_Result.SUCCEEDED, message=goal.request.goal_name))
+    client = user.create_action_client("move", MoveToGoal)
+    assert client.wait_for_server(5)
+    goal = client.send_goal(MoveToGoal.Goal(
+        goal_name="kitchen", pose=Pose2D(x=0.0, y=0.0, theta=0.0), use_heading=False))
+    status, result = goal.result(timeout=10)
+    assert dropped, "the first request was lost"
+    assert status is GoalStatus.SUCCEEDED and result.message == "kitchen"

@@ -29,6 +29,12 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("cyborg.bus")
 
+RESULT_WAIT = 30.0
+"""Seconds one get_result request waits for a running goal's end before it is asked again.
+
+The server holds the request open until the goal ends; should the request or its answer be
+lost on the way, asking again finds the result (the server keeps it), at most this late."""
+
 __all__ = ["ActionClient", "ClientGoal"]
 
 
@@ -50,7 +56,7 @@ class ClientGoal(Generic[ResultT, FeedbackT]):
         request = self.client._get_result_request(goal_id=goal_uuid(self.id))
         while not self._result.done():
             try:
-                response = self.client._get_result.call(request, timeout=3600.0)
+                response = self.client._get_result.call(request, timeout=RESULT_WAIT)
             except ServiceError as exc:
                 if self.client.closed:
                     self._result.set_exception(ActionError(f"{self.client.name}: client closed"))
