@@ -8,11 +8,24 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.bus.component import LaunchError, NodeSpec
-from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.builtin_interfaces.msg import Time
+from cyborg.bus.msgs.geometry_msgs.msg import (
+    Point,
+    Pose,
+    Pose2D,
+    PoseWithCovariance,
+    Quaternion,
+    Twist,
+    TwistWithCovariance,
+    Vector3,
+)
+from cyborg.bus.msgs.nav_msgs.msg import Odometry
+from cyborg.bus.msgs.std_msgs.msg import Header
 from cyborg.bus.wire import EntityKind
 from cyborg.interfaces import detector, perception, robot
 from cyborg.perception import component
@@ -79,6 +92,46 @@ def test_a_person_straight_ahead_is_published_on_the_map(bus: Context,
     assert (person.position.x, person.position.y) == pytest.approx((1.0 + mount + 2.0, 1.0))
     assert person.distance == pytest.approx(mount + 2.0) and person.bearing == pytest.approx(0)
     assert person.last_seen.sec == 10 and 0 < person.confidence <= 1
+
+
+def odometry(stamp: float, x: float, y: float, theta: float, frame: str = "map") -> Odometry:
+    """The robot at ``(x, y, theta)`` at ``stamp`` s, as the simulator's ``odom`` says it."""
+    whole = math.floor(stamp)
+    header = Header(stamp=Time(sec=whole, nanosec=round((stamp - whole) * 1e9)), frame_id=frame)
+    orientation = Quaternion(x=0.0, y=0.0, z=math.sin(theta / 2), w=math.cos(theta / 2))
+    pose = Pose(position=Point(x=x, y=y, z=0.0), orientation=orientation)
+    return Odometry(header=header, child_frame_id="base_link",
+                    pose=PoseWithCovariance(pose=pose, covariance=np.zeros(36)),
+                    twist=TwistWithCovariance(twist=Twist(
+                        linear=Vector3(x=0.0, y=0.0, z=0.0),
+                        angular=Vector3(x=0.0, y=0.0, z=0.0)), covariance=np.zeros(36)))
+
+
+def test_a_frame_is_placed_with_the_pose_at_its_stamp_not_the_newest(
+        bus: Context, tracker: RunningTracker) -> None:
+    """The robot turns from facing +x (stamp 20.0) to facing +y (stamp 20.2); a person 2 m
+    straight ahead in a frame stamped 20.0 that arrives after both poses is on the +x side,
+    one stamped 20.1 halfway (45 degrees). Odometry in another frame than the map is not
+    used; a frame stamped far from every odometry pose takes the newest ``pose``."""
+    peer = Peer(bus)
+    peer.wait_until_heard(tracker)  # the newest pose: (1, 1) facing +x
+    odom = robot.ODOM.publisher(peer.node)
+    assert wait_for(lambda: peer.node.context.graph.count(
+        robot.ODOM.full_name(ROBOT), EntityKind.SUBSCRIPTION), 20)
+    odom.publish(odometry(20.0, 0.0, 0.0, 0.0))
+    odom.publish(odometry(20.2, 0.0, 0.0, math.pi / 2))
+    odom.publish(odometry(20.2, 50.0, 50.0, 0.0, frame="odom"))  # drifting frame: left out
+    assert wait_for(lambda: len(tracker.tracker.history) == 2, 20)
+    reach = perception.CAMERA_MOUNT.x + 2.0
+    for label, stamp, where in (("person", 20.0, (reach, 0.0)),
+                                ("dog", 20.1, (reach / math.sqrt(2),) * 2),
+                                ("chair", 40.0, (1.0 + reach, 1.0))):
+        wanted = tracker.tracker.frames + 1  # each its own label: a new object where seen
+        peer.predictions.publish(predictions([prediction(label, 2.0)], stamp))
+        assert wait_for(lambda: tracker.tracker.frames == wanted, 20)  # noqa: B023
+        placed = [(item.x, item.y) for item in tracker.tracker.tracker.objects()
+                  if item.label == label]
+        assert placed == [pytest.approx(where, abs=1e-6)], (label, placed)
 
 
 def test_a_flood_and_bad_distances_are_counted_in_one_warning_without_a_traceback(

@@ -58,6 +58,7 @@ The enums' values come from the message definitions where those declare them
 
 from __future__ import annotations
 
+import math
 from enum import IntEnum, StrEnum
 
 from cyborg.bus.clock import CLOCK_TOPIC
@@ -148,6 +149,14 @@ TELEOP_TIMEOUT = 0.5
 Wall clock, not simulated time: the commands come from a person at the pace of the wall
 clock, and a simulation running 30 times faster would otherwise stop the robot between two
 of a 10 Hz sender's commands (MobileEyes' ratioDrive waits 2 s the same way)."""
+
+def yaw_of(x: float, y: float, z: float, w: float) -> float:
+    """The heading (rad) that the quaternion ``(x, y, z, w)`` turns about z.
+
+    ``odom`` and tf carry the robot's heading this way; the quaternion need not be normalised.
+    """
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
 
 BASE_FRAME = "base_link"
 """The robot's frame: x forward, y left, origin on the drive axle."""

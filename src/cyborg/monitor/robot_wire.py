@@ -38,6 +38,7 @@ from cyborg.bus.msgs.geometry_msgs.msg import PolygonStamped, Pose2D
 from cyborg.bus.msgs.nav_msgs.msg import Path
 from cyborg.bus.msgs.sensor_msgs.msg import LaserScan
 from cyborg.bus.msgs.tf2_msgs.msg import TFMessage
+from cyborg.interfaces import robot
 
 Warnings = list[str]
 
@@ -243,11 +244,6 @@ def footprint_wire(message: PolygonStamped) -> tuple[list[float] | None, Warning
     return [round(float(value), 3) for value in xy.reshape(-1)], []
 
 
-def _yaw(x: float, y: float, z: float, w: float) -> float:
-    """The rotation about z of the quaternion ``(x, y, z, w)`` (need not be normalised)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def transforms_wire(message: TFMessage) -> tuple[Transforms, Warnings]:
     """The transforms of a ``/tf_static`` message as ``{child: (parent, [x, y, θ])}``.
 
@@ -272,7 +268,7 @@ def transforms_wire(message: TFMessage) -> tuple[Transforms, Warnings]:
             warnings.append(f"tf: the transform {parent!r} -> {child!r} is not finite or longer "
                             f"than {BODY_LIMIT:g} m; left out")
             continue
-        found[child] = (parent, [x, y, _yaw(*rotation)])
+        found[child] = (parent, [x, y, robot.yaw_of(*rotation)])
     return found, warnings
 
 

@@ -1,15 +1,19 @@
 """The tracker on the bus: a robot's pose and its detector's predictions in, objects out.
 
-:class:`TrackerNode` subscribes to the robot's ``pose`` (:mod:`cyborg.interfaces.robot`) and
-to its detector's ``predictions`` (:mod:`cyborg.interfaces.detector`), and publishes the robot's
-``objects`` (:mod:`cyborg.interfaces.perception`):
+:class:`TrackerNode` subscribes to the robot's ``odom`` and ``pose``
+(:mod:`cyborg.interfaces.robot`) and to its detector's ``predictions``
+(:mod:`cyborg.interfaces.detector`), and publishes the robot's ``objects``
+(:mod:`cyborg.interfaces.perception`):
 
 * each predictions message is screened (:mod:`~cyborg.perception.screening`), placed on the
-  map from the robot's latest pose (:mod:`~cyborg.perception.sighting`; ``pose`` carries no
-  stamp, so the pose is the one known when the predictions arrive) and tracked
-  (:mod:`~cyborg.perception.tracker`) at the stamp of the image they were found in (else of
-  the message, else the time it came) — the camera's clock, which is ``/clock`` under
-  ``use_sim_time`` — and the objects are published at once;
+  map (:mod:`~cyborg.perception.sighting`) and tracked (:mod:`~cyborg.perception.tracker`) at
+  the stamp of the image they were found in (else of the message, else the time it came) —
+  the camera's clock, which is ``/clock`` under ``use_sim_time`` — and the objects are
+  published at once. The robot's pose is the one at that stamp, interpolated between the
+  stamped poses of ``odom`` in the map frame (:mod:`~cyborg.perception.pose_history`): a frame
+  taken while the robot turned is placed as the camera saw it, however late it comes. Without
+  an ``odom`` pose near the stamp (none published, another frame or another clock) it is the
+  newest ``pose``, which carries no stamp;
 * every :data:`REFRESH` s (wall time) the objects are forgotten and published again, so a list
   whose detector went quiet empties in time: the time then is the newest stamp plus what the
   node's clock counted since that frame came (so a detector stamping on another clock than
@@ -31,8 +35,10 @@ from collections.abc import Callable, Iterable
 from cyborg.bus import Node, Qos
 from cyborg.bus.msgs.cyborg_msgs.msg import Predictions
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
+from cyborg.bus.msgs.nav_msgs.msg import Odometry
 from cyborg.interfaces import detector, perception, robot
 from cyborg.perception.objects_message import objects_message, seconds_of
+from cyborg.perception.pose_history import PoseHistory
 from cyborg.perception.screening import MAX_PER_FRAME, Rejections, screen
 from cyborg.perception.sighting import RobotPose, locate
 from cyborg.perception.tracker import Tracker, TrackerSettings
@@ -68,6 +74,9 @@ class TrackerNode:
         self.labels = tuple(labels)
         self.limit = limit
         self.pose: RobotPose | None = None
+        """The newest ``pose``: the robot's pose for frames that the history does not cover."""
+        self.history = PoseHistory()
+        """The stamped poses of ``odom`` in the map frame, to place each frame at its stamp."""
         self.frames = 0
         """Predictions messages tracked."""
         self.dropped = Rejections()
@@ -77,6 +86,7 @@ class TrackerNode:
         self._tracked_at = 0.0  # the node's clock when the last frame was tracked
         self._publisher = perception.OBJECTS.publisher(node, robot_namespace)
         robot.POSE.subscription(node, self._on_pose, robot_namespace)
+        robot.ODOM.subscription(node, self._on_odom, robot_namespace)
         detector.PREDICTIONS.subscription(node, self._on_predictions, self.detector_namespace,
                                           qos=Qos.latched(QUEUE))
         self._timer = node.create_timer(REFRESH, self._refresh)
@@ -86,18 +96,27 @@ class TrackerNode:
         if all(math.isfinite(value) for value in values):
             self.pose = RobotPose(*values)
 
+    def _on_odom(self, message: Odometry) -> None:
+        if message.header.frame_id not in (robot.MAP_FRAME, ""):
+            return  # an odometry frame that drifts from the map: no place for objects
+        position, turn = message.pose.pose.position, message.pose.pose.orientation
+        values = (float(position.x), float(position.y),
+                  robot.yaw_of(float(turn.x), float(turn.y), float(turn.z), float(turn.w)))
+        if all(math.isfinite(value) for value in values):
+            self.history.add(seconds_of(message.header.stamp), RobotPose(*values))
+
     def _on_predictions(self, message: Predictions) -> None:
         detections, rejected = screen(message.predictions, labels=self.labels, limit=self.limit)
-        pose = self.pose
+        # when the frame was taken (the image's stamp), else when it was detected, else now
+        stamp = seconds_of(message.image_header.stamp) or seconds_of(message.header.stamp)
+        if not (math.isfinite(stamp) and stamp > 0):
+            stamp = self.now()
+        pose = self.history.at(stamp) or self.pose
         if pose is None:
             if detections:
                 rejected.counts[NO_POSE] += len(detections)
             self._count(rejected)
             return
-        # when the frame was taken (the image's stamp), else when it was detected, else now
-        stamp = seconds_of(message.image_header.stamp) or seconds_of(message.header.stamp)
-        if not (math.isfinite(stamp) and stamp > 0):
-            stamp = self.now()
         self._count(rejected)
         self.tracker.update(stamp, locate(detections, pose))
         self._tracked_at = self.now()
