@@ -243,19 +243,21 @@ function render(fromFrame = false) {
   }
   if (relaid) stats.drawMs = performance.now() - started;
   tickInfo();
-  // A task queued from the next animation frame runs once that frame has been rendered:
-  // stamp the paint there.
+  // A task queued from an animation frame runs once that frame has been rendered: stamp the
+  // paint there — from this frame when the render runs in one, else from the next.
   const tick = model.tick;
   const firstDraw = stats.firstPaint === null && stats.drawn > 0;
   if (firstDraw || stats.recordPaints) {
-    requestAnimationFrame(() => setTimeout(() => {
+    const stamp = () => {
       const now = performance.timeOrigin + performance.now();
       if (firstDraw && stats.firstPaint === null) {
         stats.firstPaint = now;
         mapPanel.load(); // the tree is on screen: now the map's code may come
       }
       if (stats.recordPaints) stats.paints.push([tick, now]);
-    }, 0));
+    };
+    if (fromFrame) setTimeout(stamp, 0);
+    else requestAnimationFrame(() => setTimeout(stamp, 0));
   }
 }
 
