@@ -27,16 +27,14 @@ except :meth:`ModeLink.notify`, which the bus calls from its threads.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import json
 import logging
-import math
-import time
 from collections.abc import Callable, Collection, Mapping
 from typing import Any
 
 from cyborg.interfaces.modes import ModeAction
 from cyborg.monitor.client import Client
+from cyborg.monitor.latest_state import LatestState
 from cyborg.monitor.limits import check_namespace
 from cyborg.monitor.mode_source import Listener, ModeError, ModeSource
 from cyborg.monitor.off_loop import ShutdownError, in_thread
@@ -80,10 +78,8 @@ class ModeLink:
         self._make: MakeSource | None = None
         self._discover: Callable[[], list[str]] = list
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._sent: dict[str, str] = {}
-        self._sent_at: dict[str, float] = {}
-        self._later: set[str] = set()
-        self._pending: set[str] = set()
+        self._state = LatestState[str](MODES_INTERVAL, lambda namespace: self._encode(
+            self.message(namespace)), self._deliver)
 
     def use(self, make_source: MakeSource, discover: Callable[[], list[str]]) -> None:
         """Follows machines from now on: ``discover()`` lists the runners that serve one."""
@@ -92,10 +88,12 @@ class ModeLink:
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         """Binds the link to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
+        self._state.attach(loop)
 
     def detach(self) -> None:
         """Lets go of the event loop as the server stops: changes are dropped from now on."""
         self._loop = None
+        self._state.detach()
 
     # ------------------------------------------------------------------ the machines
     async def periodic(self) -> None:
@@ -112,7 +110,7 @@ class ModeLink:
         for namespace in sorted(found):
             if namespace in self._trees and namespace not in self.sources:
                 self.sources[namespace] = self._make(namespace, self._notifier(namespace))
-                self._changed(namespace)
+                self._state.changed(namespace)
 
     def _release(self, namespace: str) -> None:
         source = self.sources.pop(namespace, None)
@@ -121,7 +119,7 @@ class ModeLink:
                 source.destroy()
             except Exception:
                 log.exception("could not stop following the modes of %s", namespace)
-        self._changed(namespace)
+        self._state.changed(namespace)
 
     def destroy(self) -> None:
         """Stops following every machine."""
@@ -134,12 +132,7 @@ class ModeLink:
 
     def notify(self, namespace: str) -> None:
         """Called from any thread when the machine under ``namespace`` changed, came or left."""
-        loop = self._loop
-        if loop is None or loop.is_closed() or namespace in self._pending:
-            return
-        self._pending.add(namespace)
-        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
-            loop.call_soon_threadsafe(self._changed, namespace)
+        self._state.notify(namespace)
 
     def message(self, namespace: str) -> dict[str, Any]:
         """The ``modes`` message for the tree under ``namespace`` now."""
@@ -151,29 +144,12 @@ class ModeLink:
         """Sends ``client``, which starts watching ``namespace``, its machine as it is now."""
         client.send(self._encode(self.message(namespace)))
 
-    def _changed(self, namespace: str) -> None:
-        self._pending.discard(namespace)
-        wait = self._sent_at.get(namespace, -math.inf) + MODES_INTERVAL - time.monotonic()
-        if wait > 0:
-            if namespace not in self._later and self._loop is not None:
-                self._later.add(namespace)
-                self._loop.call_later(wait, self._due, namespace)
-            return
-        text = self._encode(self.message(namespace))
-        if text == self._sent.get(namespace):
-            return
+    def _deliver(self, namespace: str, text: str) -> None:
         if self.sources.get(namespace) is None:
-            self._sent.pop(namespace, None)
-            self._sent_at.pop(namespace, None)
-        else:
-            self._sent[namespace], self._sent_at[namespace] = text, time.monotonic()
+            self._state.forget(namespace)  # a machine that comes back is sent at once
         for client in self._clients:
             if client.watching == namespace:
                 client.send(text)
-
-    def _due(self, namespace: str) -> None:
-        self._later.discard(namespace)
-        self._changed(namespace)
 
     @staticmethod
     def _encode(message: dict[str, Any]) -> str:

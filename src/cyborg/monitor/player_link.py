@@ -33,15 +33,14 @@ except :meth:`PlayerLink.notify`, which the bus calls from its threads.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import json
 import logging
 import math
-import time
 from collections.abc import Callable, Collection, Mapping
 from typing import Any
 
 from cyborg.monitor.client import Client
+from cyborg.monitor.latest_state import LatestState
 from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_source import Listener, PlayerError, PlayerSource
 from cyborg.monitor.robot_fields import short
@@ -56,6 +55,8 @@ BACKWARDS = 1e-3
 """Seconds the position must go back by to count as a jump (not rounding)."""
 PLAYER_COMMANDS = ("player_pause", "player_seek", "player_step")
 """The page's commands to the player."""
+PLAYER = "player"
+"""The one key of the player's state (a monitor follows one player)."""
 
 MakeSource = Callable[[str, Listener], PlayerSource]
 """``make(namespace, listener)``: follows the player under ``namespace``."""
@@ -88,10 +89,8 @@ class PlayerLink:
         self._position: float | None = None
         self._generations: dict[str, int] = {}
         """Each tree's structure generation at the previous state."""
-        self._sent = ""
-        self._sent_at = -math.inf
-        self._later = False
-        self._pending = False
+        self._state = LatestState[str](PLAYER_INTERVAL, lambda _key: json.dumps(
+            self.message(), separators=(",", ":")), self._deliver, self._look)
 
     def use(self, make_source: MakeSource, discover: Callable[[], list[str]]) -> None:
         """Follows players from now on: ``discover()`` lists their namespaces on the bus."""
@@ -100,10 +99,12 @@ class PlayerLink:
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         """Binds the link to the server's event loop; :meth:`notify` drops changes until then."""
         self._loop = loop
+        self._state.attach(loop)
 
     def detach(self) -> None:
         """Lets go of the event loop as the server stops: changes are dropped from now on."""
         self._loop = None
+        self._state.detach()
 
     # ------------------------------------------------------------------ the player
     async def periodic(self) -> None:
@@ -120,7 +121,7 @@ class PlayerLink:
         if self.source is None and found and self._loop is not None:
             self.source = self._make(found[0], self.notify)
             self._position = None
-            self._changed()
+            self._state.changed(PLAYER)
 
     def _release(self) -> None:
         source, self.source = self.source, None
@@ -129,7 +130,7 @@ class PlayerLink:
                 source.destroy()
             except Exception:
                 log.exception("could not stop following the player %s", source.namespace)
-        self._changed()
+        self._state.changed(PLAYER)
 
     def destroy(self) -> None:
         """Stops following the player."""
@@ -140,12 +141,7 @@ class PlayerLink:
     # ------------------------------------------------------------------ to the pages
     def notify(self) -> None:
         """Called from any thread when the player's state changed, or it came or left."""
-        loop = self._loop
-        if loop is None or loop.is_closed() or self._pending:
-            return
-        self._pending = True
-        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
-            loop.call_soon_threadsafe(self._changed)
+        self._state.notify(PLAYER)
 
     def message(self) -> dict[str, Any]:
         """The ``player`` message for the player's state now (``player`` null when none)."""
@@ -158,10 +154,10 @@ class PlayerLink:
 
     def resend(self, client: Client) -> None:
         """Sends ``client`` the player's state as the pages have it (a page saying hello)."""
-        client.send(self._sent or json.dumps(self.message(), separators=(",", ":")))
+        client.send(self._state.sent(PLAYER) or json.dumps(self.message(), separators=(",", ":")))
 
-    def _changed(self) -> None:
-        self._pending = False
+    def _look(self, _key: str) -> None:
+        """Every change, before any send: a played time gone back is a jump."""
         source = self.source
         view = source.view if source is not None else None
         if view is not None:
@@ -169,26 +165,10 @@ class PlayerLink:
                 self._jump()
             self._position = view.position
             self._generations = {name: tree.generation for name, tree in self._trees.items()}
-        self._send_due()
 
-    def _send_due(self) -> None:
-        """Sends the newest state if it changed: now, or once :data:`PLAYER_INTERVAL` passed."""
-        wait = self._sent_at + PLAYER_INTERVAL - time.monotonic()
-        if wait > 0:
-            if not self._later and self._loop is not None:
-                self._later = True
-                self._loop.call_later(wait, self._due)
-            return
-        text = json.dumps(self.message(), separators=(",", ":"))
-        if text == self._sent:
-            return
-        self._sent, self._sent_at = text, time.monotonic()
+    def _deliver(self, _key: str, text: str) -> None:
         for client in self._clients:
             client.send(text)
-
-    def _due(self) -> None:
-        self._later = False
-        self._send_due()
 
     def _jump(self) -> None:
         """The played time went back: the pages are told; trees not started over start over."""
@@ -224,7 +204,7 @@ class PlayerLink:
             position = seek_position(command.get("position"), view.duration)
             answer = await in_thread(source.seek, position)
             self.jumps += 1  # (its state, when it went back, clears what needs clearing)
-            self._send_due()
+            self._state.send_soon(PLAYER)
             return answer
         if kind == "player_step":
             return await in_thread(source.step)

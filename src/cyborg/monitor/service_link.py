@@ -16,14 +16,12 @@ except :meth:`ServiceLink.notify`, which the bus calls from its threads when a r
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import json
-import math
-import time
 from collections.abc import Collection, Mapping
 from typing import Any
 
 from cyborg.monitor.client import Client
+from cyborg.monitor.latest_state import LatestState
 from cyborg.monitor.source import TreeSource
 
 SERVICES_INTERVAL = 0.25
@@ -42,28 +40,20 @@ class ServiceLink:
 
     def __init__(self, clients: Collection[Client], sources: Mapping[str, TreeSource]) -> None:
         self._clients, self._sources = clients, sources
-        self._loop: asyncio.AbstractEventLoop | None = None
-        self._pending: set[str] = set()
-        """Namespaces whose change was handed to the loop and not yet looked at."""
-        self._later: set[str] = set()
-        """Namespaces with a send waiting for the interval to pass."""
-        self._sent: dict[str, str] = {}
-        self._sent_at: dict[str, float] = {}
-        self.messages = 0
+        self._state = LatestState[str](SERVICES_INTERVAL, self._text, self._deliver)
+
+    @property
+    def messages(self) -> int:
         """How many ``services`` messages went to pages (each counted once, however many)."""
+        return self._state.sends
 
     def attach(self, loop: asyncio.AbstractEventLoop) -> None:
         """Binds the link to the server's event loop; :meth:`notify` drops changes until then."""
-        self._loop = loop
+        self._state.attach(loop)
 
     def notify(self, namespace: str) -> None:
         """Called from any thread when the runner under ``namespace`` sent its services."""
-        loop = self._loop
-        if loop is None or loop.is_closed() or namespace in self._pending:
-            return
-        self._pending.add(namespace)
-        with contextlib.suppress(RuntimeError):  # the loop closed meanwhile
-            loop.call_soon_threadsafe(self._changed, namespace)
+        self._state.notify(namespace)
 
     def send_to(self, client: Client, namespace: str) -> None:
         """Sends ``client`` the services of the tree under ``namespace`` as they are now."""
@@ -74,33 +64,14 @@ class ServiceLink:
 
     def forget(self, namespace: str) -> None:
         """Lets go of what was kept for a tree the monitor no longer follows."""
-        self._sent.pop(namespace, None)
-        self._sent_at.pop(namespace, None)
+        self._state.forget(namespace)
 
-    def _changed(self, namespace: str) -> None:
-        self._pending.discard(namespace)
-        wait = self._sent_at.get(namespace, -math.inf) + SERVICES_INTERVAL - time.monotonic()
-        if wait > 0:
-            if namespace not in self._later and self._loop is not None:
-                self._later.add(namespace)
-                self._loop.call_later(wait, self._due, namespace)
-            return
-        self._send(namespace)
-
-    def _due(self, namespace: str) -> None:
-        self._later.discard(namespace)
-        self._send(namespace)
-
-    def _send(self, namespace: str) -> None:
+    def _text(self, namespace: str) -> str | None:
         source = self._sources.get(namespace)
         message = source.services_message() if source is not None else None
-        if message is None:
-            return
-        text = _encode(message)
-        if text == self._sent.get(namespace):
-            return
-        self._sent[namespace], self._sent_at[namespace] = text, time.monotonic()
-        self.messages += 1
+        return None if message is None else _encode(message)
+
+    def _deliver(self, namespace: str, text: str) -> None:
         for client in self._clients:
             if client.watching == namespace:
                 client.send(text)
