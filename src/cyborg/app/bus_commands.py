@@ -33,6 +33,7 @@ from cyborg.bus import (
     Context,
     MessageValueError,
     Node,
+    Publisher,
     Qos,
     ServiceError,
     new_message,
@@ -241,8 +242,9 @@ def topic_pub(args: argparse.Namespace) -> int:
         node = Node("cyborg_topic_pub", context=context)
         publisher = node.create_publisher(args.topic, args.type,
                                           Qos.latched() if args.latched else Qos(depth=10))
-        if not args.latched:  # give subscribers a moment to see the new publisher
-            context.graph.wait_for(lambda graph: publisher.subscription_count() > 0, 1.0)
+        if not args.latched and not _reaches_subscribers(publisher, SUBSCRIBER_WAIT):
+            print(f"cyborg topic pub: no subscriber of {publisher.topic} within "
+                  f"{SUBSCRIBER_WAIT:g} s; publishing anyway", file=sys.stderr)
         sent = 0
         while not times or sent < times:
             publisher.publish(message)
@@ -252,6 +254,24 @@ def topic_pub(args: argparse.Namespace) -> int:
                 time.sleep(1.0 / args.rate)
         time.sleep(0.2 if not args.latched else 0.5)  # let the last message leave
     return 0
+
+
+SUBSCRIBER_WAIT = 3.0
+"""Seconds ``cyborg topic pub`` waits for a subscriber before its first message."""
+
+
+def _reaches_subscribers(publisher: Publisher[Any], timeout: float) -> bool:
+    """Whether what ``publisher`` sends reaches a subscriber, waiting up to ``timeout`` s.
+
+    A subscriber in the graph, and matched by Zenoh's routing, which may come a moment after
+    the graph lists it: a message sent in that moment reaches nobody (a lost ``--once``).
+    """
+    deadline = time.monotonic() + timeout
+    while not (publisher.subscription_count() > 0 and publisher.matched()):
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(0.01)
+    return True
 
 
 def topic_hz(args: argparse.Namespace) -> int:

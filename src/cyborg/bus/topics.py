@@ -174,7 +174,7 @@ class Publisher(_Endpoint, Generic[MessageT]):
                         self._shm_publisher.put(reference, attachment=attachment)
                     if self._remote_subscriptions() <= len(readers):
                         return
-        if self.latched or self._matching():
+        if self.latched or self.matched():
             payload = types.serialize(message, self.type_name).obj if data is None else data
             self._zenoh.put(payload, attachment=attachment)
 
@@ -188,12 +188,12 @@ class Publisher(_Endpoint, Generic[MessageT]):
             self._graph_version = version
         return self._remote_count
 
-    def _matching(self) -> bool:
+    def matched(self) -> bool:
+        """Whether Zenoh's routing matches a subscriber elsewhere (it may lag the graph)."""
         publisher = self._zenoh
         if not isinstance(publisher, zenoh.Publisher):
             return True
-        # zenoh's stub says bool, but the binding returns a MatchingStatus
-        status: Any = publisher.matching_status
+        status: Any = publisher.matching_status  # the stub says bool: a MatchingStatus
         return bool(status.matching)
 
     def subscription_count(self) -> int:
