@@ -170,6 +170,8 @@ def test_ctrl_c_stops_cleanly_and_halts() -> None:
     assert process.stdout is not None
     first = process.stdout.readline()
     assert first.startswith("cyborg up: bus router at")
+    hint = process.stdout.readline()  # not the default router: how other shells join it
+    assert f"export CYBORG_CONNECT=tcp/127.0.0.1:{port}" in hint, hint
     while "MoveTo" not in process.stdout.readline():  # the robot is on its way
         pass
     process.send_signal(signal.SIGINT)

@@ -16,6 +16,7 @@ from cyborg.app.errors import CommandError
 from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck
 from cyborg.app.status_line import StatusLine
 from cyborg.bus.component import LaunchError
+from cyborg.bus.config import CONNECT_ENV, BusConfig
 from cyborg.modes import ModeMachine
 from cyborg.runner.component import RunningTree
 
@@ -41,6 +42,9 @@ def run_system(description: LaunchDescription, args: argparse.Namespace, *, titl
         launch.start(process, children=children, connect=connect)
         stops = "Ctrl-C stops everything" if parent is None else "stops with its launch"
         print(f"{title}: bus {where}; {stops}", flush=True)
+        if connect and connect not in BusConfig.from_environment().connect:
+            print(f"  other shells  export {CONNECT_ENV}={connect}  (or --connect {connect}): "
+                  "commands join another bus by default", flush=True)
         for line in [*notes, *launch.describe()]:
             print(f"  {line}", flush=True)
         status_line = _follow_tree(launch)
