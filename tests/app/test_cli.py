@@ -213,11 +213,14 @@ def test_a_run_whose_root_ends_in_error_fails(tmp_path: Path,
 
 def test_the_readme_bt_commands_work_as_written(capsys: pytest.CaptureFixture[str]) -> None:
     readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    readme = readme.replace("\\\n", " ")  # continued lines as one
+    shown = "../shared/trees/patrol_recharge.b3.json"
     commands = [line.split("#")[0].split("|")[0].split() for line in readme.splitlines()
-                if line.startswith("cyborg bt ") and "patrol.b3.json" in line]
+                if line.startswith("cyborg bt ") and shown in line
+                and not line.startswith("cyborg bt serve")]  # serves until stopped
     assert len(commands) >= 4
     for words in commands:
-        args = [str(PATROL) if word == "patrol.b3.json" else word.strip('"')
+        args = [str(PATROL) if word == shown else word.strip('"')
                 for word in _joined_quotes(words[1:])]
         if args[1] == "run":
             args.append("--fast")  # the same ticks on simulated time
@@ -228,3 +231,29 @@ def test_the_readme_bt_commands_work_as_written(capsys: pytest.CaptureFixture[st
 def _joined_quotes(words: list[str]) -> list[str]:
     """Shell-like words: ``"Patrol`` ``tree"`` -> ``"Patrol tree"``."""
     return shlex.split(" ".join(words))
+
+
+def test_up_refuses_a_tree_whose_goals_are_not_on_the_map() -> None:
+    """The shared patrol drives to AMROffice.map's rooms; on the default campus map its MoveTos
+    could never arrive: cyborg up names each (tree, node, id, goal), the map and its goals, and
+    stops everything, rather than warn once per MoveTo while it runs. With its map it runs."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    common = ["up", "--tree", str(PATROL), "--listen", f"tcp/127.0.0.1:{port}",
+              "--no-monitor", "--no-detector"]
+    refused = subprocess.run([sys.executable, "-m", "cyborg", *common], capture_output=True,
+                             text=True, timeout=60)
+    assert refused.returncode == 1, refused.stderr
+    assert "Traceback" not in refused.stderr
+    lines = [line for line in refused.stderr.splitlines() if "cyborg.robot" not in line]
+    assert lines[0].startswith("cyborg: error: patrol_recharge.b3.json: ")
+    assert "MoveTos drive to goals not on campus.map (its goals: Charger," in lines[0]
+    assert lines[0].endswith("give the tree's map with --map:")
+    assert any(line.startswith("  tree 'Root tree', node 'MoveTo room1' (id ")
+               and line.endswith("no goal 'room1'") for line in lines[1:]), lines
+    amr = shared_dir() / "maps" / "AMROffice.map"
+    runs = subprocess.run([sys.executable, "-m", "cyborg", *common, "--map", str(amr),
+                           "--duration", "3"], capture_output=True, text=True, timeout=60)
+    assert runs.returncode == 0, runs.stderr
+    assert "no goal" not in runs.stderr

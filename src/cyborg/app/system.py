@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 from cyborg.app.bus_options import bus_context
 from cyborg.app.errors import CommandError
+from cyborg.app.goal_check import unknown_goals
 from cyborg.app.launch import Launch, LaunchDescription, end_if_stuck
 from cyborg.app.status_line import StatusLine
 from cyborg.bus.component import LaunchError
@@ -40,6 +41,9 @@ def run_system(description: LaunchDescription, args: argparse.Namespace, *, titl
             if process == "main" else []
         connect = description.connect[0] if description.connect else description.listen
         launch.start(process, children=children, connect=connect)
+        unknown = unknown_goals(launch)
+        if unknown:  # stopped (below) before it runs long on the wrong map
+            raise CommandError("\n".join(unknown))
         stops = "Ctrl-C stops everything" if parent is None else "stops with its launch"
         print(f"{title}: bus {where}; {stops}", flush=True)
         if connect and connect not in BusConfig.from_environment().connect:
