@@ -27,9 +27,9 @@ with the 90th percentile.
 from __future__ import annotations
 
 import argparse
-import itertools
 import math
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +44,11 @@ from cyborg.sim.people import Crowd
 from cyborg.sim.people_sources import random_people
 from cyborg.sim.sights import crowd_sights
 from cyborg.sim.simulator import Simulator
+
+if __package__ in (None, ""):  # run as a file: the benchmarks package from the repository root
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.patrol import patrol_goals
 
 SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 BANDS = ((0.0, 5.0, "<= 5 m"), (5.0, 10.0, "5-10 m"), (10.0, math.inf, "> 10 m"))
@@ -104,14 +109,7 @@ def measure(arnl_map: ArnlMap, minutes: float, people: int, seed: int) -> Errors
         errors.add(errors.tracked, np.array(fresh).reshape(-1, 2), truth, robot)
         errors.frames += 1
 
-    names = [item.name for item in arnl_map.goals()]
-    end = minutes * 60
-    for name in itertools.cycle(names):
-        if sim.time >= end:
-            break
-        if sim.go_to(name).found:
-            while not sim.navigator.state.finished and sim.time < end:
-                step()
+    patrol_goals(sim, minutes * 60, step)
     return errors
 
 

@@ -16,11 +16,11 @@ nobody walking and no camera. Goal: >= 200x real time.
 from __future__ import annotations
 
 import argparse
-import itertools
 import os
 import time
 from pathlib import Path
 
+from benchmarks.patrol import patrol_goals
 from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from cyborg.sim.camera import SimCamera
@@ -64,19 +64,10 @@ def patrol(arnl_map: ArnlMap, minutes: float, people: int) -> Result:
             counts["frames"] += 1
             counts["detections"] += len(seen)
 
-    names = [item.name for item in arnl_map.goals()]
-    reached = 0
     for _ in range(50):
         step()  # compiled kernels loaded, caches warm
     started, cpu, begin = time.perf_counter(), time.process_time(), sim.time
-    end = begin + minutes * 60
-    for name in itertools.cycle(names):
-        if sim.time >= end:
-            break
-        if sim.go_to(name).found:
-            while not sim.navigator.state.finished and sim.time < end:
-                step()
-            reached += sim.navigator.state.value == "REACHED_GOAL"
+    reached = patrol_goals(sim, begin + minutes * 60, step)
     speed = (sim.time - begin) / (time.perf_counter() - started)
     cpu_speed = (sim.time - begin) / (time.process_time() - cpu)
     routes = sim.crowd.routes.planned if sim.crowd is not None else 0
