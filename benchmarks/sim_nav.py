@@ -22,11 +22,12 @@ import math
 import os
 import statistics
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks.patrol import patrol_goals
 from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
 from cyborg.nav.geometry import Pose2D
@@ -45,7 +46,10 @@ def numpy_laser_scan(laser: Laser) -> Callable[[float, float, float], np.ndarray
     relative = spec.angles()
     rows, columns = laser.occupied.shape
 
-    def scan(x: float, y: float, theta: float) -> np.ndarray:
+    def scan(x: float, y: float, theta: float, bodies: Sequence[np.ndarray] = (),
+             circles: np.ndarray | None = None) -> np.ndarray:
+        # the walls only: this patrol has no other robots and nobody walking
+        assert not bodies and (circles is None or not len(circles))
         sx, sy = x + spec.mount_x * math.cos(theta), y + spec.mount_x * math.sin(theta)
         angles = relative + theta
         px = sx + np.outer(np.cos(angles), steps)
@@ -65,17 +69,9 @@ def patrol_speed(arnl_map: ArnlMap, minutes: float, numpy_laser: bool) -> tuple[
     sim = Simulator(arnl_map)
     if numpy_laser:
         sim.laser.scan = numpy_laser_scan(sim.laser)  # type: ignore[method-assign, assignment]
-    names = [item.name for item in arnl_map.goals()]
-    reached = 0
     sim.run(1.0)  # compiled kernels loaded, caches warm
     started, begin = time.perf_counter(), sim.time
-    end = begin + minutes * 60
-    for name in itertools.cycle(names):
-        if sim.time >= end:
-            break
-        if sim.go_to(name).found:
-            sim.run_until(lambda: sim.navigator.state.finished, end - sim.time)
-            reached += sim.navigator.state.value == "REACHED_GOAL"
+    reached = patrol_goals(sim, begin + minutes * 60)
     return (sim.time - begin) / (time.perf_counter() - started), reached
 
 
