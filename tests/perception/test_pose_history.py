@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from cyborg.perception.pose_history import AHEAD, BEFORE, PoseHistory
+from cyborg.perception.pose_history import AHEAD, BEFORE, MOST, PoseHistory
 from cyborg.perception.sighting import RobotPose
 
 
@@ -75,3 +75,29 @@ def test_an_interpolated_pose_lies_between_its_neighbours(headings: list[float],
     apart = abs(math.remainder(end - start, 2 * math.pi))
     assert abs(math.remainder(pose.theta - start, 2 * math.pi)) <= apart + 1e-9
     assert abs(math.remainder(pose.theta - end, 2 * math.pi)) <= apart + 1e-9
+
+
+def test_poses_stamped_close_together_are_kept_to_a_bound() -> None:
+    """A publisher stamping its poses a microsecond apart does not grow the history past MOST:
+    the oldest go, the newest are there."""
+    history = PoseHistory()
+    for step in range(3 * MOST):
+        history.add(10.0 + step * 1e-6, RobotPose(float(step), 0.0, 0.0))
+    assert len(history) == MOST
+    assert history.at(10.0 + (3 * MOST - 1) * 1e-6) == RobotPose(3 * MOST - 1.0, 0.0, 0.0)
+
+
+@given(st.lists(st.tuples(st.floats(allow_nan=True, allow_infinity=True),
+                          st.floats(-1e6, 1e6), st.floats(-1e6, 1e6), st.floats(-10.0, 10.0)),
+                max_size=50),
+       st.floats(allow_nan=True, allow_infinity=True))
+def test_any_stamps_are_kept_or_passed_over_never_raised(
+        poses: list[tuple[float, float, float, float]], asked: float) -> None:
+    """Stamps out of order, nan or infinite, from anyone on the bus: the history stays within
+    its bounds and answers a pose or None for any stamp."""
+    history = PoseHistory()
+    for stamp, x, y, theta in poses:
+        history.add(stamp, RobotPose(x, y, theta))
+    assert len(history) <= MOST
+    found = history.at(asked)
+    assert found is None or math.isfinite(found.x)

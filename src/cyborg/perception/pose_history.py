@@ -34,10 +34,13 @@ AHEAD = 0.5
 at 10 Hz or more; a frame stamped between two of them may arrive first)."""
 BEFORE = 0.5
 """Seconds a frame's stamp may be older than the oldest pose kept and still take that one."""
+MOST = 1000
+"""Poses kept at most, whatever their stamps: 5 s at 200 Hz (a publisher stamping them
+microseconds apart fills no more)."""
 
 
 class PoseHistory:
-    """The robot's stamped poses of the last ``span`` seconds; see the module doc."""
+    """The robot's stamped poses of the last ``span`` seconds (at most :data:`MOST`)."""
 
     def __init__(self, span: float = SPAN) -> None:
         self.span = span
@@ -60,7 +63,7 @@ class PoseHistory:
             return
         self._stamps.append(stamp)
         self._poses.append(pose)
-        cut = bisect.bisect_left(self._stamps, stamp - self.span)
+        cut = max(bisect.bisect_left(self._stamps, stamp - self.span), len(self._stamps) - MOST)
         if cut:
             del self._stamps[:cut], self._poses[:cut]
 
