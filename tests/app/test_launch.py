@@ -206,6 +206,8 @@ def test_launch_across_processes_and_control_from_the_shell(
         assert f"{bad}:2" in capsys.readouterr().out
         assert main(["bt", "reload", "--connect", endpoint]) == 0
         assert "loaded 'Root tree' (18 nodes)" in capsys.readouterr().out
+        assert main(["bt", "stop", "--connect", endpoint]) == 0
+        assert capsys.readouterr().out.startswith("stopped: the tree is halted until")
         assert main(["bt", "enable", "--connect", endpoint]) == 0
     finally:
         parent.send_signal(signal.SIGINT)

@@ -120,6 +120,7 @@ class FakeSource:
         self.namespace = namespace
         self.state: TreeState | None = TreeState(SMALL_TREE)
         self.generation, self.enabled = 1, True
+        self.stopped: bool | None = False
         self.hooks: list[dict[str, Any]] = []
         self.paused_at = self.problem = ""
         FakeSource.created.append(namespace)
@@ -130,11 +131,16 @@ class FakeSource:
 
     def describe(self) -> dict[str, Any]:
         return {"ns": self.namespace, "alive": self.alive, "enabled": self.enabled,
-                "title": "small", "nodes": 3, "tick": 0, "problem": ""}
+                "stopped": self.stopped, "title": "small", "nodes": 3, "tick": 0, "problem": ""}
 
     def set_enabled(self, on: bool) -> str:
         self.enabled = on
+        self.stopped = self.stopped and not on
         return "ok"
+
+    def stop(self) -> str:
+        self.enabled, self.stopped = False, True
+        return "stopped"
 
     def control(self, node_id: str, action: str, status: str = "failure", *,
                 once: bool = False, keep: bool = False) -> str:

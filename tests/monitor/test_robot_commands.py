@@ -1,6 +1,7 @@
 """The robot commands of the map (go, go_pose, home, dock, undock, set_pose, stop, drive, tour)
 through the monitor's protocol, on a fake robot: the seat rules (stop works without the seat,
-the rest needs it), the tree paused before a manual goal and never by a stop, every page told
+the rest needs it), the tree paused before a manual goal and stopped by a stop until someone
+with the seat resumes it, every page told
 how a goal ended, bad fields answered with the field at fault and nothing sent, the robot's
 own refusals passed on, home decided, driving clamped and a driver that leaves stopped."""
 
@@ -111,12 +112,33 @@ def test_stop_needs_no_seat_but_every_other_command_does() -> None:
         assert buses == {} and _enabled(hub) is True, "nothing reached the robot or the tree"
         stopped = await _send(hub, other, {"t": "stop", "ns": ROBOT, "req": 9})
         assert stopped == {"t": "result", "n": 9, "req": 9, "command": "stop", "ok": True,
-                           "message": "/cyborg: stopped", "paused": None}
+                           "message": "/cyborg: stopped; the tree /cyborg/bt is stopped until "
+                                      "someone resumes it", "paused": None, "stopped": [TREE]}
         assert buses[ROBOT].calls == [("stop",)]
-        assert _enabled(hub) is True, "a stop does not pause the tree"
+        assert _enabled(hub) is False and hub.sources[TREE].stopped is True, "the tree stopped"
         refused = await _send(hub, viewer, {"t": "stop", "ns": ROBOT})
         assert refused["ok"] is False and VIEW_ONLY in refused["message"]
         assert of_kind(holder, "manual_pause") == []
+
+    asyncio.run(scenario())
+
+
+def test_a_stopped_tree_is_told_to_every_page_and_only_the_seat_resumes_it() -> None:
+    hub, _buses = acting_hub()
+
+    async def scenario() -> None:
+        holder, other = page(hub, 1), page(hub, 2)
+        hub.seat.claim(1)
+        assert (await _send(hub, other, {"t": "stop", "ns": ROBOT}))["ok"]
+        late = page(hub, 3)
+        await receive(hub, late, json.dumps({"t": "hello"}))
+        trees = of_kind(late, "robots")[0]["robots"]
+        assert [(tree["ns"], tree["stopped"]) for tree in trees] == [(TREE, True)]
+        refused = await _send(hub, other, {"t": "enable", "on": True, "ns": TREE})
+        assert refused["ok"] is False and NOT_HOLDER in refused["message"]
+        assert hub.sources[TREE].stopped is True
+        assert (await _send(hub, holder, {"t": "enable", "on": True, "ns": TREE}))["ok"]
+        assert hub.sources[TREE].stopped is False and _enabled(hub) is True
 
     asyncio.run(scenario())
 

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from cyborg.bt import Action, NodeRegistry, Status, default_registry
-from cyborg.bus import BusConfig, Context, Node, new_message
+from cyborg.bus import BusConfig, Context, Node, Qos, new_message
 from cyborg.bus.executor import CallbackThread
 from cyborg.robot.interface import DockState
 from cyborg.runner.tree_runner import TreeRunnerNode
@@ -259,6 +259,38 @@ def test_enable_answers_while_a_tick_waits_for_a_slow_robot(bus: Context,
         assert runner.tree.ticks == ticks, "a disabled tree does not tick"
         assert caller.call("enable", "std_srvs/srv/SetBool", data=True).success
         wait_until(lambda: runner.tree.ticks > ticks, timeout=5, what="ticking again")
+
+
+def test_stop_halts_the_tree_and_says_stopped_until_it_is_enabled(bus: Context,
+                                                                  tmp_path: Path) -> None:
+    """``stop`` (the monitor's STOP) halts as ``enable(false)`` does and latches ``stopped``,
+    which a watcher that comes later reads too; a disable changes nothing of it, an enable
+    clears it."""
+    robot = FakeRobot()
+    tree = write_tree(tmp_path, {"name": "MoveTo", "props": {"location": "home"}})
+    with runner_on(bus, tree, robot) as runner:
+        caller = Caller(bus)
+        watcher = Node("watcher", "/test", context=bus)
+        stopped: list[bool] = []
+        watcher.create_subscription("/cyborg/bt/stopped", "std_msgs/msg/Bool",
+                                    lambda message: stopped.append(message.data), Qos.latched())
+        wait_until(lambda: robot.moves and stopped == [False], timeout=5,
+                   what="the robot sent home, the runner not stopped")
+        reply = caller.call("stop", "std_srvs/srv/Trigger")
+        assert reply.success and reply.message.startswith("stopped"), reply.message
+        assert runner.stopped and not runner.enabled and robot.moves[0].cancelled
+        wait_until(lambda: stopped[-1:] == [True], timeout=5, what="stopped on the bus")
+        later: list[bool] = []
+        Node("later", "/test", context=bus).create_subscription(
+            "/cyborg/bt/stopped", "std_msgs/msg/Bool", lambda message: later.append(message.data),
+            Qos.latched())
+        wait_until(lambda: later == [True], timeout=5, what="a later watcher to hear it")
+        assert caller.call("enable", "std_srvs/srv/SetBool", data=False).success
+        assert runner.stopped, "a disable does not make a stopped tree merely paused"
+        assert caller.call("enable", "std_srvs/srv/SetBool", data=True).success
+        assert not runner.stopped and runner.enabled
+        wait_until(lambda: stopped[-1:] == [False] and len(robot.moves) == 2, timeout=5,
+                   what="not stopped on the bus, the robot sent home again")
 
 
 def test_a_routed_owner_runs_its_callbacks_on_its_own_thread() -> None:

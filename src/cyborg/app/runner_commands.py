@@ -1,4 +1,4 @@
-"""``cyborg bt serve|reload|enable|disable|mode``: a tree runner on the bus, and its controls.
+"""``cyborg bt serve|reload|enable|disable|stop|mode``: a tree runner on the bus, and its controls.
 
 ::
 
@@ -8,6 +8,7 @@
     cyborg bt reload other.b3.json                     # or another one
     cyborg bt disable                                  # halt: the robot stops
     cyborg bt enable                                   # start afresh
+    cyborg bt stop                                     # halt, shown as stopped until enabled
     cyborg bt mode demo --reason "visitors"            # request a mode (as the file allows)
     cyborg bt mode critical --force                    # force one, past everything
     cyborg bt mode --hold                              # hold the current mode (--release)
@@ -33,7 +34,7 @@ from cyborg.runner import component as runner
 
 
 def add_parsers(sub: Any) -> None:
-    """Adds ``serve``, ``reload``, ``enable`` and ``disable`` to ``cyborg bt``'s group."""
+    """Adds ``serve``, ``reload``, ``enable``, ``disable``, ``stop``, ``mode`` to ``cyborg bt``."""
     serve = sub.add_parser("serve", help="run a tree on the bus, with its topics and services",
                            description="Tick a tree as the robot's tree runner: latched "
                                        "structure, active ids, enabled flag, per-tick status, "
@@ -58,7 +59,9 @@ def add_parsers(sub: Any) -> None:
 
     for name, text in (("reload", "load the running tree's file again (or another file)"),
                        ("enable", "run the tree (from its root)"),
-                       ("disable", "halt the tree: running actions stop")):
+                       ("disable", "halt the tree: running actions stop"),
+                       ("stop", "halt the tree and keep it stopped (as the monitor's STOP) "
+                                "until `cyborg bt enable`")):
         parser = sub.add_parser(name, help=text)
         if name == "reload":
             parser.add_argument("file", nargs="?", type=Path, default=None,
@@ -106,11 +109,13 @@ def serve_command(args: argparse.Namespace) -> int:
 
 
 def control_command(args: argparse.Namespace) -> int:
-    """``cyborg bt reload|enable|disable``: calls the running tree runner's service."""
+    """``cyborg bt reload|enable|disable|stop``: calls the running tree runner's service."""
     namespace = "/" + args.namespace.strip("/")
     if args.action == "reload":
         contract: Service[Any, Any] = tree_runner.RELOAD
         fields: dict[str, Any] = {"path": str(args.file.resolve()) if args.file else ""}
+    elif args.action == "stop":
+        contract, fields = tree_runner.STOP, {}
     else:
         contract = tree_runner.ENABLE
         fields = {"data": args.action == "enable"}

@@ -11,6 +11,8 @@ name                        type                                what
 ``behavior_tree``           cyborg_msgs/BehaviorTree            latched: the structure as JSON
 ``behavior_tree_updates``   cyborg_msgs/BehaviorTreeNodes       latched: ids of the active path
 ``enabled``                 std_msgs/Bool                       latched: whether the tree ticks
+``stopped``                 std_msgs/Bool                       latched: whether ``stop`` halted it
+                                                                and no ``enable(true)`` came since
 ``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: what ran, how it ended
 ``hooks``                   cyborg_msgs/BehaviorTreeHooks       latched: hooks set, where a tick
                                                                 waits (:class:`HookAction`)
@@ -19,6 +21,8 @@ name                        type                                what
                                                                 whether each runs, when it last
                                                                 ran, what it wrote, its error
 ``enable``                  std_srvs/SetBool                    run or pause the tree
+``stop``                    std_srvs/Trigger                    halt the tree and keep it halted
+                                                                until ``enable(true)`` (STOP)
 ``reload``                  cyborg_msgs/ReloadTree              load the file again
 ``control``                 cyborg_msgs/ControlNode             set or clear a hook on one node
 ``resume``, ``step``        std_srvs/Trigger                    go on from a breakpoint
@@ -33,6 +37,11 @@ stopped, ran, wrote or failed, at most :data:`SERVICE_STATES_PER_SECOND` times a
 newest states go out when the interval has passed), and latched, so a monitor that comes late
 gets the last. A tree without services publishes nothing on it; when a reload or a mode switch
 leaves a tree without services after one with them, one message with no services says so.
+
+**Stop and pause.** ``stop`` (the monitor's red STOP, ``cyborg bt stop``) halts the tree as
+``enable(false)`` does and says so on ``stopped``, latched, so that every monitor, one that
+comes later included, shows the tree as *stopped* rather than paused; only ``enable(true)``
+(Resume, ``cyborg bt enable``) runs it again and clears ``stopped``.
 
 Hook codes and statuses come from ControlNode.srv; the statuses equal the engine's
 (:class:`cyborg.bt.Status`), which the tests check.
@@ -66,22 +75,25 @@ NAMESPACE = "/cyborg/bt"
 STRUCTURE = Topic("behavior_tree", BehaviorTree, latched=True)
 ACTIVE_PATH = Topic("behavior_tree_updates", BehaviorTreeNodes, latched=True)
 ENABLED = Topic("enabled", Bool, latched=True)
+STOPPED = Topic("stopped", Bool, latched=True)
 STATUS = Topic("status", BehaviorTreeStatus)
 HOOKS = Topic("hooks", BehaviorTreeHooks, latched=True)
 SERVICE_STATES = Topic("services", ServiceStates, latched=True)
-TOPICS: tuple[Topic, ...] = (STRUCTURE, ACTIVE_PATH, ENABLED, STATUS, HOOKS, SERVICE_STATES)
+TOPICS: tuple[Topic, ...] = (STRUCTURE, ACTIVE_PATH, ENABLED, STOPPED, STATUS, HOOKS,
+                             SERVICE_STATES)
 
 SERVICE_STATES_PER_SECOND = 4.0
 """Most ``services`` messages a runner publishes a second (wall time)."""
 
 # ---------------------------------------------------------------------- services
 ENABLE = Service("enable", SetBool)
+STOP = Service("stop", Trigger)
 RELOAD = Service("reload", ReloadTree)
 CONTROL = Service("control", ControlNode)
 RESUME = Service("resume", Trigger)
 STEP = Service("step", Trigger)
 GET_BLACKBOARD = Service("get_blackboard", GetBlackboard)
-SERVICES: tuple[Service, ...] = (ENABLE, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
+SERVICES: tuple[Service, ...] = (ENABLE, STOP, RELOAD, CONTROL, RESUME, STEP, GET_BLACKBOARD)
 
 # ---------------------------------------------------------------------- values in the messages
 

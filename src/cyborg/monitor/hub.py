@@ -234,7 +234,7 @@ class Hub:
 
     def _runner_message(self, source: TreeSource) -> dict[str, Any]:
         return {"t": "runner", "ns": source.namespace, "alive": source.alive,
-                "enabled": source.enabled, "hooks": source.hooks,
+                "enabled": source.enabled, "stopped": source.stopped, "hooks": source.hooks,
                 "paused_at": source.paused_at, "problem": source.problem}
 
     def send_tree(self, client: Client, namespace: str) -> None:
@@ -248,7 +248,7 @@ class Hub:
         self.modes.resend(client, namespace)
         client.send(self._runner_message(source) if source is not None else
                     {"t": "runner", "ns": namespace, "alive": False, "enabled": None,
-                     "hooks": [], "paused_at": "", "problem": ""})
+                     "stopped": None, "hooks": [], "paused_at": "", "problem": ""})
         state = source.state if source is not None else None
         if source is None or state is None:
             client.shown = None

@@ -15,7 +15,7 @@ undock     ns                              ``undock``
 set_pose   ns, pose: [x, y] or [x, y, θ]   ``set_pose``: relocalise (without θ: keep the
                                            heading the robot has)
 stop       ns                              ``stop``: ends the goal, docking, driving and a
-                                           tour
+                                           tour, and *stops* the robot's tree (below)
 drive      ns, vx, wz                      ``cmd_vel`` (m/s, rad/s; clamped to the robot's
                                            ``TELEOP_MAX_SPEED``, ``TELEOP_MAX_TURN_RATE``)
 tour       ns, points: [[x, y(, θ)], …]    the points in order (:mod:`cyborg.monitor.tour`)
@@ -30,8 +30,17 @@ needs only that the page may control (loopback or the token): a stop always work
 another page holds the seat. A manual goal (``go``, ``go_pose``, ``home``, ``dock``,
 ``tour``) and driving by hand first *pause* the tree runner that drives the robot (its
 ``enable(false)``, as the Pause button), so the tree does not fight the operator; every page
-hears ``{"t": "manual_pause", "tree", "ns"}``. A new goal or driving ends a tour; ``stop``
-ends it too, but never pauses the tree.
+hears ``{"t": "manual_pause", "tree", "ns"}``. A new goal or driving ends a tour; so does
+``stop``.
+
+**Stop stops.** ``stop`` calls, at once and side by side, the robot's ``stop`` service and the
+``stop`` service of every tree runner that drives the robot (the runner's goal-sending is
+halted as ``enable(false)`` halts it, and it latches ``stopped``,
+:mod:`cyborg.interfaces.tree_runner`), so the tree cannot send the next goal a moment later.
+The tree stays stopped until someone with the seat enables it again (the page's Resume, the
+Run button, ``cyborg bt enable``); every page, one that comes later included, reads it as
+``stopped`` in the ``runner`` and ``robots`` messages, and this monitor or any other shows the
+same. The answer's ``stopped`` names the trees stopped.
 
 **Answers.** Each command is answered with ``result`` (``req``, ``ok``, ``message``, and
 ``paused``: the tree paused for it, or null) once the call returns; a goal is answered when
@@ -133,7 +142,8 @@ class RobotCommands:
         ns = self._namespace(command.get("ns"))
         bus = self._clients_for(ns)
         if kind == "stop":
-            return {"message": await self._stop(ns, bus), "paused": None}
+            message, trees = await self._stop(ns, bus)
+            return {"message": message, "paused": None, "stopped": trees}
         if kind == "drive":
             return await self._drive(client, ns, bus, command)
         if kind in ("set_pose", "undock"):
@@ -209,9 +219,29 @@ class RobotCommands:
             raise RobotCommandError(f"{ns}/{service} refused: {message}")
         return f"{ns}: {message}"
 
-    async def _stop(self, ns: str, bus: RobotClients) -> str:
+    async def _stop(self, ns: str, bus: RobotClients) -> tuple[str, list[str]]:
+        """Stops the robot and the trees that drive it, side by side; what it says, the trees."""
         self._end_tour(ns, "stopped")
-        return await self._call(ns, bus, "stop")
+        trees = [tree for tree in sorted(self._trees) if robot_of_runner(tree) == ns
+                 and self._trees[tree].alive]
+        robot, *halted = await asyncio.gather(
+            self._call(ns, bus, "stop"),
+            *(asyncio.to_thread(self._trees[tree].stop) for tree in trees),
+            return_exceptions=True)
+        stopped = [tree for tree, done in zip(trees, halted, strict=True)
+                   if not isinstance(done, BaseException)]
+        failed = [f"the tree {tree} could not be stopped: {done}"
+                  for tree, done in zip(trees, halted, strict=True)
+                  if isinstance(done, BaseException)]
+        said = [f"the tree {', '.join(stopped)} is stopped until someone resumes it"] \
+            if stopped else []
+        if isinstance(robot, BaseException):
+            if not isinstance(robot, RobotCommandError):
+                raise robot
+            raise RobotCommandError("; ".join([str(robot), *said, *failed])) from None
+        if failed:
+            raise RobotCommandError("; ".join([robot, *said, *failed]))
+        return "; ".join([robot, *said]), stopped
 
     async def _adjust(self, ns: str, bus: RobotClients, kind: str,
                       command: dict[str, Any]) -> str:

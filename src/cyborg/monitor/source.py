@@ -3,17 +3,18 @@
 A :class:`TreeSource` subscribes to a runner's namespace (``/cyborg/bt`` by default; the topics
 and services are those of :mod:`cyborg.interfaces.tree_runner`) and keeps a
 :class:`~cyborg.monitor.tree_state.TreeState` up to date. It tells its listener what changed
-(``"structure"``, ``"tick"``, ``"enabled"``, ``"hooks"``, ``"alive"``, ``"services"``) from the
-bus threads; the listener hands that to the web side. The runner's ``services`` message (the
-services on its composites) is kept as it came and read for the page against the structure
-(:meth:`TreeSource.services_message`, :mod:`cyborg.monitor.service_wire`).
+(``"structure"``, ``"tick"``, ``"enabled"`` (or stopped), ``"hooks"``, ``"alive"``,
+``"services"``) from the bus threads; the listener hands that to the web side. The runner's
+``services`` message (the services on its composites) is kept as it came and read for the
+page against the structure (:meth:`TreeSource.services_message`,
+:mod:`cyborg.monitor.service_wire`).
 
 It also follows the runner's liveliness: when the runner's process goes away the source says
 ``alive = False`` (the page shows it), and when a runner comes back its latched structure
 arrives again and the page follows without a reload.
 
-Control goes through the runner's services (``enable``, ``control``, ``step``, ``resume``,
-``get_blackboard``) as blocking calls: call them from a worker thread.
+Control goes through the runner's services (``enable``, ``stop``, ``control``, ``step``,
+``resume``, ``get_blackboard``) as blocking calls: call them from a worker thread.
 """
 
 from __future__ import annotations
@@ -60,6 +61,8 @@ class TreeSource:
         self.generation = 0
         """Bumped each time a structure arrives (a start, a restart or a reload)."""
         self.enabled: bool | None = None
+        self.stopped: bool | None = None
+        """Whether a STOP halted the tree until someone enables it (the runner's ``stopped``)."""
         self.hooks: list[dict[str, Any]] = []
         self.paused_at = ""
         self.alive = False
@@ -72,13 +75,14 @@ class TreeSource:
             tree_runner.STRUCTURE.subscription(node, self._on_structure, ns),
             tree_runner.ACTIVE_PATH.subscription(node, self._on_active, ns),
             tree_runner.ENABLED.subscription(node, self._on_enabled, ns),
+            tree_runner.STOPPED.subscription(node, self._on_stopped, ns),
             tree_runner.HOOKS.subscription(node, self._on_hooks, ns),
             tree_runner.STATUS.subscription(node, self._on_status, ns, qos=Qos(depth=50)),
             tree_runner.SERVICE_STATES.subscription(node, self._on_services, ns),
         ]
         self._clients = {service.name: service.client(node, ns) for service in (
-            tree_runner.ENABLE, tree_runner.CONTROL, tree_runner.STEP, tree_runner.RESUME,
-            tree_runner.GET_BLACKBOARD)}
+            tree_runner.ENABLE, tree_runner.STOP, tree_runner.CONTROL, tree_runner.STEP,
+            tree_runner.RESUME, tree_runner.GET_BLACKBOARD)}
         self._remove_graph_listener = node.context.graph.on_change(self._check_alive)
         self._check_alive()
 
@@ -143,6 +147,10 @@ class TreeSource:
         self.enabled = bool(message.data)
         self._tell("enabled")
 
+    def _on_stopped(self, message: Any) -> None:
+        self.stopped = bool(message.data)
+        self._tell("enabled")
+
     def _on_hooks(self, message: Any) -> None:
         self.hooks = [
             {"id": uid, "mode": HOOK_MODES.get(int(action), "?"),
@@ -161,6 +169,7 @@ class TreeSource:
             self.alive = alive
             if not alive:
                 self.paused_at = ""
+                self.stopped = None  # a runner that comes back publishes its own
                 self.service_states = None  # a runner that comes back publishes its own
             self._tell("alive")
 
@@ -188,6 +197,18 @@ class TreeSource:
         if not response.success:
             raise ControlError(f"{self.namespace}/enable: {response.message}")
         self.enabled = on
+        if on:
+            self.stopped = False
+        self._tell("enabled")
+        return str(response.message)
+
+    def stop(self) -> str:
+        """Stops the tree (halted until enabled again), blocking up to :data:`SERVICE_TIMEOUT` s.
+
+        Raises :class:`ControlError` when the runner does not answer.
+        """
+        response = self._call(tree_runner.STOP)
+        self.enabled, self.stopped = False, True
         self._tell("enabled")
         return str(response.message)
 
@@ -230,7 +251,7 @@ class TreeSource:
         """The short summary the page's robot list shows."""
         state = self.state
         return {"ns": self.namespace, "alive": self.alive, "enabled": self.enabled,
-                "title": state.structure.get("title", "") if state else "",
+                "stopped": self.stopped, "title": state.structure.get("title", "") if state else "",
                 "nodes": len(state) if state else 0, "tick": state.tick if state else 0,
                 "problem": self.problem}
 

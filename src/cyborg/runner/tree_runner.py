@@ -12,6 +12,8 @@ name                        type                                what
 ``behavior_tree_updates``   cyborg_msgs/BehaviorTreeNodes       latched: ids of the active path,
                                                                 published when it changes
 ``enabled``                 std_msgs/Bool                       latched: whether the tree ticks
+``stopped``                 std_msgs/Bool                       latched: whether ``stop`` halted it
+                                                                (until ``enable(true)``)
 ``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: nodes visited with
                                                                 their status and wall time
                                                                 (timed while someone listens),
@@ -22,13 +24,15 @@ name                        type                                what
                                                                 most 4 a second;
                                                                 :mod:`cyborg.runner.service_states`)
 ``enable``                  std_srvs/SetBool                    service: run or pause the tree
+``stop``                    std_srvs/Trigger                    service: halt the tree and keep
+                                                                it halted until ``enable(true)``
 ``reload``                  cyborg_msgs/ReloadTree              service: load the file again
 ==========================  ==================================  ==================================
 
 plus the per-node controls of :mod:`cyborg.runner.tree_control` (hooks, breakpoints, blackboard),
 and the node parameter ``reload_timeout`` (seconds, wall time; default 30).
 
-**Services never wait on each other.** ``enable`` — the stop button — is answered on a thread
+**Services never wait on each other.** ``enable`` and ``stop`` are answered on a thread
 of its own, the other control services (``control``, ``step``, ``resume``,
 ``get_blackboard``) on another, and neither waits for ``reload`` or for anything else the
 node's own thread does (``/clock``, parameters). A reload loads in the background.
@@ -36,6 +40,9 @@ node's own thread does (``/clock``, parameters). A reload loads in the backgroun
 **Enable and disable.** Unlike 2018, disabling *halts* the tree: every RUNNING node is halted,
 so a MoveTo cancels its goal and the robot stops. Enabling starts the tree afresh from its root
 (memories of halted nodes are reset, as after any halt). The flag is latched on ``enabled``.
+``stop`` (the monitor's red STOP) disables as ``enable(false)`` does and latches ``stopped``
+true, which only ``enable(true)`` clears: every watcher shows a stopped tree as stopped, not as
+merely paused, until someone resumes it.
 Disabling stops the ticks at once; the halt needs the tick in progress to end, so when a node
 in it waits on a slow robot, ``enable`` answers after :data:`HALT_WAIT` seconds anyway (saying
 so) and the halt follows when that tick ends; ``enable(true)`` meanwhile is refused (the tree
@@ -97,7 +104,13 @@ from cyborg.bus.msgs.cyborg_msgs.msg import (
 )
 from cyborg.bus.msgs.cyborg_msgs.srv import ReloadTree, ReloadTree_Request, ReloadTree_Response
 from cyborg.bus.msgs.std_msgs.msg import Bool
-from cyborg.bus.msgs.std_srvs.srv import SetBool, SetBool_Request, SetBool_Response
+from cyborg.bus.msgs.std_srvs.srv import (
+    SetBool,
+    SetBool_Request,
+    SetBool_Response,
+    Trigger_Request,
+    Trigger_Response,
+)
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
 from cyborg.modes import ModeMachine, Transition, Trigger, load_machine
@@ -145,6 +158,7 @@ class TreeRunnerNode:
         """What the loop ticks: the tree, or the mode machine of a mode file."""
         self.runner: TickLoop[Tree | ModeMachine] = TickLoop(self.ticked, rate_hz=rate_hz)
         self._enabled = enabled
+        self._stopped = False
         self._active: tuple[str, ...] | None = None
         self._lock = threading.Lock()
         self._halting: threading.Thread | None = None  # halts the tree once its tick ends
@@ -157,9 +171,12 @@ class TreeRunnerNode:
         self._structure = tree_runner.STRUCTURE.publisher(node)
         self._updates = tree_runner.ACTIVE_PATH.publisher(node)
         self._enabled_pub = tree_runner.ENABLED.publisher(node)
+        self._stopped_pub = tree_runner.STOPPED.publisher(node)
         self._status = tree_runner.STATUS.publisher(node)
         self._service_states = ServiceStatesPublisher(node)
-        tree_runner.ENABLE.server(node, self._on_enable, callbacks=node.callback_thread("enable"))
+        stopping = node.callback_thread("enable")
+        tree_runner.ENABLE.server(node, self._on_enable, callbacks=stopping)
+        tree_runner.STOP.server(node, self._on_stop, callbacks=stopping)
         tree_runner.RELOAD.server(node, self._on_reload, deferred=True)
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
@@ -172,6 +189,7 @@ class TreeRunnerNode:
             self._follow(self.ticked)
         self._publish_structure()
         self._publish_enabled()
+        self._publish_stopped()
         self._thread: threading.Thread | None = None
 
     @property
@@ -271,6 +289,11 @@ class TreeRunnerNode:
         """Whether the tree is enabled, as ``enabled`` says; after a disable, a halt may pend."""
         return self._enabled
 
+    @property
+    def stopped(self) -> bool:
+        """Whether :meth:`stop_tree` halted the tree and no enable has run it since."""
+        return self._stopped
+
     def start(self) -> None:
         """Tick in a background thread; on simulated time, from the first ``/clock`` on."""
         if self._thread is not None:
@@ -321,11 +344,28 @@ class TreeRunnerNode:
                     name="cyborg-tree-halt")
                 halting.start()
         self._publish_enabled()
+        if enabled:
+            self._set_stopped(False)
         if enabled or halting is None:
             return True
         self._publish_active(())
         halting.join(wait)
         return not halting.is_alive()
+
+    def stop_tree(self, *, wait: float | None = None) -> bool:
+        """Halts the tree and keeps it halted until it is enabled again: a STOP.
+
+        As ``set_enabled(False, wait=wait)`` (its result too), and ``stopped`` says so until
+        :meth:`set_enabled` runs the tree again. Stopping a stopped tree changes nothing.
+        """
+        self._set_stopped(True)
+        return self.set_enabled(False, wait=wait)
+
+    def _set_stopped(self, stopped: bool) -> None:
+        with self._lock:
+            changed, self._stopped = stopped != self._stopped, stopped
+        if changed:
+            self._publish_stopped()
 
     def stop(self) -> None:
         """Stop ticking and halt the tree (the robot stops); withdraws nothing from the bus."""
@@ -348,6 +388,9 @@ class TreeRunnerNode:
 
     def _publish_enabled(self) -> None:
         self._enabled_pub.publish(Bool(data=self._enabled))
+
+    def _publish_stopped(self) -> None:
+        self._stopped_pub.publish(Bool(data=self._stopped))
 
     def _publish_active(self, active: tuple[str, ...]) -> None:
         self._updates.publish(BehaviorTreeNodes(ids=list(active)))
@@ -403,6 +446,14 @@ class TreeRunnerNode:
             message += ("; ticking has stopped and the tree halts when its current tick ends "
                         "(a node in it is still waiting, e.g. on the robot)")
         return response(success=True, message=message)
+
+    def _on_stop(self, _request: Trigger_Request) -> Trigger_Response:
+        done = self.stop_tree(wait=HALT_WAIT)
+        message = "stopped: the tree is halted until it is enabled again"
+        if not done:
+            message += ("; ticking has stopped and the tree halts when its current tick ends "
+                        "(a node in it is still waiting, e.g. on the robot)")
+        return Trigger_Response(success=True, message=message)
 
     def _on_reload(self, request: ReloadTree_Request,
                    responder: Responder[ReloadTree_Response]) -> None:
