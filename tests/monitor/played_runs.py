@@ -2,6 +2,9 @@
 that drives along x, and its map, written as the recorder writes them (the tree's structure and
 the map latched), to be played with the player.
 
+With ``machine`` (a mode machine's JSON) the run also has the runner's mode state, the mode
+``normal`` current, as a runner of a mode file latches it.
+
 The tree is ``root`` (a sequence) over ``work`` and ``rest``. For :data:`DURATION` seconds it
 ticks every :data:`PERIOD`: before :data:`HALF` ``work`` is RUNNING; from then on ``work``
 succeeds and ``rest`` is RUNNING. The robot's pose is ``x`` = the second it was recorded at.
@@ -16,7 +19,12 @@ import numpy as np
 
 from cyborg.bus import MessageTypes
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
-from cyborg.bus.msgs.cyborg_msgs.msg import BehaviorTree, BehaviorTreeStatus, MapGeometry
+from cyborg.bus.msgs.cyborg_msgs.msg import (
+    BehaviorTree,
+    BehaviorTreeStatus,
+    MapGeometry,
+    ModeState,
+)
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import Header
 from cyborg.record.mcap_file import McapFile
@@ -49,8 +57,8 @@ def _stamp(seconds: float) -> Time:
     return Time(sec=int(seconds), nanosec=round((seconds % 1) * 1e9))
 
 
-def write_played_run(path: Path) -> None:
-    """Writes the run (see the module) to ``path``."""
+def write_played_run(path: Path, machine: str = "") -> None:
+    """Writes the run (see the module) to ``path``; with the mode state of ``machine``."""
     types = MessageTypes()
     file = McapFile(path, types)
 
@@ -61,6 +69,10 @@ def write_played_run(path: Path) -> None:
         file.write(channel, when, when, bytes(types.serialize(message, type_name)))
 
     add(f"{TREE}/behavior_tree", BehaviorTree(tree=STRUCTURE), 0.0, [LATCHED])
+    if machine:
+        add(f"{TREE}/mode", ModeState(entered=_stamp(0.0), mode="normal", held=False,
+                                      transitions=0, machine=machine, problems=[]),
+            0.0, [LATCHED])
     add(f"{ROBOT}/map_geometry", MapGeometry(
         header=Header(stamp=_stamp(0.0), frame_id="map"), source="square.map", hash="",
         resolution=0.1, lines=np.array([-1, -1, 6, -1, 6, -1, 6, 3], np.float32),

@@ -16,6 +16,8 @@ import { goalNames } from "./node_goals.js";
 import { showBlackboard, showNode } from "./panels.js";
 import { ModesPanel } from "./modes_panel.js";
 import { PlayerBar } from "./player_bar.js";
+import { showReplay } from "./replay.js";
+import { StopBanner } from "./stop_banner.js";
 import { badgeMarkup } from "./services.js";
 import { learnRobots, onRobotSelected, treeOfRobot } from "./robots.js";
 import { TreeFolds } from "./tree_folds.js";
@@ -81,12 +83,15 @@ const tickHistory = new History({ onShow: () => markDirty("all"), say });
 const playerBar = new PlayerBar({ send: (body) => command(body), onJump: () => { if (tickHistory.state) tickHistory.live(); } });
 // The mode machine of the shown tree runner, beside the tree (js/modes_panel.js).
 const modesPanel = new ModesPanel({ send: (body) => command(body) });
+// Trees a STOP halted: a red banner with Resume on every page (js/stop_banner.js).
+const stopBanner = new StopBanner({ send: (body) => command(body) });
 // Folded and unfolded nodes of each tree shown (a mode's tree keeps them while another runs).
 const folds = new TreeFolds();
 
 // ------------------------------------------------------------------ messages
 function receive(message) {
   stats.messages += 1;
+  stopBanner.receive(message); // reads robots and seat, takes nothing from the rest
   if (mapPanel.receive(message)) return;
   switch (message.t) {
     case "watching":
@@ -183,8 +188,10 @@ function receive(message) {
       modesPanel.show(message.ns, message.modes);
       modesPanel.showTreeMode(page.title, Boolean(model.root));
       break;
-    case "player":
+    case "player": // a played recording: its timeline, and nothing here acts (js/replay.js)
       playerBar.show(message.player);
+      showReplay(message.player);
+      toolbar();
       break;
     case "manual_pause": // the monitor paused a tree before a goal sent from the map
       page.manualPause = message.tree;

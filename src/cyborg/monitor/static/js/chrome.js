@@ -4,14 +4,18 @@
 // the runner gone), the robot selector and the message line. Each function redraws its part
 // from app.js's `page` state and the tree model; none keeps state of its own.
 
+import { replaying, sayWhyOff } from "./replay.js";
 import { colourOf, knownRobots, robotOfTree, selectRobot, treeOfRobot } from "./robots.js";
 
 const $ = (id) => document.getElementById(id);
 
 export function showToolbar(page, model) {
   const seat = page.seat;
-  const mayAct = seat.control && page.alive;
-  for (const button of document.querySelectorAll("button.control")) button.disabled = !mayAct;
+  const mayAct = seat.control && page.alive && !replaying();
+  for (const button of document.querySelectorAll("button.control")) {
+    button.disabled = !mayAct;
+    sayWhyOff(button); // a played recording: the tooltip says why it is off
+  }
   const run = $("run");
   run.textContent = page.enabled === false ? "▶ Run" : "❚❚ Pause";
   run.dataset.enabled = String(page.enabled);

@@ -10,7 +10,10 @@
 // wrong with the mode file or the machine (`problems`) is listed first, in red: a machine that
 // cannot be drawn is never a blank panel. For the page that holds the control seat, each state
 // other than the current one has Force and the panel has "Hold current mode"; other pages see
-// them disabled, the tooltip saying why.
+// them disabled, the tooltip saying why; so does every page while a recording plays
+// (js/replay.js).
+
+import { onReplay, replaying, REPLAY_WHY } from "./replay.js";
 
 const $ = (id) => document.getElementById(id);
 const LABEL_LIMIT = 36;
@@ -56,6 +59,7 @@ export class ModesPanel {
     this.seat = { may_control: false, control: false };
     this.alive = false;
     this.drawnMachine = "";
+    onReplay(() => this.controls());
     $("mode-hold").addEventListener("click", () => {
       if (this.modes) this.send({ t: "mode_hold", ns: this.ns, held: !this.modes.held });
     });
@@ -218,7 +222,7 @@ export class ModesPanel {
 
   controls() {
     if (!this.modes) return;
-    const why = !this.seat.may_control
+    const why = replaying() ? `Force and hold are ${REPLAY_WHY}` : !this.seat.may_control
       ? "View only: modes are forced from the monitor's own page on its machine, or with its token"
       : !this.seat.control ? "Another page has control (or none was taken): take control to force or hold a mode"
       : !this.alive ? "The tree runner is not on the bus" : "";

@@ -4,14 +4,17 @@
 //
 // Rules (the monitor enforces them; the page only shows them): every action but Stop needs the
 // control seat, so the buttons are disabled without it and say why; Stop needs only that this
-// page may control (loopback or the token) and always shows. Which robot: `robot()`, given by
-// the panel, the one function that says whose commands these are (the robot of the shown tree).
+// page may control (loopback or the token) and always shows. While a played recording is
+// shown (js/replay.js) every action, Stop too, is off and says why: nothing would carry it out.
+// Which robot: `robot()`, given by the panel, the one function that says whose commands these
+// are (the robot of the shown tree).
 //
 // Answers: the command's `result` (accepted or refused, and whether the tree was paused for
 // it), then for a goal a `robot_result` when it ends (reached, failed, canceled, no_path), and
 // `tour` messages as a tour goes on. Each becomes a row of the log, updated in place.
 
 import { say } from "../chrome.js";
+import { onReplay, replaying, REPLAY_WHY } from "../replay.js";
 import { CATEGORY } from "./map_model.js";
 
 const LOG_KEPT = 8;
@@ -42,6 +45,7 @@ export class MapActions {
     for (const element of this.bar.querySelectorAll("button, select")) element.dataset.tip = element.title;
     this.stopButton.dataset.tip = this.stopButton.title;
     this.stopButton.addEventListener("click", () => this.stop());
+    onReplay(() => this.refresh());
     $("#map-home").addEventListener("click", () => this.act({ t: "home" }, "home"));
     $("#map-dock").addEventListener("click", () => this.act({ t: "dock" }, "dock"));
     $("#map-undock").addEventListener("click", () => this.act({ t: "undock" }, "undock"));
@@ -61,11 +65,12 @@ export class MapActions {
 
   // Whether this page may act now (holds the seat, and there is a robot to act on).
   get canAct() {
-    return this.seat.control && this.robot() !== null;
+    return this.seat.control && this.robot() !== null && !replaying();
   }
 
   // Why the page may not act, or "".
   whyNot() {
+    if (replaying()) return REPLAY_WHY;
     if (!this.seat.may_control) return VIEW_ONLY;
     if (!this.seat.control) return NO_SEAT;
     if (this.robot() === null) return "no robot on the map";
@@ -88,7 +93,7 @@ export class MapActions {
       element.disabled = !!why;
       element.title = why ? `${element.dataset.tip} (${why})` : element.dataset.tip;
     }
-    const stopWhy = !this.seat.may_control ? VIEW_ONLY : ns === null ? "no robot on the map" : "";
+    const stopWhy = replaying() ? REPLAY_WHY : !this.seat.may_control ? VIEW_ONLY : ns === null ? "no robot on the map" : "";
     this.stopButton.disabled = !!stopWhy;
     this.stopButton.title = stopWhy ? `${this.stopButton.dataset.tip} (${stopWhy})` : this.stopButton.dataset.tip;
     this.onChange();
@@ -130,6 +135,10 @@ export class MapActions {
   // Sends `command` to the robot acted on; a log row shows it and then its answer.
   async act(command, text, evenWithoutSeat = false) {
     const ns = this.robot();
+    if (replaying()) {
+      say(`${text}: ${REPLAY_WHY}`, true);
+      return null;
+    }
     if (ns === null || !(evenWithoutSeat ? this.seat.may_control : this.canAct)) return null;
     const row = this.log(`${ns}: ${text}`, "pending");
     const result = await this.send({ ...command, ns });
