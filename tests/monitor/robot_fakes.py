@@ -109,17 +109,20 @@ class FakeRobotSource:
         self.namespace, self.alive, self.pose = namespace, True, [1.0, 2.0, 0.5]
 
 
-def acting_hub(*, token: str | None = None, objects: tuple[dict[str, Any], ...] = (HOME,)
-               ) -> tuple[Hub, dict[str, FakeBus]]:
-    """A hub over a fake tree (/cyborg/bt) with the robot /cyborg on a map of ``objects``; its
-    robot commands go to fake bus clients, one per robot, returned by namespace."""
-    hub = bare_hub(token=token)
-    source = cast(RobotSource, FakeRobotSource(ROBOT))
+def acting_hub(*, token: str | None = None, objects: tuple[dict[str, Any], ...] = (HOME,),
+               robots: tuple[str, ...] = (ROBOT,)) -> tuple[Hub, dict[str, FakeBus]]:
+    """A hub over fake trees (``<robot>/bt``, as ``cyborg up`` places them) with ``robots``
+    (default /cyborg) on a map of ``objects``; its robot commands go to fake bus clients, one
+    per robot, returned by namespace."""
+    trees = tuple(f"{robot}/bt" for robot in robots)
+    hub = bare_hub(token=token, namespaces=trees, runners=trees)
     stored = StoredMap("0" * 32, b"", 0, "campus.map", {"lines": 0, "points": 0,
                                                         "objects": len(objects)}, objects)
-    hub.robot_hub.robots[ROBOT] = RobotOutbox(source, Throttle(PATH_INTERVAL),
-                                              Throttle(DETECTIONS_INTERVAL),
-                                              Throttle(OBJECTS_INTERVAL), map=stored)
+    for robot in robots:
+        source = cast(RobotSource, FakeRobotSource(robot))
+        hub.robot_hub.robots[robot] = RobotOutbox(source, Throttle(PATH_INTERVAL),
+                                                  Throttle(DETECTIONS_INTERVAL),
+                                                  Throttle(OBJECTS_INTERVAL), map=stored)
     buses: dict[str, FakeBus] = {}
 
     def make(namespace: str) -> RobotClients:

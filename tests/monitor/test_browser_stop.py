@@ -55,6 +55,9 @@ def test_stop_keeps_the_robot_stopped_until_the_seat_resumes_the_tree(browser: B
         other.keyboard.press("Space")  # STOP needs no seat
         for page in (holder, other):
             page.wait_for_selector(BANNER, timeout=20000)
+        other.wait_for_function("[...document.querySelectorAll('#map-log li.ok')].some(li => li"
+                                f".textContent.includes('STOP — done — tree {TREE} stopped'))",
+                                timeout=20000)
         wait_until(lambda: live.system.runner.stopped and not live.system.runner.enabled, 20,
                    "the tree to be stopped")
         wait_until(lambda: live.system.sim.base.speed == 0, 20, "the robot to brake")

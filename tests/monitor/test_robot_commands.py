@@ -143,6 +143,21 @@ def test_a_stopped_tree_is_told_to_every_page_and_only_the_seat_resumes_it() -> 
     asyncio.run(scenario())
 
 
+def test_in_a_fleet_stop_stops_the_robot_acted_on_and_its_tree_alone() -> None:
+    """As MobileEyes and RViz's Nav2 panel act on one robot: the others drive on."""
+    hub, buses = acting_hub(robots=("/robot1", "/robot2", "/robot3"))
+
+    async def scenario() -> None:
+        answer = await _send(hub, page(hub, 1), {"t": "stop", "ns": "/robot2"})
+        assert answer["ok"] is True and answer["stopped"] == ["/robot2/bt"], answer
+        assert set(buses) == {"/robot2"} and buses["/robot2"].calls == [("stop",)]
+        assert {tree: (source.enabled, source.stopped) for tree, source in hub.sources.items()
+                } == {"/robot1/bt": (True, False), "/robot2/bt": (False, True),
+                      "/robot3/bt": (True, False)}
+
+    asyncio.run(scenario())
+
+
 BAD_FIELDS: list[tuple[dict[str, Any], str, str]] = [
     ({"t": "go", "goal": "Office"}, "ns", "name the robot in ns (such as /cyborg)"),
     ({"t": "go", "ns": "/nope", "goal": "Office"}, "ns",

@@ -145,7 +145,8 @@ export class MapActions {
     const goal = typeof result.goal === "string" ? result.goal : null;
     if (goal !== null) row.key = `${ns}|${goal}`;
     const paused = result.paused ? ` — tree ${result.paused} paused` : "";
-    this.update(row, result.ok ? (goal !== null ? "pending" : "ok") : "error", `${ns}: ${text} — ${result.ok ? (goal !== null ? "on its way" : "done") : "refused"}${paused}`, result.message);
+    const stopped = result.stopped?.length ? ` — tree ${result.stopped.join(", ")} stopped until resumed` : "";
+    this.update(row, result.ok ? (goal !== null ? "pending" : "ok") : "error", `${ns}: ${text} — ${result.ok ? (goal !== null ? "on its way" : "done") : "refused"}${paused}${stopped}`, result.message);
     say(result.message, !result.ok);
     return result;
   }
