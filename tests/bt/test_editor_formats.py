@@ -332,3 +332,52 @@ def test_cli_validate_prints_older_form_warnings_and_exits_0(
                and "parameters" in line for line in warnings)
     assert any("'id'" in line and "'Custom Name BT'" in line for line in warnings)
     assert f"{path}: ok (0 errors, " in out
+
+
+def _repeater_tree(max_loop: str) -> str:
+    """A 0.3.0 tree export: Repeater{maxLoop: ``max_loop``, as JSON text}[Succeeder]."""
+    return """{"version": "0.3.0", "scope": "tree", "id": "t1", "title": "Forever",
+ "root": "r", "properties": {},
+ "nodes": {
+  "r": {"id": "r", "name": "Repeater", "title": "Repeat <maxLoop>x",
+        "properties": {"maxLoop": MAX_LOOP}, "child": "s"},
+  "s": {"id": "s", "name": "Succeeder", "title": "Succeeder", "properties": {}}}}
+""".replace("MAX_LOOP", max_loop)
+
+
+@pytest.mark.parametrize("written", ["1e999", '"Infinity"', "1E+400"])
+def test_a_repeater_looping_infinity_times_runs_forever_with_a_note(
+        tmp_path: Path, written: str) -> None:
+    """behavior3js loops ``while (maxLoop < 0 || i < maxLoop)``: a maxLoop of infinity (JSON
+    writes it 1e999) never ends. It loads as -1 (forever), and a note says so."""
+    from cyborg.bt import Severity, check_file
+
+    path = tmp_path / "forever.b3.json"
+    path.write_text(_repeater_tree(written), encoding="utf-8")
+    (note,) = check_file(path, registry=registry())
+    assert note.severity is Severity.NOTE and not note.is_error
+    assert (note.node_id, note.field, note.line) == ("r", "maxLoop", 4)  # the node's line
+    assert "infinity" in note.message and "forever" in note.message
+    tree = load_tree(path, registry=registry(), clock=ManualClock())
+    assert tree.by_uid["r"].max_loop == -1  # type: ignore[attr-defined]
+    assert {tree.tick().status for _ in range(50)} == {Status.RUNNING}
+
+
+def test_a_note_is_counted_apart_from_errors_and_warnings(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from cyborg.app.cli import main
+
+    path = tmp_path / "forever.b3.json"
+    path.write_text(_repeater_tree("1e999"), encoding="utf-8")
+    assert main(["bt", "validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert f"{path}:4: note: " in out
+    assert f"{path}: ok (0 errors, 0 warnings, 1 note)" in out
+
+
+@pytest.mark.parametrize("written", ["-1e999", '"-Infinity"', "NaN"])
+def test_a_loop_count_of_minus_infinity_or_nan_is_still_an_error(written: str) -> None:
+    from cyborg.bt import TreeLoadError
+
+    with pytest.raises(TreeLoadError, match=r"'maxLoop'.*finite"):
+        loads_tree(_repeater_tree(written), registry=registry(), clock=ManualClock())

@@ -68,13 +68,32 @@ def _errors(path: Path, **options: Any) -> list[Any]:
     return [p for p in check_file(path, **options) if p.is_error]
 
 
+_EMPTY_CMPS = {"editor-sample/workdir/subtree2.json": ("editor-sample/workdir/subtree2.json", "2"),
+               "editor-sample/workdir/monster.json": ("editor-sample/workdir/subtree2.json", "2"),
+               "editor-sample/workdir/sub/subtree2.json": (
+                   "editor-sample/workdir/sub/subtree2.json", "2")}
+"""The one defect of the samples, by the file loaded: a Cmp with none of gt, ge, eq, lt, le
+(behavior3editor's own check marks it too) in the editor's sample workdir, in its two
+subtree2.json files, the first of them referenced by monster.json."""
+
+
+def _defects(path: Path) -> list[tuple[str, str]]:
+    """The sample defects a load of ``path`` meets: those of the files it reads."""
+    defect = _EMPTY_CMPS.get(path.relative_to(SAMPLES).as_posix())
+    return [defect] if defect else []
+
+
 @pytest.mark.parametrize("path", SAMPLE_TREES, ids=lambda p: str(p.relative_to(SAMPLES)))
 def test_every_sample_tree_loads_with_stubs_for_the_game_nodes(path: Path) -> None:
     """The editor's sample workdir, behavior3-ts's examples and behavior3lua's trees: only
     their game-specific nodes (Attack, GetHp, ...) and v1 stock nodes cyborg lacks need
-    stubs; every subtree path resolves and every port binding fits."""
-    assert _errors(path, stub_missing=Status.SUCCESS) == []
-    tree = load_tree(path, stub_missing=Status.SUCCESS, clock=ManualClock())
+    stubs; every subtree path resolves and every port binding fits. The sample's Cmp without
+    a comparison is the only error; with a stub for Cmp every sample loads and ticks."""
+    errors = _errors(path, stub_missing=Status.SUCCESS)
+    assert [(Path(p.source).relative_to(SAMPLES).as_posix(), p.node_id)
+            for p in errors] == _defects(path)
+    registry = _registry_without("Cmp") if errors else default_registry()
+    tree = load_tree(path, registry=registry, stub_missing=Status.SUCCESS, clock=ManualClock())
     assert tree.tick().status in Status
 
 
@@ -95,12 +114,14 @@ def test_without_stubs_the_missing_nodes_are_named_with_file_line_and_id() -> No
     assert "declared in node-config.b3-setting" in get_hp.message
     cmp_in_subtree = by_node[("subtree2.json", "2")]  # problems point into the subtree's file
     assert "unknown node name 'Cmp'" in cmp_in_subtree.message and cmp_in_subtree.line == 15
-    assert ("subtree2.json", "2") not in {(Path(p.source).name, p.node_id)
-                                         for p in _errors(monster)}, "cyborg has Cmp now"
+    assert "Cmp needs one of the args" in {(Path(p.source).name, p.node_id): p.message
+                                           for p in _errors(monster)}[("subtree2.json", "2")], \
+        "cyborg has Cmp now, and finds the sample's Cmp without a comparison"
 
 
 def test_subtree_paths_resolve_against_the_workdir_and_each_reference_is_an_instance() -> None:
-    tree = load_tree(EDITOR / "workdir" / "monster.json", stub_missing=Status.SUCCESS)
+    tree = load_tree(EDITOR / "workdir" / "monster.json", registry=_registry_without("Cmp"),
+                     stub_missing=Status.SUCCESS)  # a stub for the sample's Cmp without args
     structure = tree.structure.to_json()
     attack = structure["root"]["children"][0]["children"][0]  # the tree's Sequence "攻击"
     assert attack["label"] == "攻击"
@@ -141,6 +162,83 @@ def test_ports_bind_blackboard_keys_by_position(tmp_path: Path) -> None:
     assert tree.by_uid["2"].ports == {"name": "visitor", "said": "last"}
     assert tree.tick().status is Status.SUCCESS
     assert blackboard["last"] == "Hello, Ada"
+
+
+def test_a_null_input_is_an_unbound_port_as_the_editor_reads_it(tmp_path: Path) -> None:
+    """behavior3editor 1.x writes ``"input": [null]`` for a port left empty."""
+    path = _write(tmp_path, "nulls.json", _node(1, "Sequence",
+                  _node(2, "Greet", input=["visitor", None], output=["said"]),
+                  _node(3, "Let", args={"value": 3}, input=[None], output=["hp"])))
+    assert _errors(path, registry=_registry()) == []
+    blackboard = Blackboard({"visitor": "Ada"})
+    tree = load_tree(path, registry=_registry(), blackboard=blackboard)
+    assert tree.by_uid["2"].ports == {"name": "visitor", "said": "said"}
+    assert tree.tick().status is Status.SUCCESS
+    assert (blackboard["said"], blackboard["hp"]) == ("Hello, Ada", 3)
+
+
+def test_an_input_that_is_neither_a_name_nor_null_is_still_an_error(tmp_path: Path) -> None:
+    path = _write(tmp_path, "bad.json", _node(1, "Let", args={"value": 3}, input=[7],
+                                              output=["hp"]))
+    (error,) = _errors(path)
+    assert (error.node_id, error.field) == ("1", "input") and "null" in error.message
+
+
+@pytest.mark.parametrize(("name", "time", "fragment"), [
+    ("Wait", "abc", "arg 'time' must be a finite number of seconds, 0 or more, not 'abc'"),
+    ("Wait", -2, "arg 'time' must be a finite number of seconds, 0 or more, not -2"),
+    ("Wait", True, "arg 'time' must be a finite number of seconds, 0 or more, not True"),
+    ("Timeout", [1], "arg 'time' must be a finite number of seconds, 0 or more, not [1]"),
+    ("Timeout", None, "missing arg 'time' (seconds)"),
+])
+def test_a_bad_v1_time_is_named_as_the_file_names_it(tmp_path: Path, name: str, time: Any,
+                                                     fragment: str) -> None:
+    """The file says ``time`` in seconds; cyborg's node takes ``milliseconds``: an error must
+    name the file's field and value, never the internal one."""
+    args = {} if time is None else {"time": time}
+    children = [_node(2, "JustSuccess")] if name == "Timeout" else []
+    path = _write(tmp_path, "wait.json", _node(1, name, *children, args=args))
+    (error,) = _errors(path)
+    assert (error.node_id, error.field, error.line) == ("1", "time", 6)
+    assert fragment in error.message and "milliseconds" not in error.message
+
+
+def test_a_v1_time_written_as_text_is_read_as_seconds(tmp_path: Path) -> None:
+    path = _write(tmp_path, "wait.json", _node(1, "Wait", args={"time": "1.5"}))
+    assert load_tree(path).by_uid["1"].properties == {"milliseconds": 1500}
+
+
+def test_a_cmp_without_a_comparison_is_found_by_validate_and_never_run(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """behavior3editor's own check refuses a Cmp with none of gt, ge, eq, lt, le; so does
+    ``cyborg bt validate``, and ``bt run`` refuses to load it instead of raising per tick."""
+    path = _write(tmp_path, "cmp.json", _node(1, "Sequence",
+                  _node(2, "Let", args={"value": 3}, input=[""], output=["hp"]),
+                  _node(3, "Cmp", input=["hp"])))
+    (error,) = _errors(path)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    assert (error.node_id, error.line) == ("3", lines.index('        "id": 3,') + 1)
+    assert "Cmp needs one of the args gt, ge, eq, lt, le" in error.message
+    assert main(["bt", "validate", str(path)]) == 1
+    assert "invalid (1 error" in capsys.readouterr().out
+    assert main(["bt", "run", str(path), "--fast", "--ticks", "2"]) == 1
+    err = capsys.readouterr().err
+    assert "Cmp needs one of the args" in err and "Traceback" not in err
+
+
+def test_a_node_error_while_ticking_is_one_line_never_a_traceback(
+        caplog: pytest.LogCaptureFixture, tmp_path: Path) -> None:
+    """A stock v1 node that meets bad input reports it as the node's error, in one line."""
+    path = _write(tmp_path, "cmp.json", _node(1, "Sequence",
+                  _node(2, "Let", args={"value": "high"}, input=[""], output=["hp"]),
+                  _node(3, "Cmp", args={"lt": 5}, input=["hp"])))
+    tree = load_tree(path)
+    with caplog.at_level(logging.DEBUG, logger="cyborg.bt"):
+        assert tree.tick().status is Status.ERROR
+    (record,) = [r for r in caplog.records if r.levelno >= logging.ERROR]
+    assert record.exc_info is None
+    assert "node 3 (Cmp, Cmp) returns ERROR in tick: Cmp compares a number, not 'high'" in (
+        record.getMessage())
 
 
 def test_a_required_port_left_unbound_and_extra_keys_are_reported(tmp_path: Path) -> None:

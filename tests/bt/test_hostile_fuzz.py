@@ -2,14 +2,18 @@
 
 A hypothesis fuzz suite over tree files of both formats (150 examples each, about 5 s in all):
 every input loads, and then ticks, halts, draws and serialises, or raises TreeLoadError whose
-problems are all located; never another exception, never a hang. The attacks one by one are in
-the other tests/bt/test_hostile_*.py modules.
+problems are all located; never another exception, never a hang; and no node's error while
+ticking is logged as a traceback. Among the inputs are what real editor files hold: a loop
+count of ``1e999`` (infinity: forever), ``"input": [null]`` (an unbound port), a Cmp without a
+comparison, a Wait whose ``time`` is not a number of seconds. The attacks one by one are in the
+other tests/bt/test_hostile_*.py modules.
 """
 
 from __future__ import annotations
 
 import itertools
 import json
+import logging
 import os
 import tempfile
 from collections.abc import Callable, Iterator
@@ -28,7 +32,7 @@ from tests.bt.hostile_helpers import _bounded, _chain, _registry, assert_located
 # files (a FIFO among them), then sometimes cut or spliced as text. Every input must load (and
 # then tick, halt, draw and serialise) or raise TreeLoadError whose problems are all located.
 # Placeholders stand for what json.dumps cannot write (or would recurse on); _expand fills them.
-_SPLICES = {"@@NAN@@": "NaN", "@@INF@@": "-Infinity", "@@E400@@": "1e400",
+_SPLICES = {"@@NAN@@": "NaN", "@@INF@@": "-Infinity", "@@E400@@": "1e400", "@@E999@@": "1e999",
             "@@DIGITS@@": "9" * 1200, "@@SURROGATE@@": '"a\\udc00"'}
 _DECLARATIONS = ["BatteryWatch(interval=0.01, run_on_activation=true); ClosestGoal",
                  "BatteryWatch(interval=1e-300)", "Nope(", "ClosestGoal; ClosestGoal",
@@ -55,7 +59,7 @@ _NAMES = ["Sequence", "Priority", "MemSequence", "Parallel", "Inverter", "Repeat
           *_TREES, "", "NoSuchNode"]
 _V1_NAMES = ["Sequence", "Selector", "Parallel", "Invert", "AlwaysSuccess", "Wait", "Timeout",
              "JustSuccess", "JustFailure", "Check", "Let", "IfElse", "Once", "Repeat",
-             "RetryUntilSuccess", "Race", "Delay", "Listen", "Nope", ""]
+             "RetryUntilSuccess", "Race", "Delay", "Listen", "Cmp", "Nope", ""]
 
 
 def _expand(text: str) -> str:
@@ -106,9 +110,11 @@ _NUMBER = st.integers(0, 9).flatmap(
     lambda k: _SCALARS if k == 0 else st.integers(1, 5) if k < 8 else st.floats(0, 2000))
 _TAME_LEAVES = {"Succeeder": {}, "Failer": {}, "Runner": {}, "Wait": {"milliseconds": _NUMBER},
                 "Below": {"below": _NUMBER, "radius": _NUMBER, "count": _NUMBER}}
-_TAME_DECORATORS = {"Inverter": {}, "Repeater": {"maxLoop": _NUMBER},
-                    "Timeout": {"milliseconds": _NUMBER}, "Limiter": {"maxLoop": _NUMBER},
-                    "Retry": {"maxAttempts": _NUMBER}, "MaxTime": {"maxTime": _NUMBER}}
+_LOOPS = _NUMBER | st.just("@@E999@@")
+"""A loop count: mostly a plausible number, sometimes infinity as JSON writes it (1e999)."""
+_TAME_DECORATORS = {"Inverter": {}, "Repeater": {"maxLoop": _LOOPS},
+                    "Timeout": {"milliseconds": _NUMBER}, "Limiter": {"maxLoop": _LOOPS},
+                    "Retry": {"maxAttempts": _LOOPS}, "MaxTime": {"maxTime": _NUMBER}}
 
 
 @st.composite
@@ -157,7 +163,7 @@ def _file03(draw: st.DrawFn) -> str:
     if draw(st.booleans()):  # tame: a project the engine should mostly load
         tame = [draw(_tame_tree03(tree_id, _TREES[index + 1:count]))
                 for index, tree_id in enumerate(_TREES[:count])]
-        return json.dumps({"trees": tame, "selectedTree": "t0"}, indent=1)
+        return _expand(json.dumps({"trees": tame, "selectedTree": "t0"}, indent=1))
     trees: list[Any] = [draw(st.one_of(_tame_tree03(tree_id, _TREES), _tree03(tree_id)))
              for tree_id in _TREES[:count]]
     shape = draw(st.sampled_from(["project", "project", "tree", "desktop", "nodes"]))
@@ -195,7 +201,7 @@ def _node_v1(draw: st.DrawFn, depth: int = 0) -> dict[str, Any]:
                              st.sampled_from([None, True, 10 ** 400]))),
         "name": draw(st.sampled_from(_V1_NAMES)), "desc": draw(_TEXT)}
     for key, strategy in (("args", _PROPERTIES | _SCALARS),
-                          ("input", st.lists(st.sampled_from(["a", "b", ""]), max_size=2)
+                          ("input", st.lists(st.sampled_from(["a", "b", "", None]), max_size=2)
                            | _SCALARS),
                           ("output", st.lists(st.sampled_from(["a", "c"]), max_size=2)),
                           ("disabled", st.booleans()),
@@ -211,8 +217,9 @@ def _node_v1(draw: st.DrawFn, depth: int = 0) -> dict[str, Any]:
 _TAME_V1 = {"JustSuccess": {}, "JustFailure": {}, "Wait": {"time": _NUMBER},
             "Check": {"value": st.sampled_from(["a > 1", "b", "c.d[0] + 'x'", "1 / 0"])},
             "Let": {"value": _VALUES}, "Sequence": {}, "Selector": {}, "Parallel": {},
-            "Invert": {}, "AlwaysSuccess": {}, "Once": {}, "Repeat": {"count": _NUMBER},
-            "Timeout": {"time": _NUMBER}, "Race": {}, "IfElse": {}}
+            "Invert": {}, "AlwaysSuccess": {}, "Once": {}, "Repeat": {"count": _LOOPS},
+            "Timeout": {"time": _NUMBER}, "Race": {}, "IfElse": {},
+            "Cmp": {"gt": _NUMBER, "lt": _NUMBER}}
 
 
 @st.composite
@@ -223,8 +230,8 @@ def _tame_v1(draw: st.DrawFn, depth: int = 0, subtree: bool = True) -> dict[str,
     name = draw(st.sampled_from(sorted(k for k in _TAME_V1 if not leaf or not _ARITY.get(k))))
     node: dict[str, Any] = {"id": 0, "name": name, "args": {
         key: draw(value) for key, value in _TAME_V1[name].items() if draw(st.integers(0, 5))}}
-    if name == "Check" and draw(st.booleans()):
-        node["input"] = ["a"]
+    if name in ("Check", "Cmp") and draw(st.booleans()):
+        node["input"] = [draw(st.sampled_from(["a", None]))]
     if name == "Let":
         node["output"] = ["a"]
     low, high = _ARITY.get(name, (0, 0))
@@ -258,8 +265,8 @@ def _files_v1(draw: st.DrawFn) -> dict[str, str]:
 
     def tree_text(subtree: bool = True) -> str:
         if tame:
-            return json.dumps({"name": "t", "root": _numbered(draw(_tame_v1(0, subtree)),
-                                                            itertools.count(1))})
+            return _expand(json.dumps({"name": "t", "root": _numbered(
+                draw(_tame_v1(0, subtree)), itertools.count(1))}))
         root = draw(st.one_of(_tame_v1().map(lambda n: _numbered(n, itertools.count(1))),
                               _node_v1()))
         data = {"name": draw(_TEXT), "root": root,
@@ -280,9 +287,22 @@ def _files_v1(draw: st.DrawFn) -> dict[str, str]:
     return files
 
 
+class _Tracebacks(logging.Handler):
+    """Collects the records of ``cyborg.bt`` that carry a traceback."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.exc_info:
+            self.records.append(record)
+
+
 def _exercise(load: Callable[[], Tree]) -> str:
     """Load; on success tick, draw, serialise and halt the tree; on failure check the
-    problems are located. Returns what happened, for hypothesis' statistics."""
+    problems are located. Returns what happened, for hypothesis' statistics. No node's error
+    while ticking is a traceback: the stock nodes report bad input as a NodeError, one line."""
     try:
         tree = load()
     except TreeLoadError as exc:
@@ -291,10 +311,17 @@ def _exercise(load: Callable[[], Tree]) -> str:
             assert_located(problem)
         str(exc).encode("utf-8")
         return "refused"
-    for _ in range(3):
-        tree.tick()
-        assert isinstance(tree.clock, ManualClock)
-        tree.clock.advance(0.5)
+    tracebacks = _Tracebacks()
+    logger = logging.getLogger("cyborg.bt")
+    logger.addHandler(tracebacks)
+    try:
+        for _ in range(3):
+            tree.tick()
+            assert isinstance(tree.clock, ManualClock)
+            tree.clock.advance(0.5)
+    finally:
+        logger.removeHandler(tracebacks)
+    assert not tracebacks.records, [record.getMessage() for record in tracebacks.records]
     tree.to_dot().encode("utf-8")
     json.dumps(tree.structure.to_json(), ensure_ascii=False).encode("utf-8")
     tree.halt()

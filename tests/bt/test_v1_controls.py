@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 
-from cyborg.bt import Status
+from cyborg.bt import NodeError, Status
 from cyborg.bt.v1_controls import MAX_LOOPS_PER_TICK
 from tests.bt.v1_samples import LogLines, calc, check, let, load, log, n, run, s, seq, wait
 from tests.builders import events
@@ -176,7 +176,7 @@ def test_always_running_and_assert() -> None:
     tree, clock = load(n("Assert", s("RSF", "child"), args={"message": "must hold"}))
     assert run(tree, clock, 3) == "RSE"
     error = tree.nodes[1].last_error
-    assert isinstance(error, AssertionError)
+    assert isinstance(error, NodeError)
     assert str(error) == "must hold (the child returned failure)"
 
 

@@ -25,6 +25,7 @@ from tests.builders import registry
                          "expected a value but found '>' at column 7"),
     (calc("a +", "b"), "Calculate(value='a +') raised ExpressionError"),
     (n("Cmp", args={"value": "(", "gt": 1}, i=[""]), "Cmp(value='(', gt=1.0) raised"),
+    (n("Cmp", i=["hp"]), "Cmp needs one of the args gt, ge, eq, lt, le"),
     (n("IfElse", n("JustSuccess")), "IfElse takes 2 or 3 children, not 1"),
     (n("Watchdog", n("JustSuccess"), n("JustSuccess")), "Watchdog takes 3 children, not 2"),
     (n("Case", n("JustSuccess")), "Case takes 2 children, not 1"),

@@ -24,7 +24,7 @@ from cyborg.bt import (
     default_registry,
     load_tree,
 )
-from cyborg.bt.problems import Problem
+from cyborg.bt.problems import Problem, Severity
 from cyborg.bt.registry import NodeModuleError
 from cyborg.bt.tick_loop import DEFAULT_RATE
 from cyborg.robot.interface import ROBOT
@@ -138,15 +138,17 @@ def validate_command(args: argparse.Namespace) -> int:
     problems = check_file(args.file, tree=args.tree, registry=registry_for(args),
                           stub_missing=args.stub_missing)
     errors = sum(p.is_error for p in problems)
-    warnings = len(problems) - errors
+    notes = sum(p.severity is Severity.NOTE for p in problems)
+    warnings = len(problems) - errors - notes
     if args.json:
         json.dump([_problem_json(p) for p in problems], sys.stdout, indent=2)
         print()
     else:
         print_problems(problems, sys.stdout)
         verdict = "invalid" if errors else "ok"
+        noted = f", {notes} note{'s' if notes != 1 else ''}" if notes else ""
         print(f"{args.file}: {verdict} ({errors} error{'s' if errors != 1 else ''}, "
-              f"{warnings} warning{'s' if warnings != 1 else ''})")
+              f"{warnings} warning{'s' if warnings != 1 else ''}{noted})")
     return 1 if errors else 0
 
 

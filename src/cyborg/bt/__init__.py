@@ -44,7 +44,7 @@ from cyborg.bt.editor_format import ProjectSpec, parse_project, read_project, re
 from cyborg.bt.hooks import Hook, HookError, HookMode, TreeHooks
 from cyborg.bt.leaves import Error, Failer, Runner, Succeeder, Wait
 from cyborg.bt.loader import check_file, load_tree, loads_tree
-from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
+from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node, NodeError
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, NodeType, default_registry, register
 from cyborg.bt.service_registry import (
@@ -88,6 +88,7 @@ __all__ = [
     "MemSequence",
     "MonotonicClock",
     "Node",
+    "NodeError",
     "NodeRegistry",
     "NodeType",
     "Parallel",

@@ -333,6 +333,8 @@ class _Builder:
         binding = bind(node_type.signature, properties)
         for field, message in binding.warnings:
             self.report(message, tree, spec, field, Severity.WARNING)
+        for field, message in binding.notes:
+            self.report(message, tree, spec, field, Severity.NOTE)
         for field, message in binding.errors:
             self.report(message, tree, spec, field)
         if binding.errors:

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing_extensions import override
 
 from cyborg.bt.node import Decorator
+from cyborg.bt.properties import LoopCount
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 
 
@@ -56,13 +57,15 @@ def _check_loop(field: str, value: int) -> list[str]:
 class Repeater(Decorator):
     """Ticks the child again each time it completes, ``maxLoop`` times (``-1``: forever).
 
+    A ``maxLoop`` of infinity (``1e999`` in JSON) is read as ``-1``, with a note.
+
     Completion with SUCCESS or FAILURE both count as one loop; ERROR stops the loop and is
     returned. After the last loop the child's last status is returned. One loop per tick.
     """
 
     _until: Status | None = None  # stop early when the child returns this
 
-    def __init__(self, max_loop: int = -1) -> None:
+    def __init__(self, max_loop: LoopCount = -1) -> None:
         self.max_loop = max_loop
 
     def check(self) -> list[str]:
@@ -106,7 +109,7 @@ class RepeatUntilSuccess(Repeater):
 class Retry(RepeatUntilSuccess):
     """Retries a failing child up to ``maxAttempts`` times in all (``-1``: forever)."""
 
-    def __init__(self, max_attempts: int = 3) -> None:
+    def __init__(self, max_attempts: LoopCount = 3) -> None:
         self.max_loop = max_attempts
 
     def check(self) -> list[str]:

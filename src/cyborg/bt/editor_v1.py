@@ -39,7 +39,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from cyborg.bt.editor_v1_names import EQUIVALENTS, NO_EQUIVALENT
+from cyborg.bt.editor_v1_names import EQUIVALENTS, NO_EQUIVALENT, ArgError
 from cyborg.bt.files import FileRefusedError, decode_json, read_text
 from cyborg.bt.json_text import TextLines, first_lines
 from cyborg.bt.limits import Limits
@@ -329,7 +329,11 @@ class V1Reader:
             return self.reference(spec, path, tree, source, depth)
         equivalent = EQUIVALENTS.get(spec.name)
         if equivalent is not None:
-            spec.name, spec.properties = equivalent.name, equivalent.convert(args)
+            try:
+                spec.name, spec.properties = equivalent.name, equivalent.convert(args)
+            except ArgError as exc:
+                self.problem(str(exc), source, tree=tree, node=spec, field=exc.arg)
+                spec.name = equivalent.name
         else:
             spec.properties = dict(args)
             spec.foreign = NO_EQUIVALENT.get(spec.name, "")
@@ -384,13 +388,17 @@ class V1Reader:
 
     def keys(self, raw: dict[str, Any], field: str, tree: TreeSpec, spec: NodeSpec,
              source: str) -> list[str]:
-        """The variable names in ``raw[field]``; none and a problem if not an array of strings."""
+        """The variable names in ``raw[field]``; none and a problem if not an array of strings.
+
+        A ``null`` entry is an unbound port (``""``), as the editor reads it.
+        """
         value = raw.get(field, [])
-        if not isinstance(value, list) or not all(isinstance(k, str) for k in value):
-            self.problem(f"'{field}' must be an array of blackboard variable names", source,
-                         tree=tree, node=spec, field=field)
+        if not isinstance(value, list) or not all(k is None or isinstance(k, str)
+                                                  for k in value):
+            self.problem(f"'{field}' must be an array of blackboard variable names (or null "
+                         "for an unbound port)", source, tree=tree, node=spec, field=field)
             return []
-        return list(value)
+        return ["" if key is None else key for key in value]
 
     def check_variables(self, project: ProjectSpec) -> None:
         """Once variables are declared, every input and output must name one of them."""

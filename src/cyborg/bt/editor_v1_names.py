@@ -12,9 +12,13 @@ class of that name, or run with ``--stub-missing``). docs/behavior3-v1.md has th
 
 from __future__ import annotations
 
+import contextlib
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
+
+from cyborg.bt.problems import shown
 
 Args = dict[str, Any]
 
@@ -23,16 +27,39 @@ def _same(args: Args) -> Args:
     return dict(args)
 
 
-def _seconds(key: str) -> Callable[[Args], Args]:
-    """``{key: seconds}`` -> ``{"milliseconds": seconds * 1000}``, other args kept."""
+class ArgError(ValueError):
+    """A v1 arg that cannot be converted; :attr:`arg` is its name in the file."""
+
+    def __init__(self, arg: str, message: str) -> None:
+        super().__init__(message)
+        self.arg = arg
+
+
+def _seconds(key: str, *, required: bool = False) -> Callable[[Args], Args]:
+    """``{key: seconds}`` -> ``{"milliseconds": seconds * 1000}``, other args kept.
+
+    The seconds are checked here, where the file's name and value for them are known: a value
+    that is not a finite number of 0 or more (text holding one is fine, as the editor's panel
+    writes it), or a ``required`` one that is missing, raises :class:`ArgError` naming ``key``.
+    """
 
     def convert(args: Args) -> Args:
         result = {name: value for name, value in args.items() if name != key}
-        seconds = args.get(key)
+        if key not in args:
+            if required:
+                raise ArgError(key, f"missing arg {key!r} (seconds)")
+            return result
+        seconds = args[key]
+        number = None
         if isinstance(seconds, int | float) and not isinstance(seconds, bool):
-            result["milliseconds"] = seconds * 1000
-        elif key in args:
-            result["milliseconds"] = seconds  # the node's own check names the bad value
+            number = seconds
+        elif isinstance(seconds, str) and len(seconds) <= 100:
+            with contextlib.suppress(ValueError):
+                number = float(seconds)
+        if number is None or not math.isfinite(number) or number < 0:
+            raise ArgError(key, f"arg {key!r} must be a finite number of seconds, 0 or more, not "
+                                f"{shown(seconds)}")
+        result["milliseconds"] = number * 1000
         return result
 
     return convert
@@ -57,6 +84,7 @@ class Equivalent:
     name: str
     note: str = ""
     convert: Callable[[Args], Args] = field(default=_same)
+    """The file's args as the node's properties; raises :class:`ArgError` for a bad one."""
 
 
 EQUIVALENTS: dict[str, Equivalent] = {
@@ -71,7 +99,8 @@ EQUIVALENTS: dict[str, Equivalent] = {
     "JustSuccess": Equivalent("Succeeder"),
     "JustFailure": Equivalent("Failer"),
     "Wait": Equivalent("Wait", "time in seconds -> milliseconds", _seconds("time")),
-    "Timeout": Equivalent("Timeout", "time in seconds -> milliseconds", _seconds("time")),
+    "Timeout": Equivalent("Timeout", "time in seconds -> milliseconds",
+                          _seconds("time", required=True)),
     "RepeatUntilSuccess": Equivalent("RetryUntilSuccess", "behavior3lua's name; maxLoop -> count",
                                      _renamed("maxLoop", "count")),
     "RepeatUntilFailure": Equivalent("RetryUntilFailure", "behavior3lua's name; maxLoop -> count",

@@ -8,7 +8,8 @@
     snapshot = tree.tick()
 
 Errors raise :class:`~cyborg.bt.problems.TreeLoadError` listing every problem; warnings are
-logged. :func:`check_file` returns all problems (errors and warnings) without raising.
+logged (notes, which say how a value was read, at INFO). :func:`check_file` returns all
+problems (errors, warnings and notes) without raising.
 
 Every load is bounded by three caps, each a keyword here: ``max_bytes`` (bytes read, all files
 together), ``max_depth`` (levels of the built tree) and ``max_nodes`` (node instances after
@@ -27,7 +28,7 @@ from cyborg.bt.clock import Clock
 from cyborg.bt.editor_format import ProjectSpec, parse_project, read_project
 from cyborg.bt.limits import Limits, size
 from cyborg.bt.node import TickRecord
-from cyborg.bt.problems import Problem, TreeLoadError
+from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, default_registry
 from cyborg.bt.service_registry import ServiceRegistry
 from cyborg.bt.service_runner import ServiceRunner
@@ -63,8 +64,9 @@ def load_tree(source: str | Path | ProjectSpec, *, tree: str | None = None,
     errors = [p for p in result.problems if p.is_error]
     if errors or result.root is None or result.tree is None:
         raise TreeLoadError(result.problems)
-    for problem in result.problems:
-        log.warning("%s", problem)
+    for problem in result.problems:  # a note says how the file was read: no warning
+        log.log(logging.INFO if problem.severity is Severity.NOTE else logging.WARNING, "%s",
+                problem)
     return Tree(result.root, record=record, blackboard=blackboard, clock=clock,
                 source=project.source, tree_id=result.tree.id, title=result.tree.title,
                 services=ServiceRunner(result.services) if result.services else None)

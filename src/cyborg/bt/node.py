@@ -49,6 +49,16 @@ PostTick = Callable[["Node", Status], Status | None]
 """A ``node.post_tick`` callback: a status other than the one given replaces it."""
 
 
+class NodeError(Exception):
+    """A node's own account of why it returns ERROR: a bad input, an unset variable.
+
+    Raise it from ``tick`` (or ``on_start``, ``on_end``, ``on_halt``) with a message that says
+    what is wrong in the tree's terms; the node returns ERROR and the message is logged in one
+    line, naming the node, with no traceback. Any other exception is a fault in the node's code:
+    it is logged with its traceback, which is what finding that fault takes.
+    """
+
+
 class Category(StrEnum):
     """The editor's node categories, plus ``tree`` for a subtree reference."""
 
@@ -288,6 +298,9 @@ class Node(ExtensionPoints):
         )
         if repeated:
             log.debug("node %s (%s) raised again in %s: %r", self.uid, self.label, during, exc)
+        elif isinstance(exc, NodeError):
+            log.error("node %s (%s, %s) returns ERROR in %s: %s; the tree keeps ticking",
+                      self.uid, self.label, self.name, during, exc)
         else:
             log.error(
                 "node %s (%s, %s) raised in %s; it returns ERROR and the tree keeps ticking",

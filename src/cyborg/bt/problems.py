@@ -14,10 +14,15 @@ from typing import Any
 
 
 class Severity(StrEnum):
-    """How bad a :class:`Problem` is: an error stops the load, a warning does not."""
+    """How bad a :class:`Problem` is: an error stops the load, a warning or a note does not.
+
+    A warning is something that is probably wrong; a note says how the file was read where it
+    could be misread (a loop count of infinity, run as "forever").
+    """
 
     ERROR = "error"
     WARNING = "warning"
+    NOTE = "note"
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,10 @@ The editor writes property names in camelCase (``maxLoop``); Python parameters a
   means infinity: a ``float`` parameter whose *default* is infinite (``below: float =
   math.inf``, "no limit") also takes either infinity. A whole number of any size fits an
   ``int`` parameter;
+* a count whose hint is annotated :class:`Unbounded` (``Annotated[int, Unbounded(-1)]``, the
+  :data:`LoopCount` of the repeating decorators) also takes positive infinity, and gets the
+  value that means "no end" instead, with a note: behavior3js loops ``while (i < maxLoop)``,
+  so a ``maxLoop`` of ``1e999`` (how JSON writes infinity) runs forever;
 * ``str``, ``Literal[...]``, ``Enum`` (by value or name), ``X | None``, ``list[X]``,
   ``dict[str, X]`` and ``Any`` are supported; other hints are passed through unchecked.
 
@@ -27,17 +31,30 @@ A required parameter with no property is an error; a property no parameter takes
 from __future__ import annotations
 
 import inspect
+import json
 import math
 import re
 import types
 import typing
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
-from typing import Any, Literal, Union
+from typing import Annotated, Any, Literal, Union
 
 from cyborg.bt.problems import shown
 
 _MISSING = inspect.Parameter.empty
+
+
+@dataclass(frozen=True)
+class Unbounded:
+    """Marks a count parameter in which positive infinity means "no end" (see the module)."""
+
+    means: Any
+    """The value the node takes for "no end" (``-1``, or ``None``)."""
+
+
+LoopCount = Annotated[int, Unbounded(-1)]
+"""A number of loops, ``-1`` for forever; infinity in a file is read as ``-1``."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +67,8 @@ class Param:
     """The camelCase name the editor uses (``maxLoop``)."""
     hint: Any
     default: Any = _MISSING
+    unbounded: Unbounded | None = None
+    """Set when infinity stands for this count's "no end" value."""
 
     @property
     def required(self) -> bool:
@@ -83,6 +102,8 @@ class Binding:
     errors: list[tuple[str, str]]
     """(field, message) pairs that stop the node from being built."""
     warnings: list[tuple[str, str]]
+    notes: list[tuple[str, str]] = field(default_factory=list)
+    """(field, message) pairs that say how a value was read, such as infinity as "forever"."""
 
 
 def snake_case(name: str) -> str:
@@ -103,7 +124,7 @@ def signature_of(factory: Any) -> Signature:
         return Signature((), False)
     sig = inspect.signature(target)
     try:
-        hints = typing.get_type_hints(target)
+        hints = typing.get_type_hints(target, include_extras=True)
     except Exception:  # unresolvable forward references: check nothing rather than fail
         hints = {}
     params = []
@@ -117,9 +138,18 @@ def signature_of(factory: Any) -> Signature:
         if parameter.kind in (inspect.Parameter.VAR_POSITIONAL,
                               inspect.Parameter.POSITIONAL_ONLY):
             continue
-        params.append(Param(parameter.name, camel_case(parameter.name),
-                            hints.get(parameter.name, Any), parameter.default))
+        hint, unbounded = _unannotated(hints.get(parameter.name, Any))
+        params.append(Param(parameter.name, camel_case(parameter.name), hint,
+                            parameter.default, unbounded))
     return Signature(tuple(params), takes_any)
+
+
+def _unannotated(hint: Any) -> tuple[Any, Unbounded | None]:
+    """``hint`` without ``Annotated``, and its :class:`Unbounded` mark if it has one."""
+    if typing.get_origin(hint) is not Annotated:
+        return hint, None
+    marks = [mark for mark in hint.__metadata__ if isinstance(mark, Unbounded)]
+    return hint.__origin__, marks[0] if marks else None
 
 
 def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
@@ -132,6 +162,7 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
     source: dict[str, str] = {}
     errors: list[tuple[str, str]] = []
     warnings: list[tuple[str, str]] = []
+    notes: list[tuple[str, str]] = []
     for key, value in properties.items():
         match = by_name.get(key) or by_name.get(snake_case(key))
         if match is None:
@@ -145,6 +176,11 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
             errors.append((key, f"property {key!r} repeats {source[match.name]!r}"))
             continue
         source[match.name] = key
+        if match.unbounded is not None and _is_positive_infinity(value):
+            kwargs[match.name] = match.unbounded.means
+            notes.append((key, f"property {key!r} is infinity, which behavior3js runs as no "
+                               f"end: read as {json.dumps(match.unbounded.means)} (forever)"))
+            continue
         try:
             kwargs[match.name] = convert(value, match.hint, infinite=match.allows_infinity)
         except ValueError as exc:
@@ -153,7 +189,16 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
         if param.required and param.name not in source:
             errors.append((param.editor_name,
                            f"missing property {param.editor_name!r} ({describe(param.hint)})"))
-    return Binding(kwargs, errors, warnings)
+    return Binding(kwargs, errors, warnings, notes)
+
+
+def _is_positive_infinity(value: Any) -> bool:
+    """Whether ``value`` is ``inf``, or text that reads as it (``"Infinity"``, ``"1e999"``)."""
+    try:
+        number = _number(value, float)
+    except ValueError:
+        return False
+    return isinstance(number, float) and math.isinf(number) and number > 0
 
 
 def convert(value: Any, hint: Any, *, infinite: bool = False) -> Any:

@@ -23,15 +23,20 @@ Differences, all deliberate:
 from __future__ import annotations
 
 import math
+from typing import Annotated
 
 from typing_extensions import override
 
-from cyborg.bt.node import Action, Composite, Decorator
+from cyborg.bt.node import Action, Composite, Decorator, NodeError
+from cyborg.bt.properties import Unbounded
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
 from cyborg.bt.v1_data import array_input, oneof
 
 MAX_LOOPS_PER_TICK = 1000
 """Most times Repeat (and ForEach, Filter) re-run a child that finishes at once, per tick."""
+
+Count = Annotated[int | None, Unbounded(None)]
+"""A number of runs or tries, none for no end; infinity in a file is read as none."""
 
 
 def _exactly(node: Composite, *counts: int) -> list[str]:
@@ -137,9 +142,9 @@ class Case(Composite):
         self.memory["matched"] = False
 
     def tick(self) -> Status:
-        """Raises :class:`RuntimeError` (ERROR) unless the parent is a :class:`Switch`."""
+        """Raises :class:`NodeError` (ERROR) unless the parent is a :class:`Switch`."""
         if not isinstance(self.parent, Switch):
-            raise RuntimeError(f"a Case runs only as a child of a Switch, not of "
+            raise NodeError(f"a Case runs only as a child of a Switch, not of "
                                f"{type(self.parent).__name__}")
         if not self.memory["matched"]:
             status = self.children[0].execute()
@@ -199,7 +204,7 @@ class Watchdog(Composite):
         if status is RUNNING:
             guard.halt()
             branch.halt()
-            raise RuntimeError("the guard (first child) returned RUNNING; a Watchdog's guard "
+            raise NodeError("the guard (first child) returned RUNNING; a Watchdog's guard "
                                "must finish in the tick it starts")
         if status is not SUCCESS:
             branch.halt()
@@ -238,7 +243,7 @@ class AlwaysRunning(Decorator):
 
 
 class Assert(Decorator):
-    """Passes the child's SUCCESS or RUNNING; else raises AssertionError(``message``): ERROR."""
+    """Passes the child's SUCCESS or RUNNING; else raises NodeError(``message``): ERROR."""
 
     def __init__(self, message: str = "") -> None:
         self.message = message
@@ -248,7 +253,7 @@ class Assert(Decorator):
         status = self.child.execute()
         if status is SUCCESS or status is RUNNING:
             return status
-        raise AssertionError(f"{self.message or 'assertion failed'} (the child returned "
+        raise NodeError(f"{self.message or 'assertion failed'} (the child returned "
                              f"{status.label})")
 
 
@@ -261,7 +266,7 @@ class Repeat(Decorator):
 
     inputs = ("count?",)
 
-    def __init__(self, count: int | None = None) -> None:
+    def __init__(self, count: Count = None) -> None:
         self.count = count
 
     def on_start(self) -> None:
@@ -293,7 +298,7 @@ class RetryUntilSuccess(Decorator):
     inputs = ("count?",)
     _goal: Status = SUCCESS
 
-    def __init__(self, count: int | None = None) -> None:
+    def __init__(self, count: Count = None) -> None:
         self.count = count
 
     def on_start(self) -> None:

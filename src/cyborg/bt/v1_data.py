@@ -37,7 +37,7 @@ from typing_extensions import override
 
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number, js_text, read_member, strict_equal, truthy
-from cyborg.bt.node import Action, Condition, Node
+from cyborg.bt.node import Action, Condition, Node, NodeError
 from cyborg.bt.status import FAILURE, SUCCESS, Status
 
 log = logging.getLogger("cyborg.bt")
@@ -53,7 +53,7 @@ def oneof(node: Node, port: str, arg: Any, default: Any = NO_DEFAULT) -> Any:
     """The value of an arg that input ``port`` may replace, by behavior3-ts's rule.
 
     When the file binds ``port`` to a variable, that variable's value is used; if it is unset,
-    ``default`` stands in (with a warning, logged once), or, without a default, ValueError
+    ``default`` stands in (with a warning, logged once), or, without a default, NodeError
     says which input is missing. When ``port`` is unbound, ``arg`` is used, and ``default``
     when ``arg`` is None.
     """
@@ -62,7 +62,7 @@ def oneof(node: Node, port: str, arg: Any, default: Any = NO_DEFAULT) -> Any:
     if value is None and key is not None:
         message = f"input {port!r} reads the variable {key!r}, which is not set"
         if default is NO_DEFAULT:
-            raise ValueError(message)
+            raise NodeError(message)
         warned = _WARNED.setdefault(node, set())
         if port not in warned:
             warned.add(port)
@@ -80,11 +80,11 @@ def fresh(value: Any) -> Any:
 def array_input(node: Node, port: str, *, to_change: bool = False) -> Sequence[Any]:
     """The array in input ``port``: a list, or also a tuple unless ``to_change``.
 
-    Raises TypeError naming the port when it holds something else.
+    Raises NodeError naming the port when it holds something else.
     """
     value = node.read(port)
     if not isinstance(value, list if to_change else list | tuple):
-        raise TypeError(f"input {port!r} ({node.ports.get(port)!r}) must hold an array (a "
+        raise NodeError(f"input {port!r} ({node.ports.get(port)!r}) must hold an array (a "
                         f"list), not {describe(value)}")
     return value
 
@@ -218,7 +218,7 @@ class Index(Action):
         array = array_input(self, "array")
         index = oneof(self, "index", self.at)
         if not (is_number(index) and math.isfinite(index) and index == int(index)):
-            raise ValueError(f"the index must be a whole number, not {describe(index)} (set the "
+            raise NodeError(f"the index must be a whole number, not {describe(index)} (set the "
                              "index arg or bind the index input)")
         value = read_member(array, index)
         self.write("value", value)
@@ -229,7 +229,7 @@ def _field(node: Node, arg: str | None) -> str | float:
     field = oneof(node, "field", arg)
     if isinstance(field, str | int | float) and not isinstance(field, bool):
         return field
-    raise ValueError(f"the field must be text or a number, not {describe(field)} (set the "
+    raise NodeError(f"the field must be text or a number, not {describe(field)} (set the "
                      "field arg or bind the field input)")
 
 
@@ -237,7 +237,7 @@ def _object(node: Node, *, to_change: bool = False) -> Any:
     target = node.read("object")
     kinds = (MutableMapping, list) if to_change else (Mapping, list, tuple)
     if not isinstance(target, kinds):
-        raise TypeError(f"input 'object' ({node.ports.get('object')!r}) must hold an object "
+        raise NodeError(f"input 'object' ({node.ports.get('object')!r}) must hold an object "
                         f"(a dict) or an array, not {describe(target)}")
     return target
 
@@ -292,7 +292,7 @@ class SetField(Action):
         else:
             index = int(field) if math.isfinite(field) and field == int(field) else -1
         if not 0 <= index <= len(target):
-            raise IndexError(f"field {field!r} is not an index of the {len(target)}-element "
+            raise NodeError(f"field {field!r} is not an index of the {len(target)}-element "
                              "array in input 'object'")
         if index == len(target):
             target.append(value)

@@ -18,7 +18,7 @@ from typing_extensions import override
 
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number
-from cyborg.bt.node import Action, Condition
+from cyborg.bt.node import Action, Condition, NodeError
 from cyborg.bt.status import FAILURE, SUCCESS, Status
 
 
@@ -120,7 +120,7 @@ class Math(Action):
             self.write("result", None)
             return FAILURE
         if result != result:
-            raise ValueError(f"{self.op} of {values} is not a number (NaN)")
+            raise NodeError(f"{self.op} of {values} is not a number (NaN)")
         self.write("result", result)
         return SUCCESS
 
@@ -144,12 +144,16 @@ _COMPARISONS: tuple[tuple[str, Callable[[float, float], bool]], ...] = (
     ("lt", lambda a, b: a < b), ("le", lambda a, b: a <= b))
 
 
+_NO_COMPARISON = ("Cmp needs one of the args gt, ge, eq, lt, le (the bound to compare the "
+                  "value with); none is set")
+
+
 class Cmp(Condition):
     """Compares a number with the first of ``gt``, ``ge``, ``eq``, ``lt``, ``le`` that is set.
 
-    SUCCESS when the comparison holds, else FAILURE (behavior3lua); none set raises. The number
-    is the ``value`` input when bound, else the expression ``value``; an unset number gives
-    FAILURE, anything else that is not a number raises.
+    SUCCESS when the comparison holds, else FAILURE (behavior3lua); none set is a load error.
+    The number is the ``value`` input when bound, else the expression ``value``; an unset
+    number gives FAILURE, anything else that is not a number is a :class:`NodeError` (ERROR).
     """
 
     inputs = ("value?",)
@@ -165,10 +169,20 @@ class Cmp(Condition):
             if bound is not None and self.test is None:
                 self.test = (test, bound)
 
+    def check(self) -> list[str]:
+        """The condition's problems, plus none of ``gt``, ``ge``, ``eq``, ``lt``, ``le`` set.
+
+        behavior3editor's own check of a tree refuses such a Cmp as well.
+        """
+        problems = super().check()
+        if self.test is None:
+            problems.append(_NO_COMPARISON)
+        return problems
+
     @override
     def tick(self) -> Status:
-        if self.test is None:
-            raise ValueError("Cmp needs one of the args gt, ge, eq, lt, le")
+        if self.test is None:  # a tree checked at load never has one: check() refuses it
+            raise NodeError(_NO_COMPARISON)
         if "value" in self.ports or self.expression is None:
             number = self.read("value")
         else:
@@ -176,7 +190,7 @@ class Cmp(Condition):
         if number is None:
             return FAILURE
         if not is_number(number):
-            raise TypeError(f"Cmp compares a number, not {describe(number)}")
+            raise NodeError(f"Cmp compares a number, not {describe(number)}")
         test, bound = self.test
         return SUCCESS if test(number, bound) else FAILURE
 
@@ -199,7 +213,7 @@ class Random(Action):
     def tick(self) -> Status:
         low, high = self.read("min", self.low), self.read("max", self.high)
         if not (is_number(low) and is_number(high)):
-            raise ValueError(f"Random needs numbers for min and max, not {describe(low)} and "
+            raise NodeError(f"Random needs numbers for min and max, not {describe(low)} and "
                              f"{describe(high)}")
         value = low + random.random() * (high - low)
         self.write("value", math.floor(value) if self.floor else value)
