@@ -144,7 +144,7 @@ function receive(message) {
       page.hooks = new Map(message.hooks.map((hook) => [hook.id, hook]));
       modesPanel.setAlive(message.alive);
       page.pausedAt = message.paused_at;
-      if (message.enabled !== false) page.manualPause = null;
+      if (message.enabled !== false || message.stopped) page.manualPause = null; // (a STOP's banner)
       markDirty("all");
       toolbar();
       banner();
