@@ -129,9 +129,11 @@ def test_a_stopped_tree_is_told_to_every_page_and_only_the_seat_resumes_it() -> 
     async def scenario() -> None:
         holder, other = page(hub, 1), page(hub, 2)
         hub.seat.claim(1)
+        assert (await _send(hub, holder, {"t": "go", "ns": ROBOT, "goal": "Office"}))["paused"]
         assert (await _send(hub, other, {"t": "stop", "ns": ROBOT}))["ok"]
         late = page(hub, 3)
         await receive(hub, late, json.dumps({"t": "hello"}))
+        assert of_kind(late, "manual_pause") == [], "stopped now, not paused for the goal"
         trees = of_kind(late, "robots")[0]["robots"]
         assert [(tree["ns"], tree["stopped"]) for tree in trees] == [(TREE, True)]
         refused = await _send(hub, other, {"t": "enable", "on": True, "ns": TREE})

@@ -230,6 +230,8 @@ class RobotCommands:
             return_exceptions=True)
         stopped = [tree for tree, done in zip(trees, halted, strict=True)
                    if not isinstance(done, BaseException)]
+        for tree in stopped:  # stopped, no longer paused for a manual goal
+            self._manual.pop(tree, None)
         failed = [f"the tree {tree} could not be stopped: {done}"
                   for tree, done in zip(trees, halted, strict=True)
                   if isinstance(done, BaseException)]
