@@ -26,7 +26,8 @@ home         ns                                          send it home
 dock         ns                                          dock it
 undock       ns                                          undock it
 set_pose     ns, pose: [x, y] or [x, y, θ]               relocalise it
-stop         ns                                          stop it (needs no seat)
+stop         ns                                          stop it and halt its tree until
+                                                         resumed (needs no seat)
 drive        ns, vx, wz                                  drive it by hand (10 Hz while held)
 tour         ns, points                                  drive it through the points in order
 player_pause paused                                      pause (true) or resume (false) the
