@@ -62,9 +62,19 @@ def live_system(*, speed: float = 10.0, token: str | None = None, port: int = 0,
             monitor.stop()
 
 
+WHOLE_TREE = ("localStorage.setItem('cyborg-monitor-fit', 'true');"
+              " localStorage.setItem('cyborg-monitor-fold', 'false');")
+"""A page script choosing the tree view's "Fit" and not "Fold": every node drawn, the whole
+tree in view (the page's default is a readable size, folded to fit; tests of it open their own
+pages)."""
+
+
 def open_page(browser: Browser, url: str, errors: list[str]) -> Page:
-    """A fresh page on ``url`` that records console errors into ``errors``; waits for ticks."""
+    """A fresh page on ``url`` that records console errors into ``errors``; waits for ticks.
+    The tree view shows the whole tree (:data:`WHOLE_TREE`), so that every node can be
+    clicked."""
     page = browser.new_page(viewport={"width": 1400, "height": 820}, accept_downloads=True)
+    page.add_init_script(WHOLE_TREE)
     page.on("console", lambda message: errors.append(message.text)
             if message.type == "error" else None)
     page.on("pageerror", lambda error: errors.append(str(error)))

@@ -24,6 +24,7 @@ from cyborg.bus import BusConfig, Context, Node
 from cyborg.monitor import Monitor
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.builders import N, tree_json
+from tests.monitor.browser import WHOLE_TREE
 
 pytestmark = pytest.mark.heavy
 
@@ -66,6 +67,7 @@ def traced_first_paint(browser: Browser, url: str, *,
     ``code_late``: app.js comes 0.5 s late, so the tree is waiting when the code starts."""
     context = browser.new_context(viewport={"width": 1400, "height": 820})
     page = context.new_page()
+    page.add_init_script(WHOLE_TREE)  # every node drawn, fitted: labels too small are left out
     if code_late:
         def late(route: Route) -> None:
             response = route.fetch()

@@ -9,7 +9,7 @@ import { say, selectTreeRobot, showBanner, showToolbar, showTrees } from "./chro
 import { Connection, keepSeatSecret } from "./connection.js";
 import { saveView } from "./export.js";
 import { History } from "./history.js";
-import { Layout } from "./layout.js";
+import { Layout, remember, remembered } from "./layout.js";
 import { LazyMapPanel } from "./map/lazy_panel.js";
 import { TreeModel } from "./model.js";
 import { goalNames } from "./node_goals.js";
@@ -24,6 +24,10 @@ import { TreeFolds } from "./tree_folds.js";
 import { TreeView } from "./tree_view.js";
 
 const $ = (id) => document.getElementById(id);
+// The view's choices last until changed (localStorage): "Fit" (the whole tree, at any size)
+// and "Fold to fit".
+const FIT_ITEM = "cyborg-monitor-fit";
+const FOLD_ITEM = "cyborg-monitor-fold";
 const stats = (window.__monitor = { messages: 0, structures: 0, laidOut: 0, frames: 0, draws: 0, drawn: 0, tick: 0, paints: [], recordPaints: false, firstPaint: null, drawMs: null });
 
 const model = new TreeModel();
@@ -39,6 +43,7 @@ const page = {
   title: "",
   seat: { may_control: false, control: false, holder: null },
   depth: -1,
+  foldLevel: Infinity, // nodes this far from the root or further are folded to fit (see foldLevelToFit)
   folded: new Set(), // folded by hand
   opened: new Set(), // unfolded by hand (wins over draw depth)
   selected: null,
@@ -53,11 +58,13 @@ let needsLayout = true;
 let dirty = null; // Set of ids to repaint, or "all"
 let layoutKey = "";
 let scheduled = false;
+let placedFor = null; // the tree version last placed at the readable scale (TreeView.place)
+let followed = null; // the end of the running path last scrolled into view
 
 const view = new TreeView($("tree"), {
   onSelect: (id) => select(id),
   onToggle: (id) => toggle(id),
-  onUserZoom: () => { $("autofit").checked = false; },
+  onUserZoom: () => setAutofit(false),
   badge: (node, width) => badgeMarkup(node, width, model.servicesOn.has(node.id)),
 });
 
@@ -76,7 +83,14 @@ const connection = new Connection({
 const mapPanel = new LazyMapPanel($("map-view"), { post: (message) => connection.post(message), send: (message) => connection.send(message) });
 const layout = new Layout({ onMapShown: (shown) => mapPanel.setVisible(shown) });
 mapPanel.onEmpty = (empty) => layout.setMapEmpty(empty);
-new ResizeObserver(() => { if ($("autofit").checked) view.fit(); }).observe($("tree"));
+new ResizeObserver(() => {
+  if ($("autofit").checked) view.fit();
+  if (!model.root) return;
+  // a panel maximised, a tab shown, the splitter dragged: fold again to the new width, and
+  // place the tree again unless the user has moved it
+  if (!$("autofit").checked && !view.movedByUser()) placedFor = null;
+  if (foldLevelToFit() !== page.foldLevel || placedFor !== model.version) relayout();
+}).observe($("tree"));
 // The ticks the monitor kept, one at a time (js/history.js); `tickHistory.state` is null while live.
 const tickHistory = new History({ onShow: () => markDirty("all"), say });
 // A played recording's timeline (js/player_bar.js); a jump of the played time leaves the history.
@@ -232,6 +246,7 @@ function render(fromFrame = false) {
   if (needsLayout) {
     needsLayout = false;
     dirty = null;
+    page.foldLevel = foldLevelToFit();
     layoutKey = visibleKey();
     stats.drawn = model.root ? view.draw(model.root, isOpen, tickHistory.state ? historyLook() : liveLook()) : view.clear();
     // folded nodes with part of the running path inside are known only once drawn
@@ -239,6 +254,10 @@ function render(fromFrame = false) {
     stats.draws += 1;
     stats.laidOut = stats.structures;
     if ($("autofit").checked) view.fit();
+    else if (placedFor !== model.version) {
+      followed = runningEnd();
+      if (view.place(followed)) placedFor = model.version;
+    }
     applySearch(false);
     if (page.selected) view.markClass("selected", new Set([page.selected]));
   }
@@ -248,6 +267,7 @@ function render(fromFrame = false) {
     dirty = null;
     if (page.selected) showNode(model, page.selected, page.hooks);
   }
+  followRunningPath();
   if (relaid) stats.drawMs = performance.now() - started;
   tickInfo();
   // A task queued from an animation frame runs once that frame has been rendered: stamp the
@@ -278,6 +298,24 @@ function historyLook() {
   return { code: (id) => state.codes[model.indexOf.get(id)] ?? 0, active, inside: insideActive([...active]), hooked: new Set(), pausedAt: "" };
 }
 
+// The drawn node where the running path ends (the deepest one drawn), or null.
+function runningEnd() {
+  for (let i = model.active.length - 1; i >= 0; i--) {
+    if (view.elements.has(model.active[i])) return model.active[i];
+  }
+  return null;
+}
+
+// When the running path has moved, scroll its end into view if it went off-screen (the view
+// leaves it be while the user pans; "Fit" shows everything anyway).
+function followRunningPath() {
+  if (tickHistory.state || $("autofit").checked) return;
+  const end = runningEnd();
+  if (end === followed) return;
+  followed = end;
+  if (end) view.reveal(end);
+}
+
 // Folded nodes drawn with part of the running path hidden inside them.
 function insideActive(active) {
   const inside = new Set();
@@ -290,14 +328,34 @@ function insideActive(active) {
   return inside;
 }
 
-// rqt_bt's Draw depth, hand folding, and the running path always shown.
+// rqt_bt's Draw depth, hand folding, folding to fit, and the running path always shown.
 function isOpen(node) {
+  return isOpenFolding(node, page.foldLevel);
+}
+
+function isOpenFolding(node, foldLevel) {
   if (!node.children.length) return false;
   if (page.folded.has(node.id)) return false;
   if (page.opened.has(node.id)) return true;
   if (model.activeSet.has(node.id)) return true;
   if (page.depth >= 0 && node.children.some((child) => child.depth > page.depth)) return false;
+  if (model.level.get(node.id) >= foldLevel) return false;
   return true;
+}
+
+// As Groot2 folds subtrees: the deepest level of nodes that can stay unfolded with the tree
+// still as wide as the view at the readable scale; the nodes from that level down are folded
+// (not the running path, nor what the user unfolded). At least the root's children are shown;
+// Infinity when everything fits or "Fold to fit" is off. Each try lays out only what it shows,
+// from the smallest up, so a large tree costs little more than the layout it ends with.
+function foldLevelToFit() {
+  if (!$("foldfit").checked || !model.root) return Infinity;
+  let deepest = 0;
+  for (const level of model.level.values()) deepest = Math.max(deepest, level);
+  for (let level = 1; level < deepest; level++) {
+    if (!view.fitsReadable(model.root, (node) => isOpenFolding(node, level + 1))) return level;
+  }
+  return Infinity;
 }
 
 function visibleKey() {
@@ -375,7 +433,7 @@ function applySearch(jump) {
     $("search-count").textContent = `${page.matchAt + 1} of ${page.matches.length}`;
     select(id);
     view.centerOn(id);
-    $("autofit").checked = false;
+    setAutofit(false);
   }
 }
 
@@ -406,7 +464,16 @@ $("depth").addEventListener("change", (event) => {
   relayout();
 });
 $("fit").addEventListener("click", () => view.fit());
-$("autofit").addEventListener("change", (event) => { if (event.target.checked) view.fit(); });
+$("readable").addEventListener("click", () => { setAutofit(false); view.place(runningEnd()); });
+$("autofit").addEventListener("change", (event) => {
+  setAutofit(event.target.checked);
+  if (event.target.checked) view.fit();
+  else view.place(runningEnd());
+});
+$("foldfit").addEventListener("change", (event) => {
+  remember(FOLD_ITEM, String(event.target.checked));
+  relayout();
+});
 $("highlight").addEventListener("change", (event) => { view.highlight = event.target.checked; });
 $("refresh").addEventListener("click", () => { connection.post({ t: "refresh" }); relayout(); });
 $("search").addEventListener("input", () => { page.matchAt = -1; applySearch(false); });
@@ -428,15 +495,28 @@ for (const button of document.querySelectorAll("button[data-export]")) {
 }
 window.addEventListener("resize", () => { if ($("autofit").checked) view.fit(); });
 
-// Save what is shown: the folded nodes go to the server, which draws with Graphviz.
+// Save what is shown (js/export.js): SVG and PNG from the page's drawing; DOT from the server,
+// told which nodes are folded.
 async function exportView(format) {
+  if (!model.root) return;
   const collapsed = [...view.elements.keys()].filter((id) => {
     const node = model.byId.get(id);
     return node && node.children.length && !isOpen(node);
   });
-  const result = await saveView({ ns: page.ns, format, collapsed });
-  say(result.message, !result.ok);
+  try {
+    const result = await saveView({ ns: page.ns, format, collapsed, svg: $("tree"), bounds: view.bounds, title: page.title });
+    say(result.message, !result.ok);
+  } catch (error) {
+    say(`could not save as ${format.toUpperCase()}: ${error.message || error}`, true);
+  }
 }
+
+function setAutofit(on) {
+  $("autofit").checked = on;
+  remember(FIT_ITEM, String(on));
+}
+$("autofit").checked = remembered(FIT_ITEM, "false") === "true";
+$("foldfit").checked = remembered(FOLD_ITEM, "true") === "true";
 
 toolbar();
 connection.open();

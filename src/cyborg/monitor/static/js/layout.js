@@ -3,10 +3,12 @@
 //
 // - The splitter shares the width between tree and map (drag it, or focus it and use the arrow
 //   keys; double-click: half and half). The share is kept in localStorage.
-// - Either panel can be maximised with its ⤢ button (the other is hidden until restored); kept
-//   in localStorage too.
+// - Either panel can be maximised with its ⤢ button: it takes the whole width of the page (the
+//   other panel and the details are hidden until restored); kept in localStorage too. A map
+//   maximised on a page without a map yet shows the split until one arrives.
 // - Under 700 px wide (phones), tabs replace the split: Map | Tree | Details, one at a time,
-//   Map first.
+//   Map first; the toolbar keeps the robot, Run, the control seat and a ☰ button that opens
+//   the rest of the tools (draw depth, fit, search, save) on rows of their own.
 //
 // - Until a map arrives (a monitor or robot without maps), the map is a narrow column saying
 //   "no map yet" and the tree keeps the room; the split applies once there is a map.
@@ -15,6 +17,7 @@
 // `onMapShown(on)` hears whether the map can be seen, so the page asks the monitor for map
 // data only then.
 
+const $ = (id) => document.getElementById(id);
 const SPLIT_ITEM = "cyborg-monitor-split";
 const MAX_ITEM = "cyborg-monitor-maximised";
 const TAB_ITEM = "cyborg-monitor-tab";
@@ -25,19 +28,24 @@ const KEY_STEP = 0.05;
 
 export class Layout {
   constructor({ onMapShown }) {
-    const $ = (id) => document.getElementById(id);
     this.main = document.querySelector("main");
     this.tree = $("view");
     this.map = $("map-view");
     this.splitter = $("splitter");
     this.onMapShown = onMapShown;
-    this.share = clampShare(Number(read(SPLIT_ITEM, "0.5")));
-    this.maximised = ["tree", "map"].includes(read(MAX_ITEM, "")) ? read(MAX_ITEM, "") : "";
-    this.tab = ["map", "tree", "side"].includes(read(TAB_ITEM, "map")) ? read(TAB_ITEM, "map") : "map";
+    this.share = clampShare(Number(remembered(SPLIT_ITEM, "0.5")));
+    this.maximised = ["tree", "map"].includes(remembered(MAX_ITEM, "")) ? remembered(MAX_ITEM, "") : "";
+    this.tab = ["map", "tree", "side"].includes(remembered(TAB_ITEM, "map")) ? remembered(TAB_ITEM, "map") : "map";
     this.mapEmpty = true;
     this.narrow = window.matchMedia(NARROW);
     this.narrow.addEventListener("change", () => this.apply());
     this.dragSplitter();
+    const menu = $("toolbar-menu");
+    menu.addEventListener("click", () => {
+      const open = menu.getAttribute("aria-expanded") !== "true";
+      menu.setAttribute("aria-expanded", String(open));
+      $("toolbar").classList.toggle("open", open);
+    });
     for (const button of document.querySelectorAll("button[data-max]")) {
       button.addEventListener("click", () => this.maximise(this.maximised === button.dataset.max ? "" : button.dataset.max));
     }
@@ -48,18 +56,23 @@ export class Layout {
   }
 
   get mapShown() {
-    return this.narrow.matches ? this.tab === "map" : this.maximised !== "tree";
+    return this.narrow.matches ? this.tab === "map" : this.shownMaximised !== "tree";
+  }
+
+  // The panel maximised on the page: none for a map maximised while there is no map to show.
+  get shownMaximised() {
+    return this.maximised === "map" && this.mapEmpty ? "" : this.maximised;
   }
 
   maximise(which) {
     this.maximised = which;
-    write(MAX_ITEM, which);
+    remember(MAX_ITEM, which);
     this.apply();
   }
 
   showTab(tab) {
     this.tab = tab;
-    write(TAB_ITEM, tab);
+    remember(TAB_ITEM, tab);
     this.apply();
   }
 
@@ -77,16 +90,18 @@ export class Layout {
 
   apply() {
     document.body.classList.toggle("narrow", this.narrow.matches);
-    this.main.dataset.max = this.maximised;
+    const maximised = this.shownMaximised;
+    this.main.dataset.max = maximised;
     this.main.dataset.tab = this.tab;
     // flex-grow in proportion, from a basis of 0: the two panels split what the details leave
-    const empty = this.mapEmpty && !this.maximised;
-    this.tree.style.flex = empty ? "1 1 0px" : `${this.share} 1 0px`;
-    this.map.style.flex = empty ? `0 0 ${EMPTY_MAP_PX}px` : `${1 - this.share} 1 0px`;
+    // (grows summing to 1, so they share all of it); a maximised panel grows alone
+    const empty = this.mapEmpty && !maximised;
+    this.tree.style.flex = empty || maximised ? "1 1 0px" : `${this.share} 1 0px`;
+    this.map.style.flex = empty ? `0 0 ${EMPTY_MAP_PX}px` : maximised ? "1 1 0px" : `${1 - this.share} 1 0px`;
     this.splitter.hidden = empty;
     this.splitter.setAttribute("aria-valuenow", String(Math.round(this.share * 100)));
     for (const button of document.querySelectorAll("button[data-max]")) {
-      const on = this.maximised === button.dataset.max;
+      const on = maximised === button.dataset.max;
       button.textContent = on ? "⤡" : "⤢";
       button.title = on ? "Restore the split view" : `Maximise the ${button.dataset.max === "map" ? "map" : "tree"}`;
       button.setAttribute("aria-pressed", String(on));
@@ -120,20 +135,20 @@ export class Layout {
       if (!drag) return;
       drag = null;
       splitter.classList.remove("dragging");
-      write(SPLIT_ITEM, this.share.toFixed(3));
+      remember(SPLIT_ITEM, this.share.toFixed(3));
     };
     splitter.addEventListener("pointerup", end);
     splitter.addEventListener("pointercancel", end);
     splitter.addEventListener("dblclick", () => {
       this.setShare(0.5);
-      write(SPLIT_ITEM, "0.5");
+      remember(SPLIT_ITEM, "0.5");
     });
     splitter.addEventListener("keydown", (event) => {
       const step = event.key === "ArrowLeft" ? -KEY_STEP : event.key === "ArrowRight" ? KEY_STEP : 0;
       if (!step) return;
       event.preventDefault();
       this.setShare(this.share + step);
-      write(SPLIT_ITEM, this.share.toFixed(3));
+      remember(SPLIT_ITEM, this.share.toFixed(3));
     });
   }
 }
@@ -142,8 +157,9 @@ function clampShare(share) {
   return Number.isFinite(share) ? Math.min(1 - MIN_SHARE, Math.max(MIN_SHARE, share)) : 0.5;
 }
 
-// localStorage may be refused (private windows, storage full): then the layout lasts this page.
-function read(item, fallback) {
+// The page's choices kept in localStorage. It may be refused (private windows, storage full):
+// then they last this page.
+export function remembered(item, fallback) {
   try {
     return localStorage.getItem(item) ?? fallback;
   } catch {
@@ -151,7 +167,7 @@ function read(item, fallback) {
   }
 }
 
-function write(item, value) {
+export function remember(item, value) {
   try {
     localStorage.setItem(item, value);
   } catch {

@@ -16,12 +16,14 @@ export class TreeModel {
     this.ids = [];
     this.byId = new Map();
     this.parent = new Map();
+    this.level = new Map(); // id -> its distance from the root (the root: 0)
     if (root) {
       const stack = [[root, null]];
       while (stack.length) {
         const [node, parent] = stack.pop();
         this.byId.set(node.id, node);
         this.parent.set(node.id, parent);
+        this.level.set(node.id, parent === null ? 0 : this.level.get(parent) + 1);
         this.ids.push(node.id);
         for (let i = node.children.length - 1; i >= 0; i--) stack.push([node.children[i], node.id]);
       }

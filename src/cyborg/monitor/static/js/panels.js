@@ -53,7 +53,18 @@ function ms(value) {
 }
 
 // ------------------------------------------------------------------ blackboard
+// Scope and key take the width of their text, the value the rest of the row, cut to one line;
+// each cell's whole text is its title (hover), and a click on a row shows it all (again: cut).
 let previous = new Map();
+const opened = new Set(); // rows shown whole, by scope and key
+
+document.getElementById("bb-rows").addEventListener("click", (event) => {
+  const row = event.target.closest("tr[data-row]");
+  if (!row) return;
+  const open = !opened.delete(row.dataset.row);
+  if (open) opened.add(row.dataset.row);
+  row.classList.toggle("open", open);
+});
 
 // `labelOf(id)` names a node for the "node" scope rows.
 export function showBlackboard(data, filter, labelOf) {
@@ -69,9 +80,12 @@ export function showBlackboard(data, filter, labelOf) {
   const now = new Map(entries.map(([scope, key, value]) => [`${scope}\u0000${key}`, value]));
   document.getElementById("bb-rows").innerHTML = shown
     .map(([scope, key, value]) => {
-      const before = previous.get(`${scope}\u0000${key}`);
-      const changed = previous.size && before !== value ? ' class="changed"' : "";
-      return `<tr${changed}><td>${escapeHtml(scope)}</td><td>${escapeHtml(key)}</td><td>${escapeHtml(value)}</td></tr>`;
+      const row = `${scope}\u0000${key}`;
+      const classes = [previous.size && previous.get(row) !== value ? "changed" : "", opened.has(row) ? "open" : ""].join(" ").trim();
+      const cut = (text) => `<span class="cut" title="${escapeHtml(text)}">${escapeHtml(text)}</span>`;
+      return `<tr data-row="${escapeHtml(row)}"${classes ? ` class="${classes}"` : ""}>` +
+        `<td class="bb-scope">${cut(scope)}</td><td class="bb-key">${cut(key)}</td>` +
+        `<td class="bb-value" title="${escapeHtml(value)}">${escapeHtml(value)}</td></tr>`;
     })
     .join("");
   previous = now;
