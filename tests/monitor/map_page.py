@@ -215,3 +215,24 @@ def pixel(page: Page, sx: float, sy: float) -> list[int]:
 def rgb(colour: str) -> list[int]:
     """``#rrggbb`` as three numbers."""
     return [int(colour[i:i + 2], 16) for i in (1, 3, 5)]
+
+
+def control_boxes(page: Page) -> dict[str, list[list[float]]]:
+    """The map's controls as boxes [x0, y0, x1, y1] in CSS px on its canvas: the toolbar
+    (``.map-tools``), each shown control of the actions' bar (``#map-act``) and STOP."""
+    found: dict[str, list[list[float]]] = page.evaluate("""() => {
+        const origin = document.getElementById('map-canvas').getBoundingClientRect();
+        const boxes = (selector) => [...document.querySelectorAll(selector)]
+            .map((element) => element.getBoundingClientRect())
+            .filter((box) => box.width > 0 && box.height > 0)
+            .map((box) => [box.left - origin.left, box.top - origin.top,
+                           box.right - origin.left, box.bottom - origin.top]);
+        return {toolbar: boxes('#map-view .map-tools'), actions: boxes('#map-act > *'),
+                stop: boxes('#map-stop')};
+    }""")
+    return found
+
+
+def overlap(a: list[float], b: list[float]) -> bool:
+    """Whether boxes ``a`` and ``b`` ([x0, y0, x1, y1]) share any area."""
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]

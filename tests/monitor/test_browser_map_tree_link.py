@@ -93,8 +93,9 @@ def test_the_running_node_and_the_current_goal_are_drawn(browser: Browser,
     rgb = [int(colour[i:i + 2], 16) for i in (1, 3, 5)]
     assert _close(pixel(page, gx, gy - 10), rgb), "the goal's ring in the robot's colour"
     assert _ink(page, gx - 30, gy + 13, gx + 30, gy + 26) > 20, "the goal's name under it"
-    rx, ry = on_map(page, f"m.toScreen({START[0]}, {START[1]})")
-    label = (rx + 14, ry - 7, rx + 120, ry + 7)  # the second line beside the robot
+    [name] = [found for found in on_map(page, "m.labels()") if found["kind"] == "robot"]
+    assert name["text"].endswith(" / MoveTo Goal 1"), "the running node under the robot's name"
+    label = (name["x0"], (name["y0"] + name["y1"]) / 2, name["x1"], name["y1"])  # its 2nd line
     assert _ink(page, *label) > 20, "the running node written beside the robot"
     server.push(robot_state(ROBOT, 2, *START, st="MOVING_TO_GOAL", pid=1, node="",
                             goal=None))

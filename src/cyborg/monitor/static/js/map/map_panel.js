@@ -14,9 +14,10 @@
 //
 // `window.__map` is for tests and benchmarks: {firstPaint, paints, recordPaints, drawn:
 // {points, lines, objects}, moving: {robots, laser, paths, goals, tracked, arrows, trackedLabels,
-// detections, names}, warnings, objectTip() (the tracked object's tooltip text, or null),
-// toScreen(x, y), toWorld(sx, sy), view(), colourOf(ns), robot(ns), selected(), fetches,
-// renders, where, frameMs, messageMs}; robot(ns) is a copy of what the page knows of a robot
+// detections, names}, labels() (the label boxes the last frame drew, CSS px on the canvas:
+// [{kind, text, x0, y0, x1, y1, leader}], labels.js), warnings, objectTip() (the tracked
+// object's tooltip text, or null), toScreen(x, y), toWorld(sx, sy), view(), colourOf(ns),
+// robot(ns), selected(), fetches, renders, where, frameMs, messageMs}; robot(ns) is a copy of what the page knows of a robot
 // (pose, mount, footprint, battery, alive, state, path and scan sizes, whether its path is
 // drawn and how far its end is, the running node, the current goal, the detector's objects
 // `seen` and the tracker's `tracked`, aged to now), or null; acting() what acting from the map stands
@@ -26,8 +27,10 @@
 import { colourOf, onRobotSelected, selectRobot, selectedRobot } from "../robots.js";
 import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
+import { coveringBoxes, coveringElements, freeRect } from "./free_area.js";
 import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
+import { labelBoxes } from "./labels.js";
 import { describe } from "./map_probe.js";
 import { CATEGORY, DETECTIONS_SHOWN_MS, MapModel, parseMapBlob } from "./map_model.js";
 import { drawBitmap, drawMoving } from "./moving_draw.js";
@@ -62,6 +65,8 @@ export class MapPanel {
     this.shownKey = null;
     this.loading = new Map(); // key -> promise
     this.goalHighlight = new GoalHighlight(); // the goal the node selected in the tree names
+    this.labels = []; // the labels the last frame placed (labels.js)
+    this.covered = []; // the boxes the map's controls cover (free_area.js), as of the last change
     this.scheduled = false;
     this.size = { width: 0, height: 0 };
     this.onEmpty = () => {}; // hears whether there is no map to show (the layout shrinks it)
@@ -94,6 +99,7 @@ export class MapPanel {
       highlight: () => this.goalHighlight.target && { ...this.goalHighlight.target },
       selected: () => this.selected(),
       objectTip: () => this.objectTip.text(),
+      labels: () => labelBoxes(this.labels),
     };
     // a click on a robot selects it (js/robots.js): its tree is shown, the actions go to it;
     // not while a tool is chosen
@@ -118,6 +124,7 @@ export class MapPanel {
       this.size = { width: entry.contentRect.width, height: entry.contentRect.height };
       this.schedule();
     }).observe(root);
+    this.watchControls();
     this.hud.showStatus("no map yet");
   }
 
@@ -243,9 +250,28 @@ export class MapPanel {
   fit() {
     const map = this.model.maps.get(this.shownKey);
     if (!map) return;
-    this.view.fit(map.bounds);
-    this.userMoved = false;
+    this.fitMap(map);
     this.schedule();
+  }
+
+  // Shows the whole map in the part of the panel its controls leave free (free_area.js).
+  fitMap(map) {
+    const { width, height } = this.view;
+    this.covered = coveringBoxes(this.root, this.canvas);
+    this.view.fit(map.bounds, freeRect(width, height, this.covered, (w, h) => ViewTransform.fitScale(map.bounds, w, h)));
+    this.userMoved = false;
+  }
+
+  // When a control over the map changes size (the actions' bar comes with the seat, wraps on a
+  // narrower panel): labels keep off it where it is now, and the map is fitted again unless the
+  // user moved it.
+  watchControls() {
+    const observer = new ResizeObserver(() => {
+      this.covered = coveringBoxes(this.root, this.canvas);
+      if (!this.userMoved) this.fit();
+      this.schedule();
+    });
+    for (const element of coveringElements(this.root)) observer.observe(element);
   }
 
   // ------------------------------------------------------------------ maps
@@ -293,10 +319,7 @@ export class MapPanel {
     const map = key ? this.model.maps.get(key) : null;
     this.staticLayer.setMap(map);
     this.actions.setGoals(map ? map.objects : []);
-    if (map && this.view.width) {
-      this.view.fit(map.bounds);
-      this.userMoved = false;
-    }
+    if (map && this.view.width) this.fitMap(map);
     if (emptiness) {
       this.root.classList.toggle("empty", !key);
       this.onEmpty(!key);
@@ -324,7 +347,8 @@ export class MapPanel {
       }
       this.lowerKey = "";
       const map = this.model.maps.get(this.shownKey);
-      if (map && !this.userMoved) this.view.fit(map.bounds);
+      if (map && !this.userMoved) this.fitMap(map);
+      else this.covered = coveringBoxes(this.root, this.canvas);
     }
     if (this.pickMap()) {
       // the layout may give the panel another size: draw on the next frame, at that size
@@ -349,7 +373,10 @@ export class MapPanel {
       this.lowerKey = lowerKey;
       drawBitmap(this.lowerCtx, this.view, placement, dpr);
     }
-    this.stats.moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, robots, layers, selected });
+    const map = this.model.maps.get(this.shownKey) ?? null;
+    const moving = drawMoving(this.ctx, { view: this.view, dpr, model: this.model, map, robots, layers, selected, covered: this.covered });
+    this.stats.moving = moving.drawn;
+    this.labels = moving.labels;
     this.tools.draw(this.ctx);
     this.objectTip.refresh();
     this.actions.refresh();

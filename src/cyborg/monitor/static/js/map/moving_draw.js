@@ -6,19 +6,33 @@
 // changed: a robot moving does not repaint the map under it. The upper one is cleared and
 // drawn every frame: planned paths (the part already travelled faded), the current goal,
 // laser hits, tracked objects (tracked_draw.js), detected objects, robots (footprint in the
-// robot's colour, heading as a white arrow), then names.
+// robot's colour, heading as a white arrow), then every label on top: robots' names, objects',
+// docks', goals' and areas' (the map's names too, which the bitmap leaves out), placed so that
+// none covers another (labels.js).
 // A robot that left the bus (the monitor's map_robots says it is not alive) is drawn faded,
 // without its laser, where it was last seen.
 //
 // Everything here is in CSS pixels: the context is scaled by the device pixel ratio once.
 
-import { drawTracked } from "./tracked_draw.js";
+import { CATEGORY } from "./map_model.js";
+import { drawLabels, LabelLayout } from "./labels.js";
+import { layerOf } from "./static_draw.js";
+import { addLabels, drawTracked } from "./tracked_draw.js";
 import { trackedNow } from "./tracked_objects.js";
 
 const MIN_ROBOT_PX = 14; // a robot is never drawn smaller than this, however far out
 const DOT_PX = 2;
 const GONE_ALPHA = 0.35;
 const DIAMOND_PX = 6;
+const GOAL_RING_PX = 10;
+const MAP_MARKER_PX = 6; // a goal's dot, a dock's square (static_draw.js), with their outline
+const NAME_GAP_PX = 14; // from a robot's centre to its name, at least
+const FONT = '11px system-ui, "DejaVu Sans", sans-serif';
+const BOLD = 'bold 11px system-ui, "DejaVu Sans", sans-serif';
+const ROBOT_FONT = 'bold 12px system-ui, "DejaVu Sans", sans-serif';
+const TEXT = "#3c4043";
+const MAP_TEXT = "#202124";
+const LABEL_KINDS = { [CATEGORY.DOCK]: "dock", [CATEGORY.HOME]: "home", [CATEGORY.GOAL]: "goal", [CATEGORY.GOAL_WITH_HEADING]: "goal" };
 
 // The lower canvas: the static bitmap at `placement` (StaticLayer.placement()), or nothing.
 export function drawBitmap(ctx, view, placement, dpr) {
@@ -27,58 +41,86 @@ export function drawBitmap(ctx, view, placement, dpr) {
   if (placement) blit(ctx, placement, dpr);
 }
 
-// The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), robots (the robots
-// to draw, [robot]), layers, selected (ns or null)}. Returns what it drew: {robots, laser,
-// paths, goals, tracked, arrows, trackedLabels, detections, names}.
+// The upper canvas. `scene`: {view (ViewTransform), dpr, model (MapModel), map (the shown map,
+// or null), robots (the robots to draw, [robot]), layers, selected (ns or null), covered (the
+// boxes the map's controls cover, which labels keep off)}. Returns
+// {drawn, labels}: what it drew ({robots, laser, paths, goals, tracked, arrows, trackedLabels,
+// detections, names}) and the labels placed (labels.js's, for labelBoxes).
 export function drawMoving(ctx, scene) {
   const { view, dpr, layers } = scene;
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, view.width, view.height);
   const drawn = { robots: 0, laser: 0, paths: 0, goals: 0, tracked: 0, arrows: 0, trackedLabels: 0, detections: 0, names: 0 };
+  const layout = layers.labels ? new LabelLayout(view.width, view.height, scene.covered) : null;
   if (layers.paths) {
     for (const robot of scene.robots) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
     }
   }
+  const goalNames = [];
   for (const robot of scene.robots) {
-    if (robot.goal && scene.model.travelling(robot)) drawn.goals += drawGoal(ctx, view, robot, layers.labels);
+    if (robot.goal && scene.model.travelling(robot)) {
+      drawn.goals += drawGoal(ctx, view, robot, layout);
+      goalNames.push(robot.goal);
+    }
   }
+  if (layout && scene.map) addMapLabels(layout, view, scene.map, layers, goalNames);
   if (layers.laser) {
     for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
   }
   if (layers.tracked) {
-    const placed = layers.labels ? [] : null; // label boxes, shared so robots' labels do not collide
+    const labels = [];
     for (const robot of scene.robots) {
       if (!robot.alive) continue;
-      const { objects, arrows, labels } = drawTracked(ctx, view, robot, trackedNow(robot), placed);
-      drawn.tracked += objects;
-      drawn.arrows += arrows;
-      drawn.trackedLabels += labels;
+      const tracked = drawTracked(ctx, view, robot, trackedNow(robot), layout);
+      drawn.tracked += tracked.objects;
+      drawn.arrows += tracked.arrows;
+      labels.push(...tracked.labels);
     }
+    if (layout) addLabels(layout, labels);
   }
   if (layers.detections) {
     for (const robot of scene.robots) {
-      if (robot.alive) drawn.detections += drawDetections(ctx, view, robot, scene.model.seenNow(robot), layers.labels);
+      if (robot.alive) drawn.detections += drawDetections(ctx, view, robot, scene.model.seenNow(robot), layout);
     }
   }
   if (layers.robots) {
     for (const robot of scene.robots) {
       if (!robot.pose) continue;
       ctx.globalAlpha = robot.alive ? 1 : GONE_ALPHA;
-      drawRobot(ctx, view, robot, robot.ns === scene.selected && scene.robots.length > 1);
+      const reach = drawRobot(ctx, view, robot, robot.ns === scene.selected && scene.robots.length > 1);
       ctx.globalAlpha = 1;
       drawn.robots += 1;
-    }
-    if (layers.labels) {
-      for (const robot of scene.robots) {
-        if (robot.pose) {
-          drawName(ctx, view, robot);
-          drawn.names += 1;
-        }
-      }
+      if (layout) addName(layout, view, robot, reach, robot.ns === scene.selected);
     }
   }
-  return drawn;
+  const placed = layout ? layout.place(ctx) : [];
+  drawLabels(ctx, placed);
+  for (const label of placed) {
+    if (label.kind === "robot") drawn.names += 1;
+    else if (label.kind === "tracked") drawn.trackedLabels += 1;
+  }
+  return { drawn, labels: placed };
+}
+
+// The names of the map's goals, docks, home and named areas in the view (of the layers shown),
+// and their markers for the labels to keep off. A goal a robot drives to is named by its ring
+// (drawGoal) instead. `driving`: those goals ({name, x, y}).
+function addMapLabels(layout, view, map, layers, driving) {
+  for (const item of map.objects) {
+    if (!layers[layerOf(item.category)]) continue;
+    const outline = item.outline;
+    const [sx, sy] = outline.length >= 4 ? view.toScreen(outline[0], outline[1]) : view.toScreen(item.x, item.y);
+    if (sx < 0 || sy < 0 || sx > view.width || sy > view.height) continue;
+    const point = outline.length < 4;
+    const own = point ? layout.marker(sx, sy, MAP_MARKER_PX) : -1;
+    if (!item.name || driving.some((goal) => goal.name === item.name && Math.hypot(goal.x - item.x, goal.y - item.y) < 0.5)) continue;
+    layout.add({
+      kind: point ? LABEL_KINDS[item.category] ?? "area" : "area", at: [sx, sy], own,
+      gap: point ? MAP_MARKER_PX + 2 : 2, sides: point ? ["E"] : ["SE", "E"],
+      lines: [{ text: item.name, font: FONT, colour: MAP_TEXT }],
+    });
+  }
 }
 
 function blit(ctx, { bitmap, x, y, w, h }, dpr) {
@@ -128,12 +170,12 @@ function lineTo(ctx, view, x, y, first) {
 }
 
 // The goal the robot is on its way to: a ring in its colour, a tick for its heading (when the
-// robot turns to it there), and its name when labels are on.
-function drawGoal(ctx, view, robot, labels) {
+// robot turns to it there), and its name under it when labels are on (`layout`).
+function drawGoal(ctx, view, robot, layout) {
   const goal = robot.goal;
   const [sx, sy] = view.toScreen(goal.x, goal.y);
   ctx.beginPath();
-  ctx.arc(sx, sy, 10, 0, 2 * Math.PI);
+  ctx.arc(sx, sy, GOAL_RING_PX, 0, 2 * Math.PI);
   ctx.strokeStyle = robot.colour;
   ctx.lineWidth = 3;
   ctx.stroke();
@@ -144,18 +186,12 @@ function drawGoal(ctx, view, robot, labels) {
     ctx.lineWidth = 2;
     ctx.stroke();
   }
-  if (labels && goal.name) {
-    const name = goal.name.length > 40 ? `${goal.name.slice(0, 39)}…` : goal.name;
-    ctx.font = 'bold 11px system-ui, "DejaVu Sans", sans-serif';
-    ctx.textBaseline = "top";
-    ctx.textAlign = "center";
-    ctx.lineJoin = "round";
-    ctx.lineWidth = 3;
-    ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
-    ctx.strokeText(name, sx, sy + 13);
-    ctx.fillStyle = robot.colour;
-    ctx.fillText(name, sx, sy + 13);
-    ctx.textAlign = "left";
+  if (layout) {
+    const own = layout.marker(sx, sy, GOAL_RING_PX + 1);
+    if (goal.name) {
+      const name = goal.name.length > 40 ? `${goal.name.slice(0, 39)}…` : goal.name;
+      layout.add({ kind: "goal", rank: -1, at: [sx, sy], own, gap: GOAL_RING_PX + 3, sides: ["S", "N"], lines: [{ text: name, font: BOLD, colour: robot.colour }] });
+    }
   }
   return 1;
 }
@@ -183,12 +219,9 @@ function drawScan(ctx, view, robot) {
 }
 
 // The objects the robot's detector saw: a diamond outlined in the robot's colour on white,
-// with the class and score beside it when labels are on.
-function drawDetections(ctx, view, robot, items, labels) {
+// with the class and score beside it when labels are on (`layout`).
+function drawDetections(ctx, view, robot, items, layout) {
   let count = 0;
-  ctx.font = '11px system-ui, "DejaVu Sans", sans-serif';
-  ctx.textBaseline = "middle";
-  ctx.textAlign = "left";
   ctx.lineJoin = "round";
   for (const item of items) {
     const [sx, sy] = view.toScreen(item.x, item.y);
@@ -204,13 +237,12 @@ function drawDetections(ctx, view, robot, items, labels) {
     ctx.strokeStyle = robot.colour;
     ctx.lineWidth = 2.5;
     ctx.stroke();
-    if (labels && item.label) {
-      const text = item.score === null ? item.label : `${item.label} ${Math.round(item.score * 100)} %`;
-      ctx.lineWidth = 3;
-      ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
-      ctx.strokeText(text, sx + DIAMOND_PX + 3, sy);
-      ctx.fillStyle = "#3c4043";
-      ctx.fillText(text, sx + DIAMOND_PX + 3, sy);
+    if (layout) {
+      const own = layout.marker(sx, sy, DIAMOND_PX);
+      if (item.label) {
+        const text = item.score === null ? item.label : `${item.label} ${Math.round(item.score * 100)} %`;
+        layout.add({ kind: "detection", rank: -(item.score ?? 0), at: [sx, sy], own, gap: DIAMOND_PX + 3, sides: ["E"], lines: [{ text, font: FONT, colour: TEXT }] });
+      }
     }
     count += 1;
   }
@@ -218,7 +250,8 @@ function drawDetections(ctx, view, robot, items, labels) {
 }
 
 // The footprint, in the robot's colour, at least MIN_ROBOT_PX across; the heading as a white
-// arrow in its front half (the centre pixel keeps the robot's colour).
+// arrow in its front half (the centre pixel keeps the robot's colour). Returns how far the
+// footprint reaches from the centre, px.
 function drawRobot(ctx, view, robot, selected) {
   const { x, y, th } = robot.pose;
   const [sx, sy] = view.toScreen(x, y);
@@ -248,31 +281,18 @@ function drawRobot(ctx, view, robot, selected) {
   ctx.closePath();
   ctx.fillStyle = "#ffffff";
   ctx.fill();
+  return reach * k;
 }
 
 // The robot's name with its battery (⚡ while charging, the dock state unless undocked), and
-// what it is doing (the running node) under it.
-function drawName(ctx, view, robot) {
-  const [sx, sy] = view.toScreen(robot.pose.x, robot.pose.y);
-  const lines = [robot.ns + batteryText(robot.battery) + (robot.alive ? "" : " (offline)")];
-  if (robot.node) lines.push(robot.node.length > 40 ? `${robot.node.slice(0, 39)}…` : robot.node);
-  const fonts = ['bold 12px system-ui, "DejaVu Sans", sans-serif', '11px system-ui, "DejaVu Sans", sans-serif'];
-  // right of the robot, or left of it where the right edge would cut the text
-  const widest = Math.max(...lines.map((text, i) => { ctx.font = fonts[i]; return ctx.measureText(text).width; }));
-  const left = sx + 14 + widest > view.width - 4 && sx - 14 - widest >= 4;
-  ctx.textBaseline = "middle";
-  ctx.textAlign = left ? "right" : "left";
-  ctx.lineJoin = "round";
-  lines.forEach((text, i) => {
-    const px = left ? sx - 14 : sx + 14, py = sy - 14 + i * 14;
-    ctx.font = fonts[i];
-    ctx.lineWidth = 3;
-    ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
-    ctx.strokeText(text, px, py);
-    ctx.fillStyle = i === 0 ? robot.colour : "#3c4043";
-    ctx.fillText(text, px, py);
-  });
-  ctx.textAlign = "left";
+// what it is doing (the running node) under it: beside the robot, whose footprint reaches
+// `reach` px; the selected robot's name is placed first.
+function addName(layout, view, robot, reach, selected) {
+  const at = view.toScreen(robot.pose.x, robot.pose.y);
+  const own = layout.marker(at[0], at[1], reach);
+  const lines = [{ text: robot.ns + batteryText(robot.battery) + (robot.alive ? "" : " (offline)"), font: ROBOT_FONT, colour: robot.colour }];
+  if (robot.node) lines.push({ text: robot.node.length > 40 ? `${robot.node.slice(0, 39)}…` : robot.node, font: FONT, colour: TEXT });
+  layout.add({ kind: "robot", rank: selected ? 0 : 1, at, own, gap: Math.max(NAME_GAP_PX, reach + 4), sides: ["E", "W"], lines });
 }
 
 function batteryText(battery) {

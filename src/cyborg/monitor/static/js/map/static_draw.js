@@ -1,6 +1,8 @@
 // The map's static layers, drawn once per view into a bitmap that the page then reuses frame
 // after frame: scanned points, walls, forbidden lines and areas, simulator boxes, goals (with
-// names and heading ticks), docks and home.
+// heading ticks), docks and home. Their names are not in the bitmap: they are placed with every
+// other label of the frame (labels.js, moving_draw.js), so that a robot's name and a goal's
+// give way to each other.
 //
 // Runs in the static worker (static_worker.js, on an OffscreenCanvas) or, where workers cannot
 // draw, on the page itself: it uses nothing but a 2D context, so both are the same code.
@@ -27,7 +29,7 @@ const HOME = "#188038";
 const OBSTACLE = "rgba(128, 134, 139, 0.55)";
 const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
 
-// Draws the layers switched on in `layers` ({points, walls, forbidden, goals, labels}) and
+// Draws the layers switched on in `layers` ({points, walls, forbidden, goals}) and
 // returns what it drew: {points, lines, objects} counts and the time taken (ms).
 export function drawStatic(ctx, data, region, layers) {
   const started = performance.now();
@@ -93,19 +95,24 @@ function drawWalls(ctx, lines, place) {
   return count;
 }
 
+// The layer that draws objects of `category` (and shows their names): "forbidden", "walls"
+// (simulator boxes, other shapes) or "goals" (goals, docks, home).
+export function layerOf(category) {
+  if (category === CATEGORY.FORBIDDEN_AREA || category === CATEGORY.FORBIDDEN_LINE) return "forbidden";
+  if (category === CATEGORY.SIM_OBSTACLE || category === CATEGORY.OTHER) return "walls";
+  return "goals";
+}
+
 function drawObjects(ctx, objects, place, layers) {
   const { x0, y1, k, w, h, dpr } = place;
   const at = (x, y) => [(x - x0) * k, (y1 - y) * k];
-  const margin = 60 * dpr; // a marker or label near the edge still shows
+  const margin = 60 * dpr; // a marker near the edge still shows
   const inside = ([px, py]) => px > -margin && py > -margin && px < w + margin && py < h + margin;
   let count = 0;
-  const labels = [];
-  // areas first, then lines, then markers, then their names on top of everything
+  // areas first, then lines, then markers
   const order = [CATEGORY.SIM_OBSTACLE, CATEGORY.FORBIDDEN_AREA, CATEGORY.OTHER, CATEGORY.FORBIDDEN_LINE, CATEGORY.HOME, CATEGORY.DOCK, CATEGORY.GOAL, CATEGORY.GOAL_WITH_HEADING];
   for (const category of order) {
-    const wanted = [CATEGORY.FORBIDDEN_AREA, CATEGORY.FORBIDDEN_LINE].includes(category) ? layers.forbidden
-      : [CATEGORY.SIM_OBSTACLE, CATEGORY.OTHER].includes(category) ? layers.walls : layers.goals;
-    if (!wanted) continue;
+    if (!layers[layerOf(category)]) continue;
     for (const item of objects) {
       if (item.category !== category) continue;
       const corners = [];
@@ -114,25 +121,8 @@ function drawObjects(ctx, objects, place, layers) {
       if (!(corners.length ? corners.some(inside) || crosses(corners, w, h) : inside(centre))) continue;
       count += 1;
       ctx.setLineDash([]);
-      if (corners.length >= 2) {
-        outline(ctx, corners, category, dpr);
-        if (item.name) labels.push([item.name, corners[0][0], corners[0][1]]);
-        continue;
-      }
-      marker(ctx, item, centre, dpr);
-      if (item.name) labels.push([item.name, centre[0] + 8 * dpr, centre[1] - 6 * dpr]);
-    }
-  }
-  if (layers.labels) {
-    ctx.font = `${11 * dpr}px system-ui, "DejaVu Sans", sans-serif`;
-    ctx.textBaseline = "middle";
-    ctx.lineJoin = "round";
-    for (const [name, px, py] of labels) {
-      ctx.lineWidth = 3 * dpr;
-      ctx.strokeStyle = "rgba(255, 255, 255, 0.9)";
-      ctx.strokeText(name, px, py);
-      ctx.fillStyle = "#202124";
-      ctx.fillText(name, px, py);
+      if (corners.length >= 2) outline(ctx, corners, category, dpr);
+      else marker(ctx, item, centre, dpr);
     }
   }
   return count;

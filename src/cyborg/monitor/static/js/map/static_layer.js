@@ -5,8 +5,9 @@
 // view's scale. Between renders the page blits the last bitmap shifted and scaled to the
 // current view (moving_draw.js): a 0.6 ms drawImage instead of a 11–23 ms rasterisation. A new
 // render is asked for only when the bitmap no longer serves: another scale (zoom), another
-// device pixel ratio, other layers, another map, or a pan past the margin. At most one render
-// is in flight; whatever the view did meanwhile is caught up when it returns.
+// device pixel ratio, other layers (not the labels: they are placed each frame, labels.js),
+// another map, or a pan past the margin. At most one render is in flight; whatever the view
+// did meanwhile is caught up when it returns.
 
 import { drawStatic } from "./static_draw.js";
 
@@ -100,7 +101,7 @@ export class StaticLayer {
     if (this.covers(view, dpr, layersKey)) return true;
     if (this.inFlight || this.workerState === "starting") return false;
     const region = regionFor(view, dpr);
-    const wanted = { points: !!layers.points, walls: !!layers.walls, forbidden: !!layers.forbidden, goals: !!layers.goals, labels: !!layers.labels };
+    const wanted = { points: !!layers.points, walls: !!layers.walls, forbidden: !!layers.forbidden, goals: !!layers.goals };
     this.renders += 1;
     if (this.workerState === "ready") {
       this.inFlight = true;
@@ -153,7 +154,7 @@ export class StaticLayer {
 }
 
 function keyOf(layers) {
-  return ["points", "walls", "forbidden", "goals", "labels"].map((name) => (layers[name] ? 1 : 0)).join("");
+  return ["points", "walls", "forbidden", "goals"].map((name) => (layers[name] ? 1 : 0)).join("");
 }
 
 // The view plus the margin, centred on the view's centre; smaller on huge screens.

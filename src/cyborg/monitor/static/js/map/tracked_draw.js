@@ -6,8 +6,8 @@
 // of its motion (at least a little longer than the marker, so a slow one still shows which
 // way). Older objects are more transparent (`alpha`). When labels are on and the map is zoomed
 // in to at least LABEL_MIN_SCALE px per m, each gets its label and id (`person #4`) beside it,
-// unless that would cover a label already placed: labels go out most confident first, across
-// all robots, at most MAX_LABELS, so a crowd stays readable.
+// placed with the frame's other labels (labels.js: after the robots' names, before goals'),
+// most confident first, across all robots, at most MAX_LABELS, so a crowd stays readable.
 
 const MARK_PX = 7; // a person's radius, half a square's side
 const MOVING_MPS = 0.1; // slower than this, no arrow
@@ -17,11 +17,11 @@ export const LABEL_MIN_SCALE = 8; // px per m: zoomed out further, no labels
 const MAX_LABELS = 40;
 const FONT = '11px system-ui, "DejaVu Sans", sans-serif';
 
-// Draws `items` of `robot` (with `alpha`, see trackedNow). `placed`: label boxes already on the
-// canvas ([x0, y0, x1, y1]), shared between robots and grown here; null when labels are off.
-// Returns {objects, arrows, labels}: how many of each were drawn.
-export function drawTracked(ctx, view, robot, items, placed) {
-  const drawn = { objects: 0, arrows: 0, labels: 0 };
+// Draws `items` of `robot` (with `alpha`, see trackedNow). `layout`: the frame's LabelLayout
+// (labels.js), told where each marker is; null when labels are off. Returns {objects, arrows,
+// labels}: how many objects and arrows were drawn, and the labels they want (for addLabels).
+export function drawTracked(ctx, view, robot, items, layout) {
+  const drawn = { objects: 0, arrows: 0, labels: [] };
   const margin = MARK_PX + HEAD_PX;
   const shown = items.map((item) => ({ item, at: view.toScreen(item.x, item.y) }))
     .filter(({ at: [sx, sy] }) => sx > -margin && sy > -margin && sx < view.width + margin && sy < view.height + margin);
@@ -36,6 +36,7 @@ export function drawTracked(ctx, view, robot, items, placed) {
     arrow(ctx, at, [item.vx / speed, -item.vy / speed], length, robot.colour);
     drawn.arrows += 1;
   }
+  const labelled = layout && view.scale >= LABEL_MIN_SCALE;
   for (const { item, at: [sx, sy] } of shown) {
     ctx.globalAlpha = item.alpha;
     ctx.beginPath();
@@ -47,29 +48,25 @@ export function drawTracked(ctx, view, robot, items, placed) {
     ctx.lineWidth = 2.5;
     ctx.stroke();
     drawn.objects += 1;
-  }
-  if (placed && view.scale >= LABEL_MIN_SCALE) {
-    ctx.font = FONT;
-    ctx.textBaseline = "middle";
-    ctx.textAlign = "left";
-    for (const { item, at: [sx, sy] } of [...shown].sort((a, b) => b.item.conf - a.item.conf)) {
-      if (placed.length >= MAX_LABELS) break;
-      const text = `${item.label || "object"} #${item.id}`;
-      const px = sx + MARK_PX + 3;
-      const box = [px, sy - 7, px + ctx.measureText(text).width, sy + 7];
-      if (placed.some((other) => overlaps(box, other))) continue;
-      placed.push(box);
-      ctx.globalAlpha = item.alpha;
-      ctx.lineWidth = 3;
-      ctx.strokeStyle = "rgba(255, 255, 255, 0.92)";
-      ctx.strokeText(text, px, sy);
-      ctx.fillStyle = "#3c4043";
-      ctx.fillText(text, px, sy);
-      drawn.labels += 1;
+    if (!layout) continue;
+    const own = layout.marker(sx, sy, MARK_PX);
+    if (labelled) {
+      drawn.labels.push({
+        kind: "tracked", at: [sx, sy], gap: MARK_PX + 3, own, alpha: item.alpha, rank: -item.conf,
+        lines: [{ text: `${item.label || "object"} #${item.id}`, font: FONT, colour: "#3c4043" }],
+      });
     }
   }
   ctx.globalAlpha = 1;
   return drawn;
+}
+
+// Gives `layout` the most confident MAX_LABELS of the tracked objects' `labels` (of every
+// robot); returns how many it was given.
+export function addLabels(layout, labels) {
+  const kept = [...labels].sort((a, b) => a.rank - b.rank).slice(0, MAX_LABELS);
+  for (const label of kept) layout.add(label);
+  return kept.length;
 }
 
 export function isPerson(label) {
@@ -98,8 +95,4 @@ function arrow(ctx, [sx, sy], [dx, dy], length, colour) {
   ctx.closePath();
   ctx.fillStyle = colour;
   ctx.fill();
-}
-
-function overlaps(a, b) {
-  return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
 }

@@ -13,6 +13,7 @@
 
 export const MIN_SCALE = 0.2; // px per m: 5 m a pixel
 export const MAX_SCALE = 2000; // px per m: 0.5 mm a pixel
+const FIT_MARGIN = 16; // px between a fitted map and the edge of where it is shown
 
 export class ViewTransform {
   constructor() {
@@ -78,14 +79,23 @@ export class ViewTransform {
     this.changed();
   }
 
-  // Show the whole of `bounds` ({x0, y0, x1, y1}, m) with a margin of `margin` px.
-  fit(bounds, margin = 16) {
-    if (!this.width || !this.height || !bounds) return;
+  // The scale (px per m) at which `bounds` ({x0, y0, x1, y1}, m) fill `width` × `height` px
+  // less a margin of `margin` px all round (unclamped).
+  static fitScale(bounds, width, height, margin = FIT_MARGIN) {
     const w = Math.max(bounds.x1 - bounds.x0, 0.5), h = Math.max(bounds.y1 - bounds.y0, 0.5);
     const room = (size) => Math.max(size - 2 * margin, 1);
-    this.scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, Math.min(room(this.width) / w, room(this.height) / h)));
-    this.cx = (bounds.x0 + bounds.x1) / 2;
-    this.cy = (bounds.y0 + bounds.y1) / 2;
+    return Math.min(room(width) / w, room(height) / h);
+  }
+
+  // Show the whole of `bounds` ({x0, y0, x1, y1}, m) with a margin of FIT_MARGIN px, in the
+  // middle of `area` ({x0, y0, x1, y1}, px on the canvas; the whole canvas by default).
+  fit(bounds, area = { x0: 0, y0: 0, x1: this.width, y1: this.height }) {
+    if (!this.width || !this.height || !bounds) return;
+    const scale = ViewTransform.fitScale(bounds, area.x1 - area.x0, area.y1 - area.y0);
+    this.scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, scale));
+    // the bounds' middle on the area's middle
+    this.cx = (bounds.x0 + bounds.x1) / 2 - ((area.x0 + area.x1) / 2 - this.width / 2) / this.scale;
+    this.cy = (bounds.y0 + bounds.y1) / 2 + ((area.y0 + area.y1) / 2 - this.height / 2) / this.scale;
     this.changed();
   }
 
