@@ -1,8 +1,9 @@
 """Take the README's picture of the monitor, ``docs/images/monitor_map.png``.
 
 Runs ``cyborg up`` (this checkout's, for 40 s, without the camera and detector) on free ports,
-opens its monitor in Debian's Chromium at 1280x720 with Playwright, waits until the robot has
-moved on its patrol and is on its way along a drawn path, and saves the page. Run
+opens its monitor in Debian's Chromium at 1400x900 with Playwright (the page's defaults: the
+tree at its readable size), waits until the robot has moved on its patrol and is on its way
+along a drawn path, and saves the page. Run
 ``python3 scripts/monitor_map_screenshot.py [OUT.png]`` after changing how the page looks.
 """
 
@@ -60,7 +61,7 @@ def main(out: Path) -> None:
         with sync_playwright() as playwright:
             browser = playwright.chromium.launch(executable_path=chromium,
                                                  args=["--disable-gpu", "--disable-quic"])
-            page = browser.new_page(viewport={"width": 1280, "height": 720})
+            page = browser.new_page(viewport={"width": 1400, "height": 900})
             page.goto(f"http://127.0.0.1:{web}/")
             page.wait_for_function(f"window.__map && window.__map.firstPaint !== null && "
                                    f"window.__map.robot({ROBOT!r})?.pose", timeout=20000)
