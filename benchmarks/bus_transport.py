@@ -1,8 +1,8 @@
 """How fast the bus moves messages: small round trips, camera frames, in-process delivery.
 
-    python3 benchmarks/bus_transport.py             # full run, about a minute
-    python3 benchmarks/bus_transport.py --quick     # smoke test
-    python3 benchmarks/bus_transport.py --markdown  # the results table as Markdown
+    python3 -m benchmarks.bus_transport             # full run, about a minute
+    python3 -m benchmarks.bus_transport --quick     # smoke test
+    python3 -m benchmarks.bus_transport --markdown  # the results table as Markdown
 
 Measured in one run, on this machine:
 
@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks import benchmark_options
 from cyborg.bus import BusConfig, Context, Node, Qos
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image, stamp_ns
 
@@ -241,7 +242,8 @@ def measure(rounds: int, frames: int) -> dict[str, dict[str, float]]:
     pipe_small, pipe_big = pipe_baseline(rounds, frames)
     results["frame: pickled multiprocessing Pipe"] = summary(pipe_big)
     with Context(BusConfig.router([endpoint])) as context:
-        peer = subprocess.Popen([sys.executable, __file__, "--sink", endpoint],
+        peer = subprocess.Popen([sys.executable, "-m", "benchmarks.bus_transport",
+                                 "--sink", endpoint],
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         try:
             assert peer.stdout is not None and peer.stdout.readline().strip() == "ready"
@@ -300,16 +302,19 @@ def report(results: dict[str, dict[str, float]], markdown: bool) -> None:
           f"inline=True ({'met' if inline <= 0.05 else 'NOT met'})")
 
 
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="10 frames, 50 round trips")
+    options.add_argument("--sink", metavar="ENDPOINT", help=argparse.SUPPRESS)
+    return options
+
+
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="few samples, a smoke test")
-    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
-    parser.add_argument("--sink", metavar="ENDPOINT", help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
+    args = parser().parse_args(argv)
     if args.sink:
         sink(args.sink)
         return
-    rounds, frames = (200, 10) if args.quick else (3000, 200)
+    rounds, frames = (50, 10) if args.quick else (3000, 200)
     report(measure(rounds, frames), args.markdown)
 
 

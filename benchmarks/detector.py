@@ -1,9 +1,9 @@
 """The detector end to end on 1080p frames with depth, against the 2018 approach, in one run.
 
-    python3 benchmarks/detector.py             # full run, about 100 s
-    python3 benchmarks/detector.py --quick     # smoke test, about 12 s
-    python3 benchmarks/detector.py --markdown  # the tables as Markdown
-    python3 benchmarks/detector.py --threads 1 # onnxruntime / OpenCV threads (default 2)
+    python3 -m benchmarks.detector             # full run, about 100 s
+    python3 -m benchmarks.detector --quick     # smoke test: 1 short round, a few s
+    python3 -m benchmarks.detector --markdown  # the tables as Markdown
+    python3 -m benchmarks.detector --threads 1 # onnxruntime / OpenCV threads (default 2)
 
 Frames (:mod:`benchmarks.detector_frames`): four photos from scikit-image tiled into a
 1920x1080 BGR image (YOLOX-Nano finds 5 objects at confidence 0.5), with a float32 depth map
@@ -63,7 +63,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -71,9 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-if __package__ in (None, ""):  # run as a file: the benchmarks package from the repository root
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
+from benchmarks import SHARED, benchmark_options
 from benchmarks.detector_2018 import Approach2018
 from benchmarks.detector_frames import STAGES, THRESHOLD, Run, make_frames, quantiles
 from benchmarks.detector_ours import (
@@ -84,7 +81,6 @@ from benchmarks.detector_ours import (
     detector_peer,
 )
 
-SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MODEL = SHARED / "models" / "yolox_nano.onnx"
 GOAL_FPS, GOAL_OVERHEAD = 60.0, 0.20
 
@@ -156,7 +152,7 @@ def measure(model: Path, threads: int, quick: bool) -> Results:
     """Every configuration once per round, round-robin, so drift touches all alike."""
     started = time.monotonic()
     frames = make_frames()
-    rounds, scale = (2, 5) if quick else (5, 1)
+    rounds, scale = (1, 25) if quick else (5, 1)
     runs = {key: Run(name) for key, name in CONFIGURATIONS.items()}
     bare = BareInference(frames, model, threads)
     pipeline = PipelineAlone(frames, model, threads)
@@ -167,9 +163,10 @@ def measure(model: Path, threads: int, quick: bool) -> Results:
     meter.pids += [two.peer.pid, old.peer.pid or 0]
     foreign = []
     try:
-        in_process.run(20, 1)  # warm-ups
-        two.run(20, 1)
-        old.bare(5)
+        warm_up = 5 if quick else 20
+        in_process.run(warm_up, 1)  # warm-ups
+        two.run(warm_up, 1)
+        old.bare(min(warm_up, 5))
         old.run(3, 1)
         for _ in range(rounds):
             meter.restart()
@@ -357,21 +354,25 @@ def report(results: Results, markdown: bool) -> None:
           "not available, and OpenCV 5 removed the Darknet importer)")
 
 
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="one round of a few frames each")
+    options.add_argument("--threads", type=int, default=2,
+                         help="onnxruntime and OpenCV DNN threads (default 2)")
+    options.add_argument("--model", type=Path, default=MODEL,
+                         help="a YOLOX-Nano ONNX file (default: $CYBORG_SHARED/models)")
+    options.add_argument("--detector-peer", metavar="ENDPOINT", help=argparse.SUPPRESS)
+    return options
+
+
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="few frames, a smoke test")
-    parser.add_argument("--markdown", action="store_true", help="print Markdown tables")
-    parser.add_argument("--threads", type=int, default=2,
-                        help="onnxruntime and OpenCV DNN threads (default 2)")
-    parser.add_argument("--model", type=Path, default=MODEL,
-                        help="a YOLOX-Nano ONNX file (default: $CYBORG_SHARED/models)")
-    parser.add_argument("--detector-peer", metavar="ENDPOINT", help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
+    options = parser()
+    args = options.parse_args(argv)
     if args.detector_peer:
         detector_peer(args.detector_peer, args.model, args.threads)
         return
     if not args.model.is_file():
-        parser.error(f"model {args.model} not found (set CYBORG_SHARED or give --model)")
+        options.error(f"model {args.model} not found (set CYBORG_SHARED or give --model)")
     report(measure(args.model, args.threads, args.quick), args.markdown)
 
 

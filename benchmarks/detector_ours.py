@@ -4,8 +4,8 @@
   them (in-process delivery: the frame is handed over, not copied).
 * :class:`OursTwoProcesses`: a camera node here (with the bus router) publishing each frame as
   two ``sensor_msgs/Image`` (``bgr8`` + ``32FC1``, CameraNode's topics and encodings), the
-  detector node in a process of its own (``benchmarks/detector.py --detector-peer``); the camera
-  hears the ``Detection2DArray`` back, which gives the latency.
+  detector node in a process of its own (``python3 -m benchmarks.detector --detector-peer``);
+  the camera hears the ``Detection2DArray`` back, which gives the latency.
 * :class:`PipelineAlone`: :class:`~cyborg.vision.DetectionPipeline` on the frames, no bus: frame
   in, detections with distances (and the annotated image when drawn) out.
 * :class:`BareInference`: the onnxruntime session alone on a tensor prepared once.
@@ -35,7 +35,6 @@ from cyborg.vision.pipeline import DetectionPipeline, Result
 
 IMAGE_TOPIC, DEPTH_TOPIC = "/camera/left/image_raw", "/camera/depth/depth_registered"
 DETECTIONS_TOPIC, ANNOTATED_TOPIC = "/detector/detections", "/detector/detection_image"
-ENTRY = Path(__file__).with_name("detector.py")
 """The benchmark's entry point, which runs the detector process with ``--detector-peer``."""
 
 
@@ -182,7 +181,8 @@ class OursTwoProcesses:
             probe.bind(("127.0.0.1", 0))
             endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
         self.context = Context(BusConfig.router([endpoint]))
-        self.peer = subprocess.Popen([sys.executable, str(ENTRY), "--detector-peer", endpoint,
+        self.peer = subprocess.Popen([sys.executable, "-m", "benchmarks.detector",
+                                      "--detector-peer", endpoint,
                                       "--model", str(model), "--threads", str(threads)],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         self.dropped = 0

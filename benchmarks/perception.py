@@ -1,8 +1,8 @@
 """What tracking costs the robot per camera frame, at 20 detections a frame.
 
-    python3 benchmarks/perception.py             # 3 rounds of 2,000 frames, about 20 s
-    python3 benchmarks/perception.py --quick     # 1 round of 300 frames
-    python3 benchmarks/perception.py --markdown  # the table as Markdown
+    python3 -m benchmarks.perception             # 3 rounds of 2,000 frames, about 20 s
+    python3 -m benchmarks.perception --quick     # 1 round of 300 frames
+    python3 -m benchmarks.perception --markdown  # the table as Markdown
 
 A scene of 20 people walking back and forth (at up to 0.5 to 1.5 m/s) 2 to 8 m from a robot
 that turns slowly on the spot is seen at 15 frames per second by the ZED's model
@@ -35,12 +35,10 @@ import math
 import statistics
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
+from benchmarks import benchmark_options
 from benchmarks.results_table import print_results
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.cyborg_msgs.msg import Prediction, Predictions
@@ -162,12 +160,14 @@ def p99(values: list[float]) -> float:
     return float(np.percentile(values, 99))
 
 
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    return benchmark_options(__doc__, quick="one round of 300 frames")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the benchmark and prints its table."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="one short round")
-    parser.add_argument("--markdown", action="store_true", help="print Markdown")
-    args = parser.parse_args(argv)
+    args = parser().parse_args(argv)
     rounds, count = (1, 300) if args.quick else (3, 2000)
     figures = Run()
     for round_ in range(rounds):

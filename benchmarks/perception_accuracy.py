@@ -1,8 +1,8 @@
 """Where the tracker puts people, against where they are: the simulator's camera, end to end.
 
-    python3 benchmarks/perception_accuracy.py             # 5 simulated minutes, about 15 s
-    python3 benchmarks/perception_accuracy.py --quick     # 1 simulated minute
-    python3 benchmarks/perception_accuracy.py --markdown  # the table as Markdown
+    python3 -m benchmarks.perception_accuracy             # 5 simulated minutes, about 15 s
+    python3 -m benchmarks.perception_accuracy --quick     # 15 simulated seconds
+    python3 -m benchmarks.perception_accuracy --markdown  # the table as Markdown
 
 The robot patrols the map's goals (columbia.map in ../shared) with 10 people walking at random
 among them (0.5 to 1.5 m/s, pausing, keeping out of its way), as in benchmarks/sim_people.py.
@@ -28,12 +28,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
-import sys
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks import SHARED, benchmark_options
+from benchmarks.patrol import patrol_goals
 from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.std_msgs.msg import Header
 from cyborg.interfaces.detection_messages import predictions_message
@@ -45,12 +45,6 @@ from cyborg.sim.people_sources import random_people
 from cyborg.sim.sights import crowd_sights
 from cyborg.sim.simulator import Simulator
 
-if __package__ in (None, ""):  # run as a file: the benchmarks package from the repository root
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from benchmarks.patrol import patrol_goals
-
-SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 BANDS = ((0.0, 5.0, "<= 5 m"), (5.0, 10.0, "5-10 m"), (10.0, math.inf, "> 10 m"))
 """Ranges (m, from the robot to the true person) the errors are reported in."""
 
@@ -120,15 +114,18 @@ def _figures(values: list[float]) -> str:
     return f"median {median:.2f} m, p90 {p90:.2f} m ({len(values)})"
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="1 simulated minute, not 5")
-    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
-    parser.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
-    parser.add_argument("--people", type=int, default=10, help="people walking (default 10)")
-    parser.add_argument("--seed", type=int, default=1, help="the people's and camera's seed")
-    args = parser.parse_args()
-    minutes = 1.0 if args.quick else 5.0
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="15 simulated seconds")
+    options.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
+    options.add_argument("--people", type=int, default=10, help="people walking (default 10)")
+    options.add_argument("--seed", type=int, default=1, help="the people's and camera's seed")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
+    minutes = 0.25 if args.quick else 5.0
     errors = measure(read_map(args.map), minutes, args.people, args.seed)
     rows = [(f"tracked people, {name} from the robot", _figures(errors.tracked[name]))
             for *_, name in BANDS[:2]]

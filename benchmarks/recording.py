@@ -1,8 +1,9 @@
 """What recording costs with each compression: CPU per MB, MB/s and file size.
 
-    python3 benchmarks/recording.py                   # records `cyborg up` 20 s, then measures
-    python3 benchmarks/recording.py --sample run.mcap # measures on a recording made before
-    python3 benchmarks/recording.py --markdown        # the results table as Markdown
+    python3 -m benchmarks.recording                   # records `cyborg up` 20 s, then measures
+    python3 -m benchmarks.recording --sample run.mcap # measures on a recording made before
+    python3 -m benchmarks.recording --markdown        # the results table as Markdown
+    python3 -m benchmarks.recording --quick           # a smoke test: 3 s recorded, 2 MB written
 
 The messages are the default topics of ``cyborg up`` (no camera images: a recording of all
 topics leaves them out), taken from a real run: ``cyborg up --no-detector --no-monitor --record``
@@ -17,6 +18,7 @@ of one core that recording ``cyborg up``'s own data rate takes at that CPU cost.
 from __future__ import annotations
 
 import argparse
+import socket
 import subprocess
 import sys
 import tempfile
@@ -25,6 +27,7 @@ from pathlib import Path
 
 from mcap.reader import make_reader
 
+from benchmarks import benchmark_options
 from cyborg.bus import MessageTypes
 from cyborg.record.mcap_file import COMPRESSIONS, McapFile
 
@@ -33,9 +36,13 @@ Sample = list[tuple[str, str, int, bytes]]
 
 
 def record_sample(seconds: float, folder: Path) -> Path:
+    """Records ``cyborg up`` for ``seconds`` on a bus of its own (a free loopback port)."""
     path = folder / "sample.mcap"
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
     subprocess.run([sys.executable, "-m", "cyborg", "up", "--no-detector", "--no-monitor",
-                    "--record", str(path), "--duration", str(seconds)],
+                    "--listen", endpoint, "--record", str(path), "--duration", str(seconds)],
                    check=True, stdout=subprocess.DEVNULL, timeout=seconds + 120)
     return path
 
@@ -79,15 +86,21 @@ def measure(sample: Sample, span: float, compression: str, megabytes: float,
             "core_share_live": cpu / megabytes_written * live_rate, "megabytes": megabytes_written}
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sample", type=Path, default=None, help="a recording to measure on")
-    parser.add_argument("--seconds", type=float, default=20.0,
-                        help="how long to record cyborg up for the sample (default 20)")
-    parser.add_argument("--megabytes", type=float, default=64.0,
-                        help="MB of messages each compression writes (default 64)")
-    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="--seconds 3 --megabytes 2")
+    options.add_argument("--sample", type=Path, default=None, help="a recording to measure on")
+    options.add_argument("--seconds", type=float, default=20.0,
+                         help="how long to record cyborg up for the sample (default 20)")
+    options.add_argument("--megabytes", type=float, default=64.0,
+                         help="MB of messages each compression writes (default 64)")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
+    if args.quick:
+        args.seconds, args.megabytes = 3.0, 2.0
     with tempfile.TemporaryDirectory() as folder:
         path = args.sample or record_sample(args.seconds, Path(folder))
         sample, span = read_sample(path)

@@ -1,7 +1,8 @@
 """Recording the camera's full stream: MB/s, frames dropped, the recorder against mcap alone.
 
     python3 -m benchmarks.recording_camera                     # 60 s each, three rounds
-    python3 -m benchmarks.recording_camera --seconds 10 --rounds 1   # a quick check
+    python3 -m benchmarks.recording_camera --seconds 10 --rounds 1   # a shorter measure
+    python3 -m benchmarks.recording_camera --quick     # a smoke test: 1 s, one round
     python3 -m benchmarks.recording_camera --markdown          # the rows for docs/benchmarks.md
     python3 -m benchmarks.recording_camera --chunks            # the writer alone, flat out:
                                                                # chunk sizes x compressions
@@ -53,6 +54,7 @@ import numpy as np
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from benchmarks import benchmark_options
 from benchmarks.results_table import print_results
 from cyborg.app.memory import keep_large_buffers, limit_malloc_arenas
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
@@ -340,25 +342,31 @@ def chunks_report(frame: Frame, args: argparse.Namespace, folder: Path) -> None:
                   markdown=args.markdown, widths=(24, 62, 16))
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=60.0,
-                        help="seconds of camera stream per measure (default 60)")
-    parser.add_argument("--rounds", type=int, default=3,
-                        help="rounds of (a) and (b), interleaved (default 3)")
-    parser.add_argument("--compression", choices=sorted(COMPRESSIONS), default=None,
-                        help=f"the recording's compression (default {IMAGE_COMPRESSION}, as "
-                             "cyborg record --images; with --chunks: each)")
-    parser.add_argument("--chunks", action="store_true",
-                        help="instead: the writer alone flat out, each compression and chunk size")
-    parser.add_argument("--no-end-to-end", action="store_true", help="leave out (c)")
-    parser.add_argument("--default-malloc", action="store_true",
-                        help="leave glibc's malloc thresholds as they are")
-    parser.add_argument("--folder", type=Path, default=None,
-                        help="where the files go (default: a temporary folder)")
-    parser.add_argument("--markdown", action="store_true", help="the rows for docs/benchmarks.md")
-    parser.add_argument("--publish", default=None, help=argparse.SUPPRESS)
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="--seconds 1 --rounds 1")
+    options.add_argument("--seconds", type=float, default=60.0,
+                         help="seconds of camera stream per measure (default 60)")
+    options.add_argument("--rounds", type=int, default=3,
+                         help="rounds of (a) and (b), interleaved (default 3)")
+    options.add_argument("--compression", choices=sorted(COMPRESSIONS), default=None,
+                         help=f"the recording's compression (default {IMAGE_COMPRESSION}, as "
+                              "cyborg record --images; with --chunks: each)")
+    options.add_argument("--chunks", action="store_true",
+                         help="instead: the writer alone flat out, each compression and chunk size")
+    options.add_argument("--no-end-to-end", action="store_true", help="leave out (c)")
+    options.add_argument("--default-malloc", action="store_true",
+                         help="leave glibc's malloc thresholds as they are")
+    options.add_argument("--folder", type=Path, default=None,
+                         help="where the files go (default: a temporary folder)")
+    options.add_argument("--publish", default=None, help=argparse.SUPPRESS)
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
+    if args.quick:
+        args.seconds, args.rounds = 1.0, 1
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     if not args.default_malloc:
         keep_large_buffers()  # as `cyborg record` does

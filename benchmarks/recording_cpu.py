@@ -1,7 +1,8 @@
 """What recording `cyborg up`'s default topics costs: CPU as % of one core, against 5 %.
 
     python3 -m benchmarks.recording_cpu               # 60 s each way, after a 10 s warm-up
-    python3 -m benchmarks.recording_cpu --seconds 20  # a quick check
+    python3 -m benchmarks.recording_cpu --seconds 20  # a shorter measure
+    python3 -m benchmarks.recording_cpu --quick       # a smoke test: 1 s each way, after 2 s
     python3 -m benchmarks.recording_cpu --markdown    # the rows for docs/benchmarks.md
     python3 -m benchmarks.recording_cpu --profile     # and where the in-process recorder's
                                                       # thread spends it (cProfile)
@@ -41,6 +42,7 @@ from pathlib import Path
 
 from mcap.reader import make_reader
 
+from benchmarks import benchmark_options
 from benchmarks.results_table import print_results
 from cyborg.app.cli import build_parser
 from cyborg.app.launch import Launch
@@ -125,6 +127,11 @@ def own_process(seconds: float, warm_up: float, folder: Path) -> Cost:
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         try:
             stat = Path(f"/proc/{record.pid}/stat")
+            started = time.monotonic()
+            while not path.exists():  # cyborg record has started and opened its file
+                if record.poll() is not None or time.monotonic() - started > 60:
+                    raise RuntimeError(f"cyborg record did not start writing {path}")
+                time.sleep(0.1)
             time.sleep(warm_up)
             cpu, wall, log_from = cpu_seconds(stat), time.perf_counter(), time.time_ns()
             time.sleep(seconds)
@@ -151,16 +158,22 @@ def describe(cost: Cost) -> tuple[str, str]:
             f"{cost.core / GOAL:.2f} of the goal")
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=60.0,
-                        help="wall seconds measured each way (default 60)")
-    parser.add_argument("--warm-up", type=float, default=10.0,
-                        help="seconds of recording before measuring (default 10)")
-    parser.add_argument("--profile", action="store_true",
-                        help="print where the in-process recorder's thread spends its time")
-    parser.add_argument("--markdown", action="store_true", help="the rows for docs/benchmarks.md")
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="--seconds 1 --warm-up 2")
+    options.add_argument("--seconds", type=float, default=60.0,
+                         help="wall seconds measured each way (default 60)")
+    options.add_argument("--warm-up", type=float, default=10.0,
+                         help="seconds of recording before measuring (default 10)")
+    options.add_argument("--profile", action="store_true",
+                         help="print where the in-process recorder's thread spends its time")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
+    if args.quick:
+        args.seconds, args.warm_up = 1.0, 2.0
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     with tempfile.TemporaryDirectory() as folder:
         inside = in_process(args.seconds, args.warm_up, Path(folder), args.profile)

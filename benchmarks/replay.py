@@ -1,8 +1,9 @@
 """How closely ``cyborg play`` keeps a recording's timing: publish time against schedule.
 
-    python3 benchmarks/replay.py                 # 10 s of a cyborg up-like mix at rate 1
-    python3 benchmarks/replay.py --seconds 30 --rate 2
-    python3 benchmarks/replay.py --markdown      # the results table as Markdown
+    python3 -m benchmarks.replay                 # 10 s of a cyborg up-like mix at rate 1
+    python3 -m benchmarks.replay --seconds 30 --rate 2
+    python3 -m benchmarks.replay --markdown      # the results table as Markdown
+    python3 -m benchmarks.replay --quick         # a smoke test: 2 s
 
 A recording is written first (:class:`cyborg.record.mcap_file.McapFile`, as the recorder
 writes): ``/clock`` is left out so the player makes its own; ``/cyborg/pose`` at 50 Hz,
@@ -32,6 +33,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from benchmarks import benchmark_options
 from cyborg.bus import BusConfig, Context, MessageTypes, Node, new_message
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import String
@@ -134,13 +136,20 @@ def sleep_loop(path: Path, rate: float) -> list[float]:
     return lateness
 
 
-def main() -> None:
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="--seconds 2")
+    options.add_argument("--seconds", type=float, default=10.0,
+                         help="seconds of recording (default 10)")
+    options.add_argument("--rate", type=float, default=1.0, help="the pace (default 1)")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
     """Writes the recording, measures the player and the baseline, prints the figures."""
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--rate", type=float, default=1.0)
-    parser.add_argument("--markdown", action="store_true")
-    args = parser.parse_args()
+    args = parser().parse_args(argv)
+    if args.quick:
+        args.seconds = 2.0
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "replay.mcap"
         count = write_recording(path, args.seconds)

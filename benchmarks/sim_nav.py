@@ -19,7 +19,6 @@ import argparse
 import heapq
 import itertools
 import math
-import os
 import statistics
 import time
 from collections.abc import Callable, Sequence
@@ -27,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import SHARED, benchmark_options
 from benchmarks.patrol import patrol_goals
 from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
@@ -35,8 +35,6 @@ from cyborg.nav.planner import Planner
 from cyborg.nav.temporary_obstacles import ObstacleSettings
 from cyborg.sim.laser import Laser
 from cyborg.sim.simulator import Simulator
-
-SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 
 
 def numpy_laser_scan(laser: Laser) -> Callable[[float, float, float], np.ndarray]:
@@ -130,22 +128,25 @@ def planning(arnl_map: ArnlMap) -> tuple[list[float], float, float, float, list[
     return times, length, ours, baseline, with_people
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="2 simulated minutes, not 10")
-    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
-    parser.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="1 simulated minute, the numpy baseline 6 s")
+    options.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
     arnl_map = read_map(args.map)
-    minutes = 2.0 if args.quick else 10.0
+    minutes, base_minutes = (1.0, 0.1) if args.quick else (10.0, 2.0)
     ours, reached = patrol_speed(arnl_map, minutes, numpy_laser=False)
-    base, base_reached = patrol_speed(arnl_map, minutes / 5, numpy_laser=True)
+    base, base_reached = patrol_speed(arnl_map, base_minutes, numpy_laser=True)
     times, far_length, far_ours, far_python, with_people = planning(arnl_map)
     rows = [
         ("simulation, compiled laser (x real time)", f"{ours:.0f}x",
          f"{ours / base:.1f}x baseline", f"{reached} goals in {minutes:g} min"),
         ("simulation, numpy ray-march laser (baseline)", f"{base:.0f}x", "1.0x baseline",
-         f"{base_reached} goals in {minutes / 5:g} min"),
+         f"{base_reached} goals in {base_minutes:g} min"),
         ("planning, all goal pairs: median ms", f"{statistics.median(times) * 1000:.1f}", "",
          f"{len(times)} plans"),
         ("planning, all goal pairs: worst ms", f"{max(times) * 1000:.1f}", "", ""),

@@ -20,6 +20,7 @@ import os
 import time
 from pathlib import Path
 
+from benchmarks import SHARED, benchmark_options
 from benchmarks.patrol import patrol_goals
 from benchmarks.results_table import print_results
 from cyborg.nav.arnl_map import ArnlMap, read_map
@@ -28,8 +29,6 @@ from cyborg.sim.people import Crowd
 from cyborg.sim.people_sources import random_people
 from cyborg.sim.sights import crowd_sights
 from cyborg.sim.simulator import Simulator
-
-SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 
 
 class Result:
@@ -74,15 +73,18 @@ def patrol(arnl_map: ArnlMap, minutes: float, people: int) -> Result:
     return Result(speed, cpu_speed, reached, counts["frames"], counts["detections"], routes)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="2 simulated minutes, not 10")
-    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
-    parser.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
-    parser.add_argument("--people", type=int, default=10, help="people walking (default 10)")
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="1 simulated minute")
+    options.add_argument("--map", type=Path, default=SHARED / "maps" / "columbia.map")
+    options.add_argument("--people", type=int, default=10, help="people walking (default 10)")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
     arnl_map = read_map(args.map)
-    minutes = 2.0 if args.quick else 10.0
+    minutes = 1.0 if args.quick else 10.0
     ours = patrol(arnl_map, minutes, args.people)
     base = patrol(arnl_map, minutes, 0)
     rows = [

@@ -1,6 +1,7 @@
 """Soak: the whole `cyborg up` system as fast as the machine allows, for a wall-clock time.
 
-    python3 benchmarks/soak.py [--minutes 60] [--markdown] [--detector]
+    python3 -m benchmarks.soak [--minutes 60] [--markdown] [--detector]
+    python3 -m benchmarks.soak --quick     # a smoke test: 6 s (--minutes 0.1)
 
 Starts what `cyborg up` starts — the simulated Pioneer LX on the bundled campus map, the tree
 runner with the bundled mission on modes on simulated time, the web monitor (on a free
@@ -25,6 +26,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from benchmarks import benchmark_options
 from cyborg.app.cli import build_parser
 from cyborg.app.launch import Launch
 from cyborg.app.memory import limit_malloc_arenas
@@ -97,12 +99,18 @@ def soak(minutes: float, detector: bool) -> dict[str, float]:
             launch.stop()
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--minutes", type=float, default=60.0, help="wall-clock minutes")
-    parser.add_argument("--detector", action="store_true", help="run the camera and detector")
-    parser.add_argument("--markdown", action="store_true", help="a table for docs/benchmarks.md")
-    args = parser.parse_args()
+def parser() -> argparse.ArgumentParser:
+    """The benchmark's options."""
+    options = benchmark_options(__doc__, quick="--minutes 0.1")
+    options.add_argument("--minutes", type=float, default=60.0, help="wall-clock minutes")
+    options.add_argument("--detector", action="store_true", help="run the camera and detector")
+    return options
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parser().parse_args(argv)
+    if args.quick:
+        args.minutes = 0.1
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     result = soak(args.minutes, args.detector)
     verdict = "meets" if result["growth"] <= 1.10 and result["collisions"] == 0 else "MISSES"
