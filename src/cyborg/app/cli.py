@@ -30,70 +30,105 @@ Exit codes: 0 success, 1 the input has errors, 2 wrong usage, 130 interrupted.
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
+import os
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
 
 from cyborg import __version__
-from cyborg.app import (
-    bt_commands,
-    bus_commands,
-    detect_commands,
-    foxglove_commands,
-    monitor_commands,
-    param_commands,
-    play_commands,
-    record_commands,
-    report_commands,
-    runner_commands,
-    sim_commands,
-    up,
-)
 from cyborg.app.errors import CommandError
-from cyborg.app.memory import limit_malloc_arenas
 
+COMMAND_MODULES = ("up", "monitor_commands", "foxglove_commands", "bt_commands",
+                   "runner_commands", "bus_commands", "record_commands", "play_commands",
+                   "report_commands", "param_commands", "sim_commands", "detect_commands")
+"""The modules of :mod:`cyborg.app` that add the commands, imported by :func:`build_parser`
+(not when this module is imported: they take seconds, and Ctrl-C may come meanwhile)."""
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``cyborg`` command's parser, with every subcommand."""
+    """The ``cyborg`` command's parser, with every subcommand (imports their modules)."""
+    modules = {name: importlib.import_module(f"cyborg.app.{name}") for name in COMMAND_MODULES}
     parser = argparse.ArgumentParser(
         prog="cyborg", description="Control stack for the NTNU Cyborg robot.")
     parser.add_argument("--version", action="version", version=f"cyborg {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="more log output (-vv for debug)")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    up.add_parser(commands)
-    monitor_commands.add_parser(commands)
-    foxglove_commands.add_parser(commands)
-    runner_commands.add_parsers(bt_commands.add_parser(commands))
-    bus_commands.add_parser(commands)
-    record_commands.add_parser(commands)
-    play_commands.add_parser(commands)
-    report_commands.add_parser(commands)
-    param_commands.add_parser(commands)
-    sim_commands.add_parser(commands)
-    detect_commands.add_parser(commands)
+    modules["up"].add_parser(commands)
+    modules["monitor_commands"].add_parser(commands)
+    modules["foxglove_commands"].add_parser(commands)
+    modules["runner_commands"].add_parsers(modules["bt_commands"].add_parser(commands))
+    for name in ("bus_commands", "record_commands", "play_commands", "report_commands",
+                 "param_commands", "sim_commands", "detect_commands"):
+        modules[name].add_parser(commands)
     return parser
+
+def _exit_interrupted(_signum: int, _frame: FrameType | None) -> None:
+    os._exit(130)
+
+
+@contextmanager
+def interrupt_ends_at_once() -> Iterator[None]:
+    """Within, Ctrl-C (SIGINT) ends the process at once with code 130, saying nothing.
+
+    For the command's start-up, which only imports and parses: nothing is there to stop yet.
+    A ``KeyboardInterrupt`` raised inside an import can surface as a traceback of the module
+    being imported, or (raised inside code an extension module runs) make the interpreter end
+    itself by SIGINT after ``main`` returned 130; exiting from the signal handler avoids both.
+    Outside the main thread (where signals cannot be handled) this does nothing.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous: Callable[[int, FrameType | None], object] | int | None = \
+        signal.signal(signal.SIGINT, _exit_interrupted)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _forget_interrupts_in_strings_run() -> None:
+    """Makes the interpreter exit with the code :func:`main` returns after a Ctrl-C.
+
+    CPython marks the interpreter when a ``KeyboardInterrupt`` leaves code run from a string
+    (``exec``/``eval`` of text, as ``namedtuple``, ``dataclasses`` and numba's compiler run it),
+    even where the exception is caught further up, and then ends the process by SIGINT at exit
+    instead of with the code returned. Running any string clears that mark.
+    """
+    exec("None")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Runs the ``cyborg`` command with ``argv`` and returns its exit code."""
-    limit_malloc_arenas()  # before any thread starts: keeps a long run's memory flat
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
-    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    """Runs the ``cyborg`` command with ``argv`` and returns its exit code.
+
+    Ctrl-C ends any command with code 130 and no traceback, during its start-up too (the
+    imports of :func:`build_parser` take seconds on a busy machine).
+    """
     try:
+        with interrupt_ends_at_once():
+            from cyborg.app.memory import limit_malloc_arenas
+            limit_malloc_arenas()  # before any thread starts: keeps a long run's memory flat
+            parser = build_parser()
+            args = parser.parse_args(argv)
+        level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+        logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
         result: int = args.handler(args)
     except CommandError as exc:
         print(f"cyborg: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        return 130
+        result = 130
     except BrokenPipeError:  # e.g. `cyborg bt dot FILE | head`
         sys.stderr.close()
         return 0
+    if result == 130:
+        _forget_interrupts_in_strings_run()
     return result
-
 
 if __name__ == "__main__":
     raise SystemExit(main())
