@@ -21,7 +21,9 @@ from cyborg.bt import (
     loads_tree,
 )
 from cyborg.nav.geometry import Pose2D
+from cyborg.robot import move_to
 from cyborg.robot.interface import DockState, MoveOutcome
+from cyborg.robot.rate_limited_log import RateLimitedLog
 from tests.builders import N, registry, tree_json
 from tests.robot.fake_robot import FakeRobot, robot_tree
 
@@ -387,3 +389,28 @@ def test_charge_and_undock_time_out_after_the_clock_went_back() -> None:
     run(undock, clock, 1.0)
     clock.jump_to(10.0)
     assert FAILURE in run(undock, clock, 5.5)
+
+
+def test_a_goal_blocked_again_and_again_is_reported_once_then_summarised(
+        caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch) -> None:
+    robot, clock = FakeRobot(), ManualClock()
+    # the failures come a simulated minute apart: well past the rate limit's interval
+    monkeypatch.setattr(move_to, "limited", RateLimitedLog(move_to.log, clock=clock.now))
+    tree = robot_tree(N("Repeater", N("MoveTo", location="home", retries=0), maxLoop=-1),
+                      robot, clock)
+    caplog.set_level(logging.INFO, "cyborg.robot")
+    blocked = "WAITING: waited 60 s for the objects in the way to move"
+    for _ in range(20):  # a patrol back at a goal whose way stays blocked, 20 times
+        tree.tick()
+        robot.moves[-1].finish(MoveOutcome.FAILED, blocked)
+        tree.tick()
+        clock.advance(60.0)
+    warnings = [record.getMessage() for record in caplog.records
+                if record.levelno >= logging.WARNING]
+    assert len(warnings) == 1 and blocked in warnings[0], warnings
+    tree.tick()
+    robot.moves[-1].finish(MoveOutcome.SUCCEEDED)
+    tree.tick()
+    said = [record.getMessage() for record in caplog.records if record.levelno == logging.INFO]
+    assert any("failed 19 more times in 1200 s alike, then reached the goal" in line
+               and blocked in line for line in said), said

@@ -29,6 +29,10 @@ the move_to_goal action (the robot turns to the goal's heading when the map give
 
 Failures and retries are logged rate-limited (:class:`~cyborg.robot.rate_limited_log.
 RateLimitedLog`): one line per kind per 10 s of wall time, with the count of those left out.
+A blocked goal is reported once: when the node fails again for the same reason, with no success
+between (a patrol that comes back to a goal whose way stays blocked), it only counts, and
+says once how often and for how long (tree clock) when that ends — the goal reached, another
+failure, or the node halted.
 
 All times are in the tree's clock: simulated seconds when the tree runs on ``/clock``; the
 node never sleeps, it compares deadlines in its ticks. Unlike the 2018 node, the result is reset
@@ -106,6 +110,7 @@ class MoveTo(Action):
         # the back-off outlives an activation: the robot is as unreachable as a tick ago
         self._delay = 0.0
         self._next_try = -math.inf
+        self._repeated: tuple[str, int, float] | None = None  # reason, repeats, first at
 
     # ------------------------------------------------------------------ lifecycle
     @override
@@ -156,13 +161,33 @@ class MoveTo(Action):
         if self.move is not None:
             self.move.cancel()  # harmless when the move is over; stops the robot otherwise
         if status is FAILURE and self.reason:
+            if self._repeated is not None and self._repeated[0] == self.reason:
+                reason, repeats, since = self._repeated
+                self._repeated = (reason, repeats + 1, since)
+                log.debug("MoveTo %s (%s) failed again: %s", self.location, self.uid, reason)
+                return
+            self._summarise("failed otherwise")
+            self._repeated = (self.reason, 0, self.now)
             limited.warning(self._failure, "MoveTo %s (%s) failed: %s", self.location, self.uid,
                             self.reason)
+        elif status is SUCCESS:
+            self._summarise("reached the goal")
 
     @override
     def on_halt(self) -> None:
         if self.move is not None:
             self.move.cancel()
+        self._summarise("was halted")
+
+    def _summarise(self, ending: str) -> None:
+        """Say how often the failure reported once came again, now that it ended so."""
+        if self._repeated is None:
+            return
+        reason, repeats, since = self._repeated
+        self._repeated = None
+        if repeats:
+            log.info("MoveTo %s (%s) failed %d more times in %.0f s alike, then %s: %s",
+                     self.location, self.uid, repeats, self.now - since, ending, reason)
 
     def _after_clock_went_back(self) -> None:
         """Counts again from now if the clock went back (a restarted simulation, a /clock jump).
