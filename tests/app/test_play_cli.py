@@ -17,6 +17,7 @@ import pytest
 from cyborg.app.cli import main
 from cyborg.app.play_commands import PlayLine, notes
 from cyborg.bus import BusConfig, Context, MessageTypes, Node
+from cyborg.bus.config import CONNECT_ENV
 from cyborg.bus.wire import EntityKind
 from cyborg.record.playback_source import open_recording
 from tests.bus.bus_peer import wait_for
@@ -54,6 +55,29 @@ def test_cyborg_play_publishes_the_recording_to_another_process(tmp_path: Path) 
         assert len(listener.data("/map")) == 1
     assert f"cyborg play: {path}" in result.stderr
     assert f"played {CHATTER + 1} messages on 2 topics" in result.stderr
+
+
+@pytest.mark.heavy
+def test_cyborg_play_with_no_router_reachable_hosts_one_as_cyborg_up_does(
+        tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    record_run(path)
+    address = f"tcp/127.0.0.1:{free_port()}"
+    environment = {key: value for key, value in os.environ.items() if key != CONNECT_ENV}
+    play = subprocess.Popen(
+        [sys.executable, "-m", "cyborg", "play", str(path), "--listen", address, "--wait", "3"],
+        stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True, env=environment)
+    assert play.stderr is not None
+    first = play.stderr.readline()
+    assert first.strip() == f"cyborg play: bus router at {address}", first
+    with Context(BusConfig.from_environment([address])) as bus:  # a monitor, as it joins
+        listener = Listener(Node("listener", context=bus))
+        listener.listen("/map", STRING, latched=True)
+        assert wait_for(lambda: len(listener.data("/map")) == 1, 20)
+    _, err = play.communicate(timeout=120)
+    assert play.returncode == 0, first + err
+    assert "no router reachable" not in err
+    assert f"played {CHATTER + 1} messages on 2 topics" in err
 
 
 @pytest.mark.parametrize("name", sorted(REFUSED))

@@ -46,20 +46,24 @@ def add_join_command(group: Any, name: str, text: str,
     return parser
 
 
-def bus_context(connect: list[str], listen: str) -> tuple[Context, str]:
+def bus_context(connect: list[str], listen: str,
+                types: MessageTypes | None = None) -> tuple[Context, str]:
     """A context joining the given router, or being the router at ``listen``, and where it is.
 
-    If a router already runs at ``listen``, the context joins it.
+    If a router already runs at ``listen``, the context joins it. ``types``: the message types
+    the command uses, as for :func:`open_context`.
     """
     try:
         if connect:
-            return Context(BusConfig.from_environment(connect)), f"connected to {connect[0]}"
+            return (Context(BusConfig.from_environment(connect), types=types),
+                    f"connected to {connect[0]}")
         try:
-            return Context(BusConfig.router([listen])), f"router at {listen}"
+            return Context(BusConfig.router([listen]), types=types), f"router at {listen}"
         except BusConfigError:
             raise
         except Exception:  # the address is taken: a router already runs there
-            return Context(BusConfig.from_environment([listen])), f"connected to {listen}"
+            return (Context(BusConfig.from_environment([listen]), types=types),
+                    f"connected to {listen}")
     except BusConfigError as exc:
         raise CommandError(str(exc)) from exc
 

@@ -6,7 +6,9 @@
     cyborg play run.mcap --exclude '/cyborg/camera/*'
     cyborg play robot.bag                         a ROS 1 bag; a ROS 2 bag folder plays too
 
-It joins the bus's router like the other bus commands (``--connect``, ``--wait``); Ctrl-C and
+With ``--connect`` (or ``$CYBORG_CONNECT``) it joins that router; without, it hosts the bus's
+router at ``--listen`` (this machine's default address), as ``cyborg up`` does, or joins the one
+already there, so that it plays as pasted while a monitor joins it. Ctrl-C and
 SIGTERM stop it, saying how far it played. On a terminal the space key pauses and resumes and
 ``s`` plays one message (pausing first); the player's services do the same from anywhere
 (``/player/pause``, ``/player/step``, ``/player/seek``: :mod:`cyborg.interfaces.player`). A
@@ -23,12 +25,12 @@ import time
 from pathlib import Path
 from typing import Any, TextIO
 
-from cyborg.app.bus_options import open_context
+from cyborg.app.bus_options import bus_context, open_context
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
 from cyborg.app.progress import LiveLine, duration
 from cyborg.bus import Context, MessageTypes, Node
-from cyborg.bus.config import DEFAULT_ROUTER
+from cyborg.bus.config import CONNECT_ENV, DEFAULT_ROUTER, BusConfig
 from cyborg.interfaces import player as contract
 from cyborg.record.playback_source import Recording, RecordingError, open_recording
 from cyborg.record.player import Player, topic_filter
@@ -61,7 +63,12 @@ def add_parser(commands: Any) -> None:
     play.add_argument("--namespace", default="/", metavar="NS",
                       help="namespace of the player's node and services (default /)")
     play.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
-                      help=f"router to join (default $CYBORG_CONNECT or {DEFAULT_ROUTER})")
+                      help=f"router to join (default ${CONNECT_ENV}; without either, be the "
+                           "router at --listen or join the one there)")
+    play.add_argument("--listen", default=DEFAULT_ROUTER, metavar="ENDPOINT",
+                      help=f"be the bus's router there unless --connect or ${CONNECT_ENV} "
+                           f"names one; if a router already runs there, join it (default "
+                           f"{DEFAULT_ROUTER})")
     play.add_argument("--wait", type=float, default=0.5, metavar="S",
                       help="seconds to let subscribers find the player's topics before the "
                            "first message (default 0.5)")
@@ -81,13 +88,30 @@ def play_command(args: argparse.Namespace) -> int:
         raise CommandError(str(exc)) from None
     try:
         _check(args, recording)
-        context = open_context(args, types)
+        context = _context(args, types)
         try:
             return _play(args, context, recording, sys.stderr)
         finally:
             context.close()
     finally:
         recording.close()
+
+
+def _context(args: argparse.Namespace, types: MessageTypes) -> Context:
+    """The bus: the router ``--connect`` or the environment names, else one hosted here.
+
+    Hosted at ``--listen`` as ``cyborg up`` hosts it (or joined, when a router already runs
+    there), saying which on stderr.
+    """
+    if args.connect or BusConfig.from_environment().connect != (DEFAULT_ROUTER,):
+        return open_context(args, types)
+    context, where = bus_context([], args.listen, types)
+    print(f"cyborg play: bus {where}", file=sys.stderr, flush=True)
+    if args.listen != DEFAULT_ROUTER and where.startswith("router"):
+        print(f"  other shells  export {CONNECT_ENV}={args.listen}  (or --connect "
+              f"{args.listen}): commands join another bus by default", file=sys.stderr,
+              flush=True)
+    return context
 
 
 def _check(args: argparse.Namespace, recording: Recording) -> None:
