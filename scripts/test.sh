@@ -17,7 +17,8 @@ if [ ${#need_debian[@]} -gt 0 ]; then
         "${need_debian[@]}"
 fi
 
-python3 -m pip install -q --disable-pip-version-check -e ".[dev]"
+# the exact versions that are tested (constraints.txt; pyproject.toml keeps the allowed ranges)
+python3 -m pip install -q --disable-pip-version-check -c constraints.txt -e ".[dev]"
 python3 -m ruff check src tests benchmarks
 python3 -m mypy
 python3 -m pytest "$@"

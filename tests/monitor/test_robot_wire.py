@@ -85,6 +85,8 @@ def test_a_valid_reading_never_reads_as_no_return() -> None:
     ({"increment": math.nan, "angle_max": LAST}, "angle_increment is nan"),
     ({"increment": math.inf, "angle_max": LAST}, "angle_increment is inf"),
     ({"increment": 0.0, "angle_max": LAST}, "angle_increment is 0"),
+    ({"beams": 1, "angle_min": -2.356, "angle_max": -2.356, "increment": 1e30},
+     "angle_increment is 1e+30 rad, more than a full turn"),
     ({"range_max": math.inf}, "range_max is inf"),
     ({"range_max": -1.0}, "range_max is -1 m"),
     ({"angle_min": math.nan}, "angle_min is nan"),
@@ -190,6 +192,7 @@ def test_any_scan_never_raises(ranges: list[float], angle_min: float, angle_max:
     if payload is not None:
         assert len(payload["r"]) == len(ranges)
         assert all(-1 <= value <= WORLD_LIMIT * 1000 for value in payload["r"])
+        assert abs(payload["a0"]) <= math.pi and 0 < abs(payload["da"]) <= math.tau
 
 
 @settings(max_examples=100, deadline=None)

@@ -87,7 +87,10 @@ def test_outlines_follow_the_box_edges_and_leave_the_inside_alone() -> None:
     image = photo()
     annotated = annotate(image, [person((100.0, 200.0, 500.0, 900.0))])
     green = np.array(BOX_COLOUR, dtype=np.uint8)
-    for x, y in ((300, 900), (100, 600), (500, 600), (490, 200), (499, 899)):
+    label_x, _y, label_w, _h = Overlay.of(WIDTH, HEIGHT, [person((0, 0, 1, 1))]).labels[0]
+    right_of_label = label_x + label_w + 100  # on the top edge, past the label over it
+    assert right_of_label < 500
+    for x, y in ((300, 900), (100, 600), (500, 600), (right_of_label, 200), (499, 899)):
         assert np.array_equal(annotated[y, x], green), (x, y)
     for x, y in ((300, 600), (50, 600), (600, 600), (300, 950), (103, 203)):
         assert np.array_equal(annotated[y, x], image[y, x]), (x, y)
@@ -107,10 +110,41 @@ def test_the_label_sits_above_the_box_with_its_caption() -> None:
     assert white > 0.6 and dark > 0.03  # a white patch with black text on it
 
 
+def _kerning(text: str, font: GlyphFont, scale: float) -> int:
+    """How far OpenCV's width of ``text`` may stray from its characters' advances: the pixels
+    by which it moves each pair of neighbours from where their advances put them (OpenCV 5.1
+    kerns some pairs), plus one for rounding fractional advances (OpenCV 4)."""
+    def alone(pair: str) -> float:
+        return 1 + float(sum(font.advances[ord(character) - FIRST] for character in pair))
+    return 1 + round(sum(abs(cv2.getTextSize(text[i:i + 2], FONT, scale, 1)[0][0]
+                             - alone(text[i:i + 2])) for i in range(len(text) - 1)))
+
+
+def _characters_side_by_side(text: str, font: GlyphFont, size: tuple[int, int],
+                             origin: tuple[int, int]) -> np.ndarray:
+    """A grey label with each character of ``text`` drawn by ``putText`` on its own, moved on
+    from the last by the font's advance (the darker pixel where two characters meet)."""
+    width, height = size
+    margin = font.cells.shape[1]  # room for any character: OpenCV shades an edge it clips
+    label = np.full((height + 2 * margin, width + 2 * margin), LABEL_GREY, dtype=np.uint8)
+    pen = float(origin[0] + margin)
+    for character in text:
+        alone = np.full(label.shape, 255, dtype=np.uint8)
+        cv2.putText(alone, character, (round(pen), origin[1] + margin), FONT, font.scale, 0, 1,
+                    cv2.LINE_AA)
+        np.minimum(label, alone, out=label)
+        pen += font.advances[ord(character) - FIRST]
+    return label[margin:margin + height, margin:margin + width]
+
+
 def test_labels_are_sized_and_drawn_as_opencv_sizes_and_draws_text() -> None:
-    """Each label is ``getTextSize``'s text size plus a 1-pixel margin, with the caption where
-    ``putText`` puts it: pixel for pixel where the font advances by whole pixels (OpenCV 5),
-    within half a pixel per character where it does not."""
+    """Each label is its caption's size plus a 1-pixel margin, the caption drawn character by
+    character where the font's advances put them, pixel for pixel what ``putText`` draws of
+    each character. Where OpenCV lays the caption out as its characters side by side (no
+    kerned pairs), label and caption are ``getTextSize``'s and ``putText``'s own: pixel for
+    pixel where the font advances by whole pixels (OpenCV 5.0), within half a pixel per
+    character where it does not (OpenCV 4). OpenCV 5.1 kerns some pairs, moving its text by
+    a pixel or a few: the label's width then differs from ``getTextSize``'s by no more."""
     image = np.full((HEIGHT, WIDTH, 3), 90, dtype=np.uint8)
     detections = [person((100.0, 200.0, 500.0, 900.0), distance=2.371),
                   Detection("motorcycle", 3, 0.5049, (900.0, 300.0, 1500.0, 700.0), math.nan),
@@ -118,20 +152,28 @@ def test_labels_are_sized_and_drawn_as_opencv_sizes_and_draws_text() -> None:
     annotated = annotate(image, detections)
     overlay = Overlay.of(WIDTH, HEIGHT, detections)
     scale, _thickness = line_sizes(WIDTH, HEIGHT)
-    whole_pixels = np.array_equal(overlay.font.advances, np.round(overlay.font.advances))
+    font = overlay.font
+    whole_pixels = np.array_equal(font.advances, np.round(font.advances))
     for (x0, y0, w, h), detection in zip(overlay.labels.tolist(), detections, strict=True):
         text = caption(detection).encode("ascii", "replace").decode()  # as the label shows it
         (text_w, text_h), baseline = cv2.getTextSize(text, FONT, scale, 1)
-        assert (w, h) == (text_w + 3, text_h + baseline + 3), text
-        expected = np.full((h, w), LABEL_GREY, dtype=np.uint8)
-        cv2.putText(expected, text, (1, text_h + 1), FONT, scale, 0, 1, cv2.LINE_AA)
         label = annotated[y0:y0 + h, x0:x0 + w]
         assert np.array_equal(label[..., 0], label[..., 2])  # grey
-        difference = np.abs(label[..., 0].astype(int) - expected)
-        if whole_pixels:
-            assert not difference.any(), text
-        else:
-            assert difference.mean() < 8, text
+        advances = 1 + sum(font.advances[ord(character) - FIRST] for character in text)
+        assert (w, h) == (round(advances) + 3, text_h + baseline + 3), text
+        kerning = _kerning(text, font, scale)
+        assert abs(w - (text_w + 3)) <= kerning, text
+        side_by_side = _characters_side_by_side(text, font, (w, h), (1, text_h + 1))
+        assert np.array_equal(label[..., 0], side_by_side), text
+        if text_w == round(advances):  # OpenCV too draws the characters side by side
+            assert w == text_w + 3, text
+            expected = np.full((h, w), LABEL_GREY, dtype=np.uint8)
+            cv2.putText(expected, text, (1, text_h + 1), FONT, scale, 0, 1, cv2.LINE_AA)
+            difference = np.abs(label[..., 0].astype(int) - expected)
+            if whole_pixels:
+                assert not difference.any(), text
+            else:
+                assert difference.mean() < 8, text
 
 
 def test_captions_outside_printable_ascii_are_drawn_with_question_marks() -> None:

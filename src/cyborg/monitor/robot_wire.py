@@ -114,8 +114,9 @@ def scan_wire(message: LaserScan) -> tuple[dict[str, Any] | None, Warnings]:
     """The scan as ``{"a0", "da", "mx", "r"}`` (see the module docstring), or None.
 
     Refused with a warning: a scan whose angles or ``range_max`` are not finite, whose
-    increment is 0, with more than :data:`SCAN_BEAM_LIMIT` beams, or whose number of ranges is
-    not ``round((angle_max - angle_min) / angle_increment) + 1`` (±1).
+    increment is 0 or more than a full turn, with more than :data:`SCAN_BEAM_LIMIT` beams, or
+    whose number of ranges is not ``round((angle_max - angle_min) / angle_increment) + 1``
+    (±1).
     """
     angle_min, angle_max = float(message.angle_min), float(message.angle_max)
     increment = float(message.angle_increment)
@@ -128,6 +129,9 @@ def scan_wire(message: LaserScan) -> tuple[dict[str, Any] | None, Warnings]:
             return None, [f"scan: {name} is {_number(value)}; scan not drawn"]
     if increment == 0.0:
         return None, ["scan: angle_increment is 0; scan not drawn"]
+    if abs(increment) > math.tau:
+        return None, [f"scan: angle_increment is {_number(increment)} rad, more than a full "
+                      "turn; scan not drawn"]
     if not 0.0 < range_max <= WORLD_LIMIT:
         return None, [f"scan: range_max is {_number(range_max)} m; scan not drawn"]
     if beams > SCAN_BEAM_LIMIT:
@@ -148,7 +152,7 @@ def scan_wire(message: LaserScan) -> tuple[dict[str, Any] | None, Warnings]:
         millimetres = np.zeros(beams, np.int64)
         millimetres[seen] = np.maximum(np.rint(values[seen] * _MM), 1)
         millimetres[invalid] = -1
-    return {"a0": round(_angle(angle_min), 6), "da": round(increment, 9),
+    return {"a0": round(_angle(angle_min), 6), "da": float(f"{increment:.9g}"),
             "mx": round(range_max * _MM), "r": millimetres.tolist()}, []
 
 

@@ -7,11 +7,13 @@ labels). A caption is its characters side by side, each moved on from the last b
 advance. :class:`GlyphFont` renders each printable ASCII character once per scale,
 anti-aliased, grey on white, in a cell of its own; the annotated image's compiled loop
 (:mod:`cyborg.vision.annotate`) then composes captions from these cells, keeping the darker
-pixel where two characters' edges meet. OpenCV 5's font advances by whole pixels, and its
-characters' edges do not meet: the composed caption is pixel for pixel what ``putText`` draws.
-OpenCV 4's Hershey font advances by fractions of a pixel, which ``putText`` keeps and the
-composition rounds: characters may then sit up to half a pixel from where ``putText`` puts
-them.
+pixel where two characters' edges meet. Each character is pixel for pixel what ``putText``
+draws of it. OpenCV 5.0's font advances by whole pixels, and its characters' edges do not meet:
+the composed caption is pixel for pixel what ``putText`` draws of the whole text. OpenCV 4's
+Hershey font advances by fractions of a pixel, which ``putText`` keeps and the composition
+rounds: characters may then sit up to half a pixel from where ``putText`` puts them. OpenCV 5.1
+kerns some pairs of characters (``rc``, ``Te``) a pixel or a few closer or further apart; the
+composition does not, so such a caption is that much wider or narrower than ``putText``'s.
 
     font = GlyphFont.at(1.08)             # cells, ink boxes, advances, descents
     codes, ends = encode(["person: 0.93 (2.37 m)", "car: 0.71 (? m)"])   # for the loop
