@@ -86,6 +86,22 @@ def wait_until(predicate: Callable[[], object], timeout: float = 30.0,
         time.sleep(0.01)
 
 
+def wait_in_simulated_time(predicate: Callable[[], object], clock: Callable[[], float],
+                           within: float, what: str = "condition",
+                           wall_limit: float = 900.0) -> None:
+    """Waits until ``predicate`` holds, failing once the simulated ``clock`` passes ``within``
+    seconds without it: a busy machine slows the simulation, not the test's verdict.
+    ``wall_limit`` (wall seconds) only ends a simulation that has stopped advancing."""
+    deadline = time.monotonic() + wall_limit
+    while not predicate():
+        if clock() > within:
+            raise AssertionError(f"{what} did not happen within {within:g} simulated s")
+        if time.monotonic() > deadline:
+            raise AssertionError(f"the simulation reached {clock():g} of {within:g} simulated s "
+                                 f"in {wall_limit:g} wall s, waiting for {what}")
+        time.sleep(0.01)
+
+
 @contextmanager
 def running_system(map_path: Path, tree_path: Path, *, speed: float = 20.0,
                    battery: float = 100.0, start: str = "", rate: float = 10.0,

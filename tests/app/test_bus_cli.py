@@ -18,7 +18,12 @@ pytestmark = pytest.mark.heavy
 PEER = Path(__file__).resolve().parents[1] / "bus" / "bus_peer.py"
 
 
-def cyborg(*args: str, timeout: float = 20) -> subprocess.CompletedProcess[str]:
+COMMAND_LIMIT = 90.0
+"""Wall seconds a command may take: each starts a Python process that imports the bus and the
+command's modules, seconds on a busy 2-core machine; a hung command still fails."""
+
+
+def cyborg(*args: str, timeout: float = COMMAND_LIMIT) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "cyborg", *args], capture_output=True,
                           text=True, timeout=timeout)
 
@@ -133,7 +138,7 @@ def test_echo_pub_and_hz(endpoint: str) -> None:
     published = on(endpoint, "topic", "pub", "/note", "std_msgs/msg/String", "{data: hi there}",
                    "--times", "3", "--rate", "5")
     assert published.returncode == 0, published.stderr
-    out, _ = listener.communicate(timeout=20)
+    out, _ = listener.communicate(timeout=COMMAND_LIMIT)
     assert listener.returncode == 0 and "data: hi there" in out
     hz = on(endpoint, "topic", "hz", "/robot/chatter", "--duration", "2")
     rates = [float(line.split()[-1]) for line in hz.stdout.splitlines()
@@ -201,7 +206,7 @@ def test_echo_waits_for_a_publisher_to_learn_the_type(endpoint: str) -> None:
     published = on(endpoint, "topic", "pub", "/late/battery", "sensor_msgs/msg/BatteryState",
                    "{percentage: 0.5, power_supply_status: 2}", "--times", "30", "--rate", "10")
     assert published.returncode == 0, published.stderr
-    out, err = echo.communicate(timeout=20)
+    out, err = echo.communicate(timeout=COMMAND_LIMIT)
     assert echo.returncode == 0, err
     fields = [line.split(":")[0] for line in out.splitlines() if not line.startswith(" ")]
     battery = MessageTypes().store.fielddefs["sensor_msgs/msg/BatteryState"][1]
@@ -217,7 +222,7 @@ def test_a_late_latched_publisher_reaches_a_waiting_echo(fresh_endpoint: str,
                       "--connect", fresh_endpoint, "--wait", "0.5")
     assert "waiting for a publisher" in first_line(echo.stderr, 20), rest(echo)
     peers("latched", fresh_endpoint)
-    out, err = echo.communicate(timeout=20)
+    out, err = echo.communicate(timeout=COMMAND_LIMIT)
     assert echo.returncode == 0, err
     # "first" may arrive live (the peer publishes it as it starts), "latest" from history
     assert out in ("data: first\n---\n", "data: latest\n---\n")
@@ -229,7 +234,7 @@ def test_an_echo_given_the_type_hears_a_late_latched_publisher(fresh_endpoint: s
                       "--timeout", "20", "--connect", fresh_endpoint, "--wait", "0.5")
     threading.Event().wait(3.0)  # it has subscribed by now, before any publisher
     peers("latched", fresh_endpoint)
-    out, err = echo.communicate(timeout=20)
+    out, err = echo.communicate(timeout=COMMAND_LIMIT)
     assert echo.returncode == 0, err
     assert out in ("data: first\n---\n", "data: latest\n---\n")
 
@@ -243,7 +248,7 @@ def test_service_call_waits_for_its_server(fresh_endpoint: str, peers: Any) -> N
             call.stderr, 20), rest(call)
     peers("server", fresh_endpoint)
     for call in calls:
-        out, err = call.communicate(timeout=20)
+        out, err = call.communicate(timeout=COMMAND_LIMIT)
         assert call.returncode == 0, err
         assert "sum: 42" in out
 

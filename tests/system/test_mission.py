@@ -35,7 +35,7 @@ from cyborg.modes import ModeMachine, read_mode_file
 from cyborg.runner.component import RunningTree
 from cyborg.sim.component import RunningSimulator
 from cyborg.sim.simulator import Simulator
-from tests.running_system import running_system, wait_until
+from tests.running_system import running_system, wait_in_simulated_time
 
 HOURS = 13.0
 """At most this many simulated hours; the test ends once the robot patrols again after charging."""
@@ -187,7 +187,6 @@ def test_cyborg_up_on_its_defaults_goes_to_charge_and_back_to_patrol_within_thre
     seen: list[str] = []
     with Context(BusConfig.isolated()) as context:
         launch = Launch(up_description(args), context)
-        started = time.monotonic()
         launch.start()
         try:
             sim = next(item for item in launch.running
@@ -198,9 +197,9 @@ def test_cyborg_up_on_its_defaults_goes_to_charge_and_back_to_patrol_within_thre
             labels = {node.uid: node.label for tree in machine.trees.values() for node in tree}
             runner.runner.runner.add_listener(lambda snapshot: seen.extend(
                 labels[uid] for uid in snapshot.active[-1:]))
-            wait_until(lambda: machine.transition_count >= 2,
-                       timeout=2 * CYCLE_WITHIN / FASTER - (time.monotonic() - started),
-                       what="low_battery and back to normal")
+            wait_in_simulated_time(lambda: machine.transition_count >= 2,
+                                   lambda: sim.time, CYCLE_WITHIN * DEFAULT_SPEED,
+                                   what="low_battery and back to normal")
             charged = sim.battery.charge_percent
         finally:
             launch.stop()

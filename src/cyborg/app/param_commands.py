@@ -29,12 +29,17 @@ def add_parser(commands: Any) -> None:
     set_.add_argument("value")
 
 
+NODE_WAIT = 5.0
+"""Seconds a command waits for a node's parameter services that are not on the bus yet (a node
+just started, or a busy machine), as ``ros2 param`` waits for them."""
+
+
 def _client(args: argparse.Namespace, run: Callable[[ParameterClient], None]) -> int:
     with open_context(args) as context:
         target = args.node if args.node.startswith("/") else "/" + args.node
-        if target not in context.graph.nodes():
-            raise CommandError(f"no node {target!r} (see `cyborg node list`)")
         client = ParameterClient(Node("cyborg_param", context=context), target)
+        if target not in context.graph.nodes() and not client.wait_for_service(NODE_WAIT):
+            raise CommandError(f"no node {target!r} (see `cyborg node list`)")
         try:
             run(client)
         except (ParameterError, ServiceError) as exc:
