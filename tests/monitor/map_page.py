@@ -29,6 +29,7 @@ from cyborg.monitor.map_store import map_blob
 from cyborg.monitor.page_files import page_files
 from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.map_message import map_geometry
+from tests.monitor.browser import WHOLE_TREE
 
 ROBOT = "/robot1"
 START = (-0.5, 0.8, 1.0)
@@ -187,8 +188,10 @@ def wait_for(condition: Callable[[], object], timeout: float, what: str) -> None
 def open_map_page(browser: Browser, url: str, errors: list[str], width: int = 1000,
                   height: int = 600) -> Page:
     """A fresh page (and browser context) on ``url`` that records console errors into
-    ``errors``; waits until the map is drawn."""
+    ``errors``; waits until the map is drawn. The tree view beside it shows the whole tree
+    (browser.py's :data:`WHOLE_TREE`)."""
     page = browser.new_page(viewport={"width": width, "height": height})
+    page.add_init_script(WHOLE_TREE)
     page.on("console", lambda message: errors.append(message.text)
             if message.type == "error" else None)
     page.on("pageerror", lambda error: errors.append(str(error)))

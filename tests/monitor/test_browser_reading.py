@@ -107,6 +107,11 @@ def test_the_tree_is_drawn_readable_on_a_desktop_and_on_a_phone(browser: Browser
     }""")
     assert inside == drawn
     assert page.evaluate("document.getElementById('viewport').getCTM().a") < 1
+    width = page.evaluate("document.getElementById('tree').clientWidth")
+    page.set_viewport_size({"width": 1300, "height": 900})  # a window resized keeps the fit
+    page.wait_for_function(f"document.getElementById('tree').clientWidth !== {width}")
+    page.evaluate("new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done)))")
+    assert page.evaluate("document.getElementById('viewport').getCTM().a") < 1
     page.click("#readable")
     _assert_readable(page, 3)
     # "Fold" off: every node drawn, at the readable size all the same

@@ -463,7 +463,7 @@ $("depth").addEventListener("change", (event) => {
   page.depth = Math.max(-1, parseInt(event.target.value, 10) || 0);
   relayout();
 });
-$("fit").addEventListener("click", () => view.fit());
+$("fit").addEventListener("click", () => view.fit(true));
 $("readable").addEventListener("click", () => { setAutofit(false); view.place(runningEnd()); });
 $("autofit").addEventListener("change", (event) => {
   setAutofit(event.target.checked);

@@ -312,7 +312,8 @@ export class TreeView {
     this.size = { width, height };
   }
 
-  fit() {
+  // Fit the whole drawing in the view (`byUser`: asked for, so kept as a pan of the user's).
+  fit(byUser = false) {
     // The size comes from the ResizeObserver, or from draw(): asking the DOM here would force a
     // layout of everything just drawn.
     if (!this.size.width) this.measure();
@@ -325,6 +326,7 @@ export class TreeView {
       x: (box.width - width * k) / 2 - this.bounds.x0 * k,
       y: Math.max(0, (box.height - height * k) / 2) - this.bounds.y0 * k,
     };
+    if (byUser) this.userMovedAt = performance.now();
     this.apply();
   }
 
