@@ -40,16 +40,27 @@ def live() -> Iterator[tuple[System, Monitor]]:
             monitor.stop()
 
 
+ENDED: list[dict[str, Any]] = []
+"""``robot_result`` messages that came while a test waited for an answer (a goal a stop ended
+may end before the stop is answered: the stop waits for the tree's stop too)."""
+
+
 def _answer(socket: Any, command: dict[str, Any]) -> dict[str, Any]:
     socket.send_json(command)
     while True:
-        message = receive_until(socket, "result")
-        if message["req"] == command.get("req"):
+        message = next_json(socket)
+        if message["t"] == "robot_result":
+            ENDED.append(message)
+        elif message["t"] == "result" and message["req"] == command.get("req"):
             return message
 
 
 def _ended(socket: Any, goal: str, timeout: float = 90.0) -> dict[str, Any]:
     """The ``robot_result`` of ``goal``, waiting up to ``timeout`` s for each message."""
+    for message in list(ENDED):
+        if message["goal"] == goal:
+            ENDED.remove(message)
+            return message
     for _ in range(1000):
         message = next_json(socket, timeout)
         if message["t"] == "robot_result" and message["goal"] == goal:
@@ -105,8 +116,10 @@ def test_set_pose_stop_and_driving_by_hand(live: tuple[System, Monitor]) -> None
                                       system.sim.pose.y - OFFICE[1]) > 0.3, 60, "the robot to move")
         stopped = _answer(socket, {"t": "stop", "ns": ROBOT, "req": 4})
         assert stopped["ok"] is True and stopped["paused"] is None
+        assert stopped["stopped"] == ["/cyborg/bt"] and system.runner.stopped, stopped
         ended = _ended(socket, "(40.00, 6.00)")
         assert ended["outcome"] == "failed" and "stop" in ended["message"], ended
+        wait_until(lambda: system.sim.base.speed == 0, 20, "the robot to brake")
         start = system.sim.pose
         sent_at = [0.0]
 

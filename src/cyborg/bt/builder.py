@@ -331,10 +331,9 @@ class _Builder:
             return stub_class(spec, same_kind, self.stub_missing)()
         properties = attaching.without_services(node_type.cls, spec.properties)
         binding = bind(node_type.signature, properties)
-        for field, message in binding.warnings:
-            self.report(message, tree, spec, field, Severity.WARNING)
-        for field, message in binding.notes:
-            self.report(message, tree, spec, field, Severity.NOTE)
+        for level, said in ((Severity.WARNING, binding.warnings), (Severity.NOTE, binding.notes)):
+            for field, message in said:
+                self.report(message, tree, spec, field, level)
         for field, message in binding.errors:
             self.report(message, tree, spec, field)
         if binding.errors:

@@ -53,7 +53,7 @@ from cyborg.bt.js_values import (
     strict_equal,
     truthy,
 )
-from cyborg.bt.node import NodeError
+from cyborg.bt.status import NodeError
 
 MAX_LENGTH = 1000
 """Longest expression text accepted, in characters."""
@@ -82,8 +82,7 @@ _POSTFIX_POWER = 15
 class ExpressionError(NodeError, ValueError):
     """An expression that cannot be parsed, or whose operands do not fit its operators.
 
-    The message quotes the expression and, where it helps, the part of it at fault. Raised
-    while a node ticks, it is that node's :class:`~cyborg.bt.node.NodeError`: one logged line.
+    The message quotes the expression and, where it helps, the part of it at fault.
     """
 
 
