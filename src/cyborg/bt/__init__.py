@@ -44,7 +44,7 @@ from cyborg.bt.editor_format import ProjectSpec, parse_project, read_project, re
 from cyborg.bt.hooks import Hook, HookError, HookMode, TreeHooks
 from cyborg.bt.leaves import Error, Failer, Runner, Succeeder, Wait
 from cyborg.bt.loader import check_file, load_tree, loads_tree
-from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node, NodeError
+from cyborg.bt.node import Action, Category, Composite, Condition, Decorator, Node
 from cyborg.bt.problems import Problem, Severity, TreeLoadError
 from cyborg.bt.registry import NodeRegistry, NodeType, default_registry, register
 from cyborg.bt.service_registry import (
@@ -56,7 +56,7 @@ from cyborg.bt.service_registry import (
 from cyborg.bt.service_runner import ServiceRunner, ServiceState
 from cyborg.bt.services import Service, ServiceBoard, ServiceTiming
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
-from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status
 from cyborg.bt.tick_loop import TickLoop
 from cyborg.bt.tree import Tree
 

@@ -388,10 +388,7 @@ class V1Reader:
 
     def keys(self, raw: dict[str, Any], field: str, tree: TreeSpec, spec: NodeSpec,
              source: str) -> list[str]:
-        """The variable names in ``raw[field]``; none and a problem if not an array of strings.
-
-        A ``null`` entry is an unbound port (``""``), as the editor reads it.
-        """
+        """The variable names in ``raw[field]`` (``null``: unbound, ``""``); a problem if not."""
         value = raw.get(field, [])
         if not isinstance(value, list) or not all(k is None or isinstance(k, str)
                                                   for k in value):

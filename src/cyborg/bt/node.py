@@ -35,7 +35,7 @@ from enum import StrEnum
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from cyborg.bt.extension import ExtensionPoints, TickRecord
-from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
@@ -47,16 +47,6 @@ PreTick = Callable[["Node"], Status | None]
 :mod:`cyborg.bt.extension`)."""
 PostTick = Callable[["Node", Status], Status | None]
 """A ``node.post_tick`` callback: a status other than the one given replaces it."""
-
-
-class NodeError(Exception):
-    """A node's own account of why it returns ERROR: a bad input, an unset variable.
-
-    Raise it from ``tick`` (or ``on_start``, ``on_end``, ``on_halt``) with a message that says
-    what is wrong in the tree's terms; the node returns ERROR and the message is logged in one
-    line, naming the node, with no traceback. Any other exception is a fault in the node's code:
-    it is logged with its traceback, which is what finding that fault takes.
-    """
 
 
 class Category(StrEnum):
@@ -302,10 +292,8 @@ class Node(ExtensionPoints):
             log.error("node %s (%s, %s) returns ERROR in %s: %s; the tree keeps ticking",
                       self.uid, self.label, self.name, during, exc)
         else:
-            log.error(
-                "node %s (%s, %s) raised in %s; it returns ERROR and the tree keeps ticking",
-                self.uid, self.label, self.name, during, exc_info=exc,
-            )
+            log.error("node %s (%s, %s) raised in %s; it returns ERROR and the tree keeps "
+                      "ticking", self.uid, self.label, self.name, during, exc_info=exc)
         return ERROR
 
     def bind(self, *, uid: str, node_id: str, name: str, title: str, label: str,

@@ -55,6 +55,8 @@ class Unbounded:
 
 LoopCount = Annotated[int, Unbounded(-1)]
 """A number of loops, ``-1`` for forever; infinity in a file is read as ``-1``."""
+OptionalLoopCount = Annotated[int | None, Unbounded(None)]
+"""A number of runs or tries, none for no end (behavior3 v1's); infinity is read as none."""
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The four results a behaviour-tree node can return.
+"""The four results a behaviour-tree node can return, and the error a node raises for ERROR.
 
 The numbers are behavior3's (``SUCCESS=1, FAILURE=2, RUNNING=3, ERROR=4``) so that logs and
 messages line up with trees and tools written for behavior3editor. Compare statuses with ``is``:
@@ -41,3 +41,13 @@ SUCCESS = Status.SUCCESS
 FAILURE = Status.FAILURE
 RUNNING = Status.RUNNING
 ERROR = Status.ERROR
+
+
+class NodeError(Exception):
+    """A node's own account of why it returns ERROR: a bad input, an unset variable.
+
+    Raise it from ``tick`` (or ``on_start``, ``on_end``, ``on_halt``) with a message that says
+    what is wrong in the tree's terms; the node returns ERROR and the message is logged in one
+    line, naming the node, with no traceback. Any other exception is a fault in the node's code:
+    it is logged with its traceback, which is what finding that fault takes.
+    """

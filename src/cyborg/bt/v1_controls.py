@@ -23,20 +23,16 @@ Differences, all deliberate:
 from __future__ import annotations
 
 import math
-from typing import Annotated
 
 from typing_extensions import override
 
-from cyborg.bt.node import Action, Composite, Decorator, NodeError
-from cyborg.bt.properties import Unbounded
-from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, Status
+from cyborg.bt.node import Action, Composite, Decorator
+from cyborg.bt.properties import OptionalLoopCount
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status
 from cyborg.bt.v1_data import array_input, oneof
 
 MAX_LOOPS_PER_TICK = 1000
 """Most times Repeat (and ForEach, Filter) re-run a child that finishes at once, per tick."""
-
-Count = Annotated[int | None, Unbounded(None)]
-"""A number of runs or tries, none for no end; infinity in a file is read as none."""
 
 
 def _exactly(node: Composite, *counts: int) -> list[str]:
@@ -266,7 +262,7 @@ class Repeat(Decorator):
 
     inputs = ("count?",)
 
-    def __init__(self, count: Count = None) -> None:
+    def __init__(self, count: OptionalLoopCount = None) -> None:
         self.count = count
 
     def on_start(self) -> None:
@@ -298,7 +294,7 @@ class RetryUntilSuccess(Decorator):
     inputs = ("count?",)
     _goal: Status = SUCCESS
 
-    def __init__(self, count: Count = None) -> None:
+    def __init__(self, count: OptionalLoopCount = None) -> None:
         self.count = count
 
     def on_start(self) -> None:

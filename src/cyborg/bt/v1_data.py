@@ -37,8 +37,8 @@ from typing_extensions import override
 
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number, js_text, read_member, strict_equal, truthy
-from cyborg.bt.node import Action, Condition, Node, NodeError
-from cyborg.bt.status import FAILURE, SUCCESS, Status
+from cyborg.bt.node import Action, Condition, Node
+from cyborg.bt.status import FAILURE, SUCCESS, NodeError, Status
 
 log = logging.getLogger("cyborg.bt")
 

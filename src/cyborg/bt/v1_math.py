@@ -18,8 +18,8 @@ from typing_extensions import override
 
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number
-from cyborg.bt.node import Action, Condition, NodeError
-from cyborg.bt.status import FAILURE, SUCCESS, Status
+from cyborg.bt.node import Action, Condition
+from cyborg.bt.status import FAILURE, SUCCESS, NodeError, Status
 
 
 def _round(value: float) -> float:
