@@ -9,12 +9,13 @@ at once without recursion errors.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
 import pytest
 
-from cyborg.bt.expressions import MAX_DEPTH, MAX_LENGTH, Expression, ExpressionError
+from cyborg.bt.expressions import MAX_DEPTH, MAX_LENGTH, MAX_TEXT, Expression, ExpressionError
 
 
 @pytest.mark.parametrize(("text", "expected"), [
@@ -135,8 +136,38 @@ def test_the_deepest_accepted_expression_still_evaluates() -> None:
     assert Expression(chain).evaluate({}) == MAX_DEPTH
 
 
-def test_huge_numbers_give_a_clear_error_not_a_crash() -> None:
+def test_huge_numbers_are_doubles_as_in_javascript() -> None:
     big = {"x": 10 ** 400}
-    with pytest.raises(ExpressionError, match="too large"):
-        Expression("x / 3").evaluate(big)
+    assert Expression("x / 3").evaluate(big) == math.inf
     assert Expression("x * x > 0").evaluate(big) is True
+    assert Expression("-x").evaluate(big) == -math.inf
+    assert Expression("9007199254740993").evaluate({}) == 2.0 ** 53  # the nearest double
+    assert Expression("9007199254740992 + 1").evaluate({}) == 2.0 ** 53
+    assert Expression("3 * 3").evaluate({}) == 9 and isinstance(
+        Expression("3 * 3").evaluate({}), int), "small integers stay integers, shown as 9"
+
+
+def test_squaring_over_and_over_stays_one_machine_number() -> None:
+    """``n ? n * n : 3`` in a Repeat of 40 held the interpreter in one multiplication of
+    integers with billions of digits; as doubles it reaches Infinity in a few steps."""
+    square = Expression("n ? n * n : 3")
+    n: Any = None
+    for _ in range(40):
+        n = square.evaluate({"n": n})
+    assert n == math.inf
+
+
+def test_a_text_that_doubles_is_refused_past_its_limit() -> None:
+    double = Expression("s ? s + s : 'x'")
+    s: Any = None
+    with pytest.raises(ExpressionError, match=r"'s \+ s' would be 2,097,152 characters, more "
+                                              r"than the 1,048,576"):
+        for _ in range(40):
+            s = double.evaluate({"s": s})
+    assert len(s) == MAX_TEXT
+
+
+@pytest.mark.parametrize("source", ["\u0663 > 2", "\uff13 > 2", "x + \u0663"])  # ٣, fullwidth 3
+def test_digits_are_ascii_as_in_behavior3s_runtimes(source: str) -> None:
+    with pytest.raises(ExpressionError, match="unexpected character"):
+        Expression(source)

@@ -27,7 +27,11 @@ Operands are numbers (``3``, ``2.5``, ``1e3``), strings (``'s'``, ``"s"``, with 
 escapes), ``true``/``false``, ``null``/``undefined`` (both ``None``), ``NaN``, ``Infinity`` and
 identifiers, which name blackboard variables (an unset one is ``undefined``). ``a.b`` and
 ``a[k]`` read a dict's key, a list's element (``undefined`` past its end) or ``length``.
-Values follow JavaScript's rules (:mod:`cyborg.bt.js_values`): an empty list is true.
+Values follow JavaScript's rules (:mod:`cyborg.bt.js_values`): an empty list is true, and
+numbers are doubles, as behavior3's runtimes have them: an integer past 2**53 becomes the
+nearest double and one past the largest ``Infinity``, so ``n * n`` ticked over and over stays
+one machine number. Digits are ASCII (``٣`` is no number). A text an expression makes holds at
+most :data:`MAX_TEXT` characters.
 
 Mixing kinds where JavaScript would silently coerce (``undefined > 3``, ``[1] + 1``) raises
 :class:`ExpressionError` naming the operand instead. Text longer than :data:`MAX_LENGTH`
@@ -48,6 +52,7 @@ from cyborg.bt.js_values import (
     ORDER,
     describe,
     int32,
+    js_number,
     js_text,
     read_member,
     strict_equal,
@@ -59,10 +64,12 @@ MAX_LENGTH = 1000
 """Longest expression text accepted, in characters."""
 MAX_DEPTH = 50
 """Deepest nesting accepted: parentheses, operators applied to operators, member chains."""
+MAX_TEXT = 1 << 20
+"""Longest text an expression makes, in characters: ``s + s`` ticked over and over doubles."""
 
 _TOKEN = re.compile(r"""
     (?P<space>\s+)
-  | (?P<number>\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)
+  | (?P<number>[0-9]+(?:\.[0-9]+)?(?:[eE][+-]?[0-9]+)?)
   | (?P<name>[A-Za-z_$][A-Za-z0-9_$]*)
   | (?P<string>['"])
   | (?P<op>===|!==|>>>|<<|>>|<=|>=|==|!=|&&|\|\||[-+*/%<>!~&|^?:.\[\]()])
@@ -201,7 +208,7 @@ def _tokens(source: str) -> list[_Token]:
                 raise ExpressionError(f"in {source!r}: {word.group() if word else ''!r} at "
                                       f"column {position + 1} is neither a number nor a name")
             text = match.group()
-            number = float(text) if any(c in text for c in ".eE") else int(text)
+            number = float(text) if any(c in text for c in ".eE") else js_number(int(text))
             tokens.append(_Token("number", number, position, end))
         elif kind in ("name", "op"):
             tokens.append(_Token(kind, match.group(), position, end))
@@ -366,7 +373,7 @@ class _Evaluator:
 
     def number(self, node: Expr, value: Any, op: str) -> float:
         if isinstance(value, int | float):
-            return int(value) if type(value) is bool else value
+            return int(value) if type(value) is bool else js_number(value)
         raise self.fail(f"{op!r} needs a number, but {self.shown(node, value)} is not one")
 
     def unary(self, node: Unary) -> Any:
@@ -400,12 +407,19 @@ class _Evaluator:
                 if not isinstance(value, str | int | float):
                     raise self.fail(f"'+' joins a string only with a string, number or "
                                     f"boolean, not {self.shown(side, value)}")
-            return js_text(left) + js_text(right)
+            return self.joined(node, js_text(left), js_text(right))
         a, b = self.number(node.left, left, op), self.number(node.right, right, op)
         try:
-            return a + b if op == "+" else ARITHMETIC[op](a, b)
+            return js_number(a + b if op == "+" else ARITHMETIC[op](a, b))
         except OverflowError:
             raise self.fail(f"{op!r}: the result of {self.text(node)} is too large") from None
+
+    def joined(self, node: Binary, left: str, right: str) -> str:
+        if len(left) + len(right) > MAX_TEXT:
+            raise self.fail(f"'+': the result of {self.text(node)} would be "
+                            f"{len(left) + len(right):,} characters, more than the "
+                            f"{MAX_TEXT:,} a text may hold")
+        return left + right
 
     def member(self, node: Member) -> Any:
         target = self.value(node.target)

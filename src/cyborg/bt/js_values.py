@@ -79,6 +79,25 @@ def is_number(value: Any) -> bool:
     return isinstance(value, int | float) and type(value) is not bool
 
 
+SAFE_INTEGER = 2**53
+"""Beyond this, JavaScript's numbers (doubles) no longer hold every integer."""
+
+
+def js_number(value: float) -> float:
+    """``value`` as JavaScript holds a number: a double past :data:`SAFE_INTEGER`.
+
+    An int beyond it becomes the nearest double (``±Infinity`` past the largest), so no
+    arithmetic grows without bound; ints within it stay ints (``3`` shows as ``3``, as
+    JavaScript shows it).
+    """
+    if isinstance(value, int) and not -SAFE_INTEGER <= value <= SAFE_INTEGER:
+        try:
+            return float(value)
+        except OverflowError:
+            return math.inf if value > 0 else -math.inf
+    return value
+
+
 def int32(value: float) -> int:
     """JavaScript's ToInt32, which bitwise operators apply: truncate, wrap to 32-bit signed."""
     if isinstance(value, float) and not math.isfinite(value):
