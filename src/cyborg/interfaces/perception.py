@@ -36,6 +36,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TypeVar
+
+import numpy as np
 
 from cyborg.bus.msgs.cyborg_msgs.msg import TrackedObjects
 from cyborg.bus.msgs.std_msgs.msg import String
@@ -53,6 +56,10 @@ MAP_FRAME = "map"
 
 
 # ---------------------------------------------------------------------- the camera
+Depth = TypeVar("Depth", float, np.ndarray)
+"""A depth in metres, or an array of them."""
+
+
 @dataclass(frozen=True)
 class CameraModel:
     """A pinhole camera as far as bearings go: image size and horizontal field of view."""
@@ -67,6 +74,16 @@ class CameraModel:
     """Nearest depth the camera measures, metres."""
     max_range: float
     """Farthest depth the camera measures, metres."""
+    depth_noise: tuple[float, float] = (0.01, 0.002)
+    """``(a, b)``: a measured depth ``d`` is off by ``a d + b d²`` (one standard deviation),
+    as stereo depth error grows with the square of the range: 1 % at 1 m, 2 % at 5 m, 5 % at
+    20 m (the ZED 2 in the 2018 Cyborg's lighting)."""
+
+    def depth_sigma(self, depth: Depth) -> Depth:
+        """One standard deviation (m) of a depth measured at ``depth`` metres (or of each)."""
+        linear, square = self.depth_noise
+        sigma: Depth = linear * depth + square * depth * depth
+        return sigma
 
     @property
     def centre_column(self) -> float:

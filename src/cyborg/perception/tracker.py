@@ -8,16 +8,27 @@ through :meth:`Tracker.update`:
   :attr:`TrackerSettings.horizon` seconds ahead, so an old guess does not wander off);
 * **gating and association**, per label — a sighting may only join an object of its own label
   whose predicted position, or the position where it was last seen (someone who stopped or
-  turned back while unseen), lies within :attr:`TrackerSettings.gate` metres; the pairs within
-  the gate are taken greedily, nearest first, each object and sighting at most once (a greedy
-  assignment: with objects further apart than the gate, as people are, it gives what an optimal
-  one would);
+  turned back while unseen), lies within the pair's gate: :attr:`TrackerSettings.gate`
+  metres, widened by :attr:`TrackerSettings.spread` metres for each second the object has
+  been unseen (up to the horizon: a person hidden behind a pillar or another person for a
+  second may be a metre and a half from where they were guessed to be) and by
+  :attr:`TrackerSettings.depth_sigmas` standard deviations of the sighting's depth error (a
+  stereo camera's depth of a person 15 m away jumps by a metre from frame to frame:
+  :meth:`~cyborg.interfaces.perception.CameraModel.depth_sigma`). The pairs within their gate
+  are taken greedily, nearest first, each object and sighting at most once (a greedy
+  assignment: with objects further apart than the gate, as people are, it gives what an
+  optimal one would). So a person keeps their track through missed frames, a turn, or a few
+  seconds hidden; one unseen for :attr:`TrackerSettings.forget_after` seconds is forgotten and
+  gets a new id when seen again (the tracker compares places, not looks);
 * **update** — a joined object follows its sighting with an alpha-beta filter (a small
   constant-velocity filter): position ``p = p' + alpha * r`` and velocity
   ``v = v + beta * r / dt``, where ``p'`` is the prediction, ``r`` the sighting's offset from
   it and ``dt`` the time since the object was last seen; speeds are capped at
-  :attr:`TrackerSettings.max_speed`. A sighting no object takes starts a new object (its own
-  id, at rest);
+  :attr:`TrackerSettings.max_speed`. The longer an object was unseen, the more its sighting is
+  believed: ``alpha`` is at least the share of the gate that the time unseen added. An object
+  found beyond the plain gate from its prediction but nearer where it was last seen stopped or
+  turned while unseen: it goes on from there, at rest (a stale velocity would carry it off).
+  A sighting no object takes starts a new object (its own id, at rest);
 * **confidence** — each sighting raises it, ``c = 1 - (1 - c) * (1 - g * s)`` (``s`` the
   detection's score, ``g`` :attr:`TrackerSettings.gain`), so an object seen often is trusted
   more than one seen once; unseen, it halves every :attr:`TrackerSettings.half_life` seconds
@@ -39,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cyborg.interfaces.perception import ASSOCIATION_GATE, CAMERA, FORGET_AFTER
+from cyborg.interfaces.perception import ASSOCIATION_GATE, CAMERA, FORGET_AFTER, CameraModel
 from cyborg.perception.sighting import Detection, RobotPose, Sighting, locate
 
 
@@ -48,7 +59,17 @@ class TrackerSettings:
     """How the tracker joins, smooths, trusts and forgets (see the module docstring)."""
 
     gate: float = ASSOCIATION_GATE
-    """Metres: the furthest a sighting may lie from an object's prediction to join it."""
+    """Metres: the furthest a sighting may lie from an object's prediction to join it, when
+    the object was seen in the frame before and the sighting is near (see the next two)."""
+    spread: float = 1.5
+    """Metres per second: how much the gate widens for each second an object is unseen (up
+    to ``horizon``), as far as a person walking briskly may stray from the guess meanwhile."""
+    depth_sigmas: float = 3.0
+    """How many standard deviations of a sighting's depth error (``camera``'s
+    :meth:`~cyborg.interfaces.perception.CameraModel.depth_sigma` at its distance) widen the
+    gate, so that the noise of a far sighting does not start a new object."""
+    camera: CameraModel = CAMERA
+    """The camera the sightings come from, for its depth noise."""
     forget_after: float = FORGET_AFTER
     """Seconds unseen after which an object is dropped."""
     alpha: float = 0.4
@@ -75,6 +96,10 @@ class TrackerSettings:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"tracker setting {name} must be a positive number, not {value}")
+        for name in ("spread", "depth_sigmas"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"tracker setting {name} must be 0 or more, not {value}")
         for name in ("alpha", "beta", "gain"):
             value = getattr(self, name)
             if not 0.0 < value <= 1.0:
@@ -152,12 +177,14 @@ class Tracker:
             settings = self.settings
             predicted = np.array([item.predicted(stamp, settings.horizon) for item in candidates])
             last = np.array([(item.x, item.y) for item in candidates])
-            seen = np.array([(sighting.x, sighting.y) for sighting in sightings])
+            unseen = np.array([item.last_seen for item in candidates])
+            seen = np.array([(sighting.x, sighting.y, sighting.distance)
+                             for sighting in sightings])
             gaps = np.minimum(  # to the prediction, or to where it was (it stopped, turned)
                 np.hypot(seen[:, None, 0] - predicted[None, :, 0],
                          seen[:, None, 1] - predicted[None, :, 1]),
                 np.hypot(seen[:, None, 0] - last[None, :, 0], seen[:, None, 1] - last[None, :, 1]))
-            rows, cols = np.nonzero(gaps <= settings.gate)
+            rows, cols = np.nonzero(gaps <= self._gates(stamp, unseen, seen[:, 2]))
             used: set[int] = set()
             for index in np.argsort(gaps[rows, cols], kind="stable"):
                 row, col = int(rows[index]), int(cols[index])
@@ -170,13 +197,33 @@ class Tracker:
             if row not in taken:
                 self._start(sighting, stamp)
 
+    def _gates(self, stamp: float, last_seen: np.ndarray, distances: np.ndarray) -> np.ndarray:
+        """The gate (m) of each sighting (rows) and object (columns), per the module docstring.
+
+        It is wider the longer the object is unseen (since ``last_seen``) and the further the
+        sighting is (its ``distances``).
+        """
+        settings = self.settings
+        unseen = np.clip(stamp - last_seen, 0.0, settings.horizon)
+        depth = np.nan_to_num(distances, nan=0.0, posinf=0.0)
+        noise = settings.depth_sigmas * settings.camera.depth_sigma(depth)
+        result: np.ndarray = settings.gate + settings.spread * unseen[None, :] + noise[:, None]
+        return result
+
     def _follow(self, item: TrackedObject, sighting: Sighting, stamp: float) -> None:
         settings = self.settings
         dt = stamp - item.last_seen
         if dt > 0:
             px, py = item.predicted(stamp, settings.horizon)
+            if math.hypot(sighting.x - px, sighting.y - py) > settings.gate and math.hypot(
+                    sighting.x - item.x, sighting.y - item.y) < math.hypot(sighting.x - px,
+                                                                           sighting.y - py):
+                # it stopped or turned while unseen: go on from where it was, at rest
+                px, py, item.vx, item.vy = item.x, item.y, 0.0, 0.0
+            widened = settings.spread * min(dt, settings.horizon)
+            alpha = max(settings.alpha, widened / (settings.gate + widened))
             rx, ry = sighting.x - px, sighting.y - py
-            item.x, item.y = px + settings.alpha * rx, py + settings.alpha * ry
+            item.x, item.y = px + alpha * rx, py + alpha * ry
             vx = item.vx + settings.beta * rx / dt
             vy = item.vy + settings.beta * ry / dt
             speed = math.hypot(vx, vy)

@@ -58,7 +58,7 @@ class CameraSpec:
     detect_near: float = 0.97
     detect_far: float = 0.3
     sure_range: float = 5.0
-    distance_noise: tuple[float, float] = (0.01, 0.002)
+    distance_noise: tuple[float, float] = CAMERA.depth_noise
     bearing_noise: float = math.radians(1.0)
     size_noise: float = 0.05  # relative
 
