@@ -119,6 +119,25 @@ def test_toml_syntax_errors_and_repeated_modes_give_their_line(tmp_path: Path) -
     assert problem.line == 1 and problem.column is not None
 
 
+@pytest.mark.parametrize(("value", "said"), [
+    ("[" * 1000 + "]" * 1000, "nested more than 32 deep"),
+    ("{a=" * 1000 + "1" + "}" * 1000, "nested more than 32 deep"),
+    ("1" + "0" * 5000, "a number of more than 100 digits"),
+])
+def test_what_tomllib_cannot_read_is_a_located_problem(tmp_path: Path, value: str,
+                                                       said: str) -> None:
+    """1,000 nested arrays or inline tables raised RecursionError from tomllib, a 5,001-digit
+    number ValueError, and a 401-digit min_dwell OverflowError: each is one located problem."""
+    text = GOOD + f"\nx = {value}\n"
+    problem = only(tmp_path, text)
+    assert said in problem.message and problem.line == len(GOOD.splitlines()) + 2
+    dwell = only(tmp_path, GOOD.replace("[modes.normal]", "min_dwell = 1" + "0" * 400
+                                        + "\n[modes.normal]", 1))
+    assert "more than 100 digits" in dwell.message and dwell.line is not None
+    quoted = GOOD + '\nnote = "' + "[" * 1000 + '"\n'  # brackets in a string are text
+    assert "nested" not in only(tmp_path, quoted).message
+
+
 def test_an_unknown_tree_lists_the_trees_there_are(tmp_path: Path) -> None:
     text = GOOD.replace('tree = "charge"', 'tree = "charging"')
     problem = only(tmp_path, text)

@@ -24,7 +24,10 @@ _VALUES = ["1", "-1", "0", "nan", "inf", "1e400", '"x"', '""', "true", "[]", '["
            "{}", '{ tree = "patrol" }', '"*"', '"normal"', '"low_battery"', '"demo"',
            '"patrol"', '"battery.percent <"', '"a ? b"', '"\\ud800"', "'''\nx\n'''", "[1, [2]]",
            '"' + "(" * 60 + '"', "99999999999999999999999999",
-           '"a\\u0000b"', '["x", "\\u0000"]']
+           '"a\\u0000b"', '["x", "\\u0000"]',
+           # tomllib's recursion and digit limits: each a located problem, never its exception
+           "[" * 1000 + "]" * 1000, "{a=" * 1000 + "1" + "}" * 1000, "1" + "0" * 5000,
+           "1" + "0" * 400, "1." + "0" * 400, '"' + "[" * 1000 + '"']
 _FRAGMENTS = ["[", "]", "[[", "=", '"', "'", "#", ".", "\n", "[modes.x]", "[[transitions]]",
               "[modes]", "modes = 3", "transitions = 1", "from", "to = ", "\ud800", "\x00"]
 _MUTATIONS = st.one_of(

@@ -96,3 +96,30 @@ def test_stop_keeps_the_robot_stopped_until_the_seat_resumes_the_tree(browser: B
         finally:
             second.stop()
         assert errors == [], json.dumps(errors)
+
+
+def test_a_stop_from_another_page_ends_a_drive_by_hand_whose_key_is_still_held(
+        browser: Browser) -> None:
+    with live_system() as live:
+        errors: list[str] = []
+        driver = _on_map(browser, live.url, errors)
+        driver.wait_for_function("window.__map.acting().canAct", timeout=30000)  # the seat
+        other = _on_map(browser, live.url, errors)
+        sim = live.system.sim
+        driver.focus("#map-canvas")
+        driver.keyboard.down("ArrowLeft")  # turning on the spot, held from now on
+        wait_until(lambda: sim.base.turn_rate > 0.1, 30, "the robot to turn by hand")
+        other.click("#map-stop")
+        wait_until(lambda: sim.base.turn_rate == 0 and sim.base.speed == 0, 20,
+                   "the robot to stop")
+        heading, since = sim.pose.theta, sim.time
+        wait_until(lambda: sim.time >= since + 10.0, 60, "10 s of simulated time")
+        assert sim.pose.theta == heading, "the held key drives no more"
+        driver.wait_for_function("[...document.querySelectorAll('#map-log li.error')].some("
+                                 "li => li.textContent.includes('drive refused'))",
+                                 timeout=20000)
+        driver.keyboard.up("ArrowLeft")
+        driver.keyboard.down("ArrowLeft")  # pressed again: it drives again
+        wait_until(lambda: sim.pose.theta != heading, 30, "the robot to turn again")
+        driver.keyboard.up("ArrowLeft")
+        assert errors == [], json.dumps(errors)

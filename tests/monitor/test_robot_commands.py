@@ -309,6 +309,35 @@ def test_driving_is_clamped_and_a_driver_that_leaves_is_stopped_once() -> None:
     asyncio.run(scenario())
 
 
+def test_a_stop_ends_a_drive_in_progress_until_the_driver_lets_go() -> None:
+    """A key or the joystick still held on the driver's page must not drive the robot on 100 ms
+    after another page's STOP."""
+    hub, buses = acting_hub()
+
+    async def scenario() -> None:
+        driver, other = page(hub, 1), page(hub, 2)
+        hub.seat.claim(1)
+        await receive(hub, driver, json.dumps({"t": "drive", "ns": ROBOT, "vx": 0.3, "wz": 0}))
+        assert (await _send(hub, other, {"t": "stop", "ns": ROBOT}))["ok"]
+        bus = buses[ROBOT]
+        calls = len(bus.calls)
+        held = await _send(hub, driver, {"t": "drive", "ns": ROBOT, "vx": 0.3, "wz": 0})
+        assert held["ok"] is False and held["command"] == "drive"
+        assert "/cyborg was stopped while you drove it: let go, then drive again" in \
+            held["message"]
+        assert len(bus.calls) == calls, "nothing reached the robot"
+        await receive(hub, driver, json.dumps({"t": "drive", "ns": ROBOT, "vx": 0, "wz": 0}))
+        again = await _send(hub, driver, {"t": "drive", "ns": ROBOT, "vx": 0.3, "wz": 0,
+                                          "req": 5})
+        assert again["ok"] is True and bus.calls[-2:] == [("drive", 0.0, 0.0),
+                                                          ("drive", 0.3, 0.0)]
+        assert (await _send(hub, driver, {"t": "stop", "ns": ROBOT}))["ok"]
+        own = await _send(hub, driver, {"t": "drive", "ns": ROBOT, "vx": 0.2, "wz": 0, "req": 6})
+        assert own["ok"] is True, "the page that stops lets go of its own drive"
+
+    asyncio.run(scenario())
+
+
 def test_stop_ends_a_tour_and_a_new_goal_replaces_one() -> None:
     hub, buses = acting_hub()
 

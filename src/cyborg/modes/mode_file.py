@@ -41,6 +41,7 @@ from cyborg.bt.limits import Limits
 from cyborg.bt.problems import Problem, TreeLoadError, printable, shown
 from cyborg.modes.conditions import Condition, ExpressionError
 from cyborg.modes.spec import ANY, MachineSpec, ModeSpec, TransitionSpec, reachable
+from cyborg.modes.toml_bounds import MAX_DIGITS, MAX_NESTING, first_long_number, first_too_deep
 from cyborg.modes.toml_lines import TomlLines
 from cyborg.modes.tree_sources import TreeSource, find_tree, read_sources
 
@@ -86,6 +87,7 @@ def parse_mode_file(text: str, source: str = "<string>",
         raise ModeFileError([Problem(
             f"the text holds a lone UTF-16 surrogate (U+{ord(surrogate.group()):04X}), which "
             "is not a character", source, line, column)])
+    _check_bounds(text, source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -100,6 +102,20 @@ def parse_mode_file(text: str, source: str = "<string>",
     if reader.problems or spec is None:
         raise ModeFileError(reader.problems)
     return spec
+
+
+def _check_bounds(text: str, source: str) -> None:
+    """Refuses, located, what :mod:`tomllib` cannot read safely (:mod:`.toml_bounds`)."""
+    deep = first_too_deep(text)
+    if deep is not None:
+        raise ModeFileError([Problem(
+            f"arrays and inline tables nested more than {MAX_NESTING} deep (a mode file needs "
+            "two or three levels)", source, *deep)])
+    long = first_long_number(text)
+    if long is not None:
+        raise ModeFileError([Problem(
+            f"a number of more than {MAX_DIGITS} digits (no setting needs more than 20)",
+            source, *long)])
 
 
 class _Reader:

@@ -40,7 +40,10 @@ halted as ``enable(false)`` halts it, and it latches ``stopped``,
 The tree stays stopped until someone with the seat enables it again (the page's Resume, the
 Run button, ``cyborg bt enable``); every page, one that comes later included, reads it as
 ``stopped`` in the ``runner`` and ``robots`` messages, and this monitor or any other shows the
-same. The answer's ``stopped`` names the trees stopped.
+same. The answer's ``stopped`` names the trees stopped. A page that was driving the robot by
+hand when another page stopped it (a key or the joystick still held) is refused its next drive
+commands until it lets go (a zero ``drive``): the held key does not drive the robot on 100 ms
+after the STOP.
 
 **Answers.** Each command is answered with ``result`` (``req``, ``ok``, ``message``, and
 ``paused``: the tree paused for it, or null) once the call returns; a goal is answered when
@@ -119,6 +122,8 @@ class RobotCommands:
         self._tours: dict[str, Tour] = {}
         self._driven: dict[int, tuple[str, float]] = {}
         """Connection number → (robot, when it last sent ``drive``, monotonic s)."""
+        self._drives_stopped: set[tuple[int, str]] = set()
+        """(Connection, robot) of drives a STOP ended, refused until the page lets go."""
         self._tasks: set[asyncio.Task[None]] = set()
         self._manual: dict[str, str] = {}
         """Trees paused for a manual goal → the robot they drive, until they run again."""
@@ -142,7 +147,7 @@ class RobotCommands:
         ns = self._namespace(command.get("ns"))
         bus = self._clients_for(ns)
         if kind == "stop":
-            message, trees = await self._stop(ns, bus)
+            message, trees = await self._stop(client, ns, bus)
             return {"message": message, "paused": None, "stopped": trees}
         if kind == "drive":
             return await self._drive(client, ns, bus, command)
@@ -219,9 +224,17 @@ class RobotCommands:
             raise RobotCommandError(f"{ns}/{service} refused: {message}")
         return f"{ns}: {message}"
 
-    async def _stop(self, ns: str, bus: RobotClients) -> tuple[str, list[str]]:
-        """Stops the robot and the trees that drive it, side by side; what it says, the trees."""
+    async def _stop(self, client: Client, ns: str, bus: RobotClients) -> tuple[str, list[str]]:
+        """Stops the robot and the trees that drive it, side by side; what it says, the trees.
+
+        Drives of other pages in progress are refused until they let go (the page that stops
+        lets go of its own).
+        """
         self._end_tour(ns, "stopped")
+        now = time.monotonic()
+        self._drives_stopped |= {(number, ns) for number, (driven, when) in self._driven.items()
+                                 if driven == ns and now - when < TELEOP_TIMEOUT
+                                 and number != client.number}
         trees = [tree for tree in sorted(self._trees) if robot_of_runner(tree) == ns
                  and self._trees[tree].alive]
         robot, *halted = await asyncio.gather(
@@ -264,6 +277,11 @@ class RobotCommands:
     async def _drive(self, client: Client, ns: str, bus: RobotClients,
                      command: dict[str, Any]) -> dict[str, Any] | None:
         vx, wz = number_field(command, "vx"), number_field(command, "wz")
+        if (client.number, ns) in self._drives_stopped:
+            if vx or wz:
+                raise RobotCommandError(f"{ns} was stopped while you drove it: let go, then "
+                                        "drive again")
+            self._drives_stopped.discard((client.number, ns))
         paused = None
         if vx or wz:
             paused = await self._pause_tree(ns)
@@ -384,6 +402,8 @@ class RobotCommands:
     def disconnected(self, client: Client) -> None:
         """A page left: one zero twist to the robot it drove, if it drove just now."""
         driven = self._driven.pop(client.number, None)
+        self._drives_stopped = {stopped for stopped in self._drives_stopped
+                                if stopped[0] != client.number}
         if driven is None or time.monotonic() - driven[1] >= TELEOP_TIMEOUT:
             return
         bus = self._bus.get(driven[0])

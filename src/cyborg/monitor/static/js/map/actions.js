@@ -42,6 +42,7 @@ export class MapActions {
     this.rows = []; // {key, item, text}
     this.tour = null; // the monitor's latest tour message for the robot acted on
     this.shownKey = "";
+    this.onDriveEnded = () => {}; // (zero): driving by hand must end now (js/map/drive.js sets it)
     for (const element of this.bar.querySelectorAll("button, select")) element.dataset.tip = element.title;
     this.stopButton.dataset.tip = this.stopButton.title;
     this.stopButton.addEventListener("click", () => this.stop());
@@ -129,6 +130,7 @@ export class MapActions {
   }
 
   stop() {
+    this.onDriveEnded(false); // a key or the joystick held here drives no more (the stop follows)
     return this.act({ t: "stop" }, "STOP", true);
   }
 
@@ -176,6 +178,7 @@ export class MapActions {
     }
     if (message.t === "result" && ROBOT_COMMANDS.has(message.command)) {
       if (!message.ok) this.log(`${message.command} refused`, "error", message.message);
+      if (!message.ok && message.command === "drive") this.onDriveEnded(true); // (stopped by another page)
       return true;
     }
     return false;

@@ -6,7 +6,9 @@
 // one zero. Speeds are in m/s and rad/s, at most SPEED and TURN at full deflection (the robot's
 // own limits, TELEOP_MAX_SPEED and TELEOP_MAX_TURN_RATE, which the monitor and the robot
 // enforce again); the keys drive at KEY_SHARE of that, Shift at full. Driving needs the seat,
-// as every action but Stop does; the monitor pauses the robot's tree on the first move.
+// as every action but Stop does; the monitor pauses the robot's tree on the first move. A STOP
+// (from this page, or a refused drive: another page stopped the robot) ends the drive: the key
+// or the joystick must be pressed again, a key's auto-repeat does not start it again.
 
 const PERIOD_MS = 100;
 const SPEED = 0.5; // m/s
@@ -29,6 +31,7 @@ export class Driver {
     this.stick = null; // [x, y] in -1..1 (y forward) while the joystick is held
     this.timer = null;
     this.target = null; // the robot being driven
+    actions.onDriveEnded = (zero) => this.release(zero);
     this.toggle = root.querySelector("#map-drive");
     this.pad = root.querySelector("#map-joystick");
     this.knob = this.pad.querySelector(".knob");
@@ -55,7 +58,7 @@ export class Driver {
     }
     if (!(event.code in KEYS)) return;
     event.preventDefault(); // no scrolling with the arrows
-    if (!this.actions.canAct) return;
+    if (!this.actions.canAct || (event.repeat && this.timer === null)) return;
     this.shift = event.shiftKey;
     this.keys.add(event.code);
     this.start();
