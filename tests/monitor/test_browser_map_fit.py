@@ -19,6 +19,7 @@ from tests.conftest import shared_dir
 from tests.monitor import map_page
 from tests.monitor.browser import screenshot
 from tests.monitor.map_page import StandInMonitor
+from tests.running_system import wait_until
 
 pytestmark = pytest.mark.heavy
 
@@ -76,8 +77,8 @@ def test_after_fit_no_marker_lies_under_the_toolbar_or_stop(
         return {**markers, ROBOT: (robot["pose"]["x"], robot["pose"]["y"],
                                    max(7.0, reach * scale))}
 
-    page.wait_for_timeout(300)  # the map fitted again once the actions' bar came
-    assert _covered_markers(page, with_robot()) == [], "fitted again when the bar came"
+    wait_until(lambda: _covered_markers(page, with_robot()) == [], 10,
+               "the map fitted again once the actions' bar came")
     page.mouse.move(width / 2, height / 2)
     page.mouse.wheel(0, 600)  # zoomed out by hand, then Fit
     page.click("#map-fit")

@@ -62,10 +62,12 @@ def fleet() -> Iterator[StandInMonitor]:
 
 
 def _labels(page: Page, server: StandInMonitor) -> list[dict[str, Any]]:
-    """The label boxes of a frame drawn with the person tracked (the tracker's list is shown
-    for 3 s after it comes: it is sent again, and the boxes read once it is drawn)."""
+    """The label boxes of a frame drawn after what the test did last, with the person tracked
+    (the tracker's list is shown for 3 s after it comes: it is sent again)."""
+    paints = on_map(page, "m.paints")
     server.push(PERSON)
-    page.wait_for_function("window.__map.moving.tracked === 1", timeout=5000)
+    page.wait_for_function(f"window.__map.paints > {paints} && window.__map.moving.tracked === 1",
+                           timeout=5000)
     found: list[dict[str, Any]] = on_map(page, "m.labels()")
     return found
 

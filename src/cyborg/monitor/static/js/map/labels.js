@@ -9,8 +9,8 @@
 //
 // (PRIORITY below; the selected robot goes first among robots, the most confident objects
 // first among objects). The spots, in order: beside the marker on the label's own preferred
-// side, then the other sides and corners; then, when all of those are taken, the nearest free
-// spot further out (two more rings) or slid along a side (up to two box sizes), with a thin
+// side, then the other sides and corners; then, when all of those are taken, a spot slid along
+// a side (up to two box sizes) or further out (two more rings), nearer ones first, with a thin
 // leader line back to the marker. A spot that covers a marker (a robot, a goal dot, an object)
 // is taken only when no spot is clear of markers too. A label with no free spot is left out:
 // the lower one gives way. Every spot lies inside the canvas, clear of the map's controls.
@@ -19,17 +19,19 @@
 // `window.__map.labels()` returns, so a test can measure that none overlap.
 
 export const PRIORITY = { robot: 0, tracked: 1, detection: 1, dock: 2, home: 2, goal: 3, area: 4 };
-export const LINE_PX = 14; // one line of text
+const LINE_PX = 14; // one line of text
 const HALO_PX = 2; // the white outline around the text, and a hair of air
 const LEADER_STEP_PX = 18; // each further ring is this much further out
 const LEADER_RINGS = 2;
-const MARKER_AIR_PX = 6;
+const MARKER_AIR_PX = 6; // labels keep this far off others' markers where they can
 const SLIDES = 4; // half box sizes a spot may slide along its side, either way
+const GRID_PX = 48; // the cells boxes are filed by (BoxGrid)
+const GRID_ROW = 1 << 16; // a cell's number: column · GRID_ROW + row
 const LEADER = "rgba(60, 64, 67, 0.7)";
 const HALO = "rgba(255, 255, 255, 0.92)";
 const DIAGONAL = Math.SQRT1_2;
 
-// Sides: [dx, dy] unit steps from the marker (screen y down), and how the text aligns there.
+// Sides: [dx, dy] unit steps from the marker (screen y down).
 const SIDES = {
   E: [1, 0], W: [-1, 0], N: [0, -1], S: [0, 1],
   NE: [DIAGONAL, -DIAGONAL], SE: [DIAGONAL, DIAGONAL], NW: [-DIAGONAL, -DIAGONAL], SW: [-DIAGONAL, DIAGONAL],
@@ -70,42 +72,94 @@ export class LabelLayout {
   // y1] (halo included), `align` and `leader` (null, or the [x, y] on the box the line meets).
   place(ctx) {
     const queue = [...this.wanted].sort((a, b) => PRIORITY[a.kind] - PRIORITY[b.kind] || a.rank - b.rank || a.order - b.order);
+    this.markerGrid = new BoxGrid();
+    this.markers.forEach((box, i) => this.markerGrid.add(box, i));
+    const taken = new BoxGrid();
     const placed = [];
     for (const label of queue) {
       const size = measure(ctx, label.lines);
-      const spot = this.spotFor(label, size, placed);
-      if (spot) placed.push({ ...label, ...spot, size });
+      const spot = this.spotFor(label, size, taken);
+      if (!spot) continue;
+      placed.push({ ...label, ...spot, size });
+      taken.add(spot.box, placed.length);
     }
     return placed;
   }
 
-  spotFor(label, size, placed) {
+  // The first spot for `label` of `size` that lies in the canvas, off the controls, and covers
+  // no box `taken` (a BoxGrid of the labels placed), preferring those clear of markers; or null.
+  spotFor(label, size, taken) {
     const sides = [...label.sides, ...ALL_SIDES.filter((side) => !label.sides.includes(side))];
-    const inside = (s) => s.box[0] >= 0 && s.box[1] >= 0 && s.box[2] <= this.width && s.box[3] <= this.height
-      && !this.covered.some((box) => overlaps(s.box, box));
-    const free = (s) => inside(s) && !placed.some((other) => overlaps(s.box, other.box));
-    const clear = (s) => !this.markers.some((box, i) => i !== label.own && overlaps(s.box, box));
-    const near = sides.map((side) => spot(label, size, side, 0, 0));
-    let found = near.find((s) => free(s) && clear(s));
-    if (found) return found;
-    const far = farSpots(label, size, sides);
-    found = far.find((s) => free(s) && clear(s)) ?? near.find(free) ?? far.find(free);
-    return found ?? null;
+    const free = (box) => box[0] >= 0 && box[1] >= 0 && box[2] <= this.width && box[3] <= this.height
+      && !this.covered.some((other) => overlaps(box, other)) && !taken.hits(box, -1);
+    // the first free spot of `spots` clear of markers, else the first free one (or null)
+    const first = (spots) => {
+      let fallback = null;
+      for (const s of spots) {
+        if (!free(s.box)) continue;
+        if (!this.markerGrid.hits(s.box, label.own)) return [s, s];
+        fallback ??= s;
+      }
+      return [null, fallback];
+    };
+    const [beside, besideFallback] = first(sides.map((side) => spot(label, size, side, 0, 0)));
+    if (beside) return beside;
+    const [away, awayFallback] = first(farSpots(label, size, sides));
+    return away ?? besideFallback ?? awayFallback;
   }
 }
 
-// The spots away from the marker, tied to it by a leader line, nearest first: on each side,
-// further out (LEADER_RINGS rings) and slid along the side (SLIDES steps either way).
-function farSpots(label, size, sides) {
-  const spots = [];
-  for (let ring = 0; ring <= LEADER_RINGS; ring++) {
-    for (const side of sides) {
-      for (let slide = -SLIDES; slide <= SLIDES; slide++) if (ring || slide) spots.push(spot(label, size, side, ring, slide));
+// Boxes ([x0, y0, x1, y1]) filed by the GRID_PX cells they touch, so that asking what a box
+// overlaps looks only at its own cells: a crowd of markers costs little more than a few.
+class BoxGrid {
+  constructor() {
+    this.cells = new Map(); // cell number -> [box, id, box, id, ...]
+  }
+
+  add(box, id) {
+    const [cx0, cy0, cx1, cy1] = cellsOf(box);
+    for (let cx = cx0; cx <= cx1; cx++) {
+      for (let cy = cy0; cy <= cy1; cy++) {
+        const key = cx * GRID_ROW + cy;
+        const cell = this.cells.get(key);
+        if (cell) cell.push(box, id);
+        else this.cells.set(key, [box, id]);
+      }
     }
   }
-  const [sx, sy] = label.at;
-  return spots.map((s, i) => ({ s, i, d: Math.hypot(s.leader[0] - sx, s.leader[1] - sy) }))
-    .sort((a, b) => a.d - b.d || a.i - b.i).map(({ s }) => s);
+
+  // Whether `box` overlaps a box filed here, other than the one of id `skip`.
+  hits(box, skip) {
+    const [cx0, cy0, cx1, cy1] = cellsOf(box);
+    for (let cx = cx0; cx <= cx1; cx++) {
+      for (let cy = cy0; cy <= cy1; cy++) {
+        const cell = this.cells.get(cx * GRID_ROW + cy);
+        if (!cell) continue;
+        for (let i = 0; i < cell.length; i += 2) if (cell[i + 1] !== skip && overlaps(box, cell[i])) return true;
+      }
+    }
+    return false;
+  }
+}
+
+// The cells a box touches: [cx0, cy0, cx1, cy1], inclusive.
+function cellsOf([x0, y0, x1, y1]) {
+  return [Math.floor(x0 / GRID_PX), Math.floor(y0 / GRID_PX), Math.floor(x1 / GRID_PX), Math.floor(y1 / GRID_PX)];
+}
+
+// The spots away from the marker, tied to it by a leader line, nearer first: on each side slid
+// along it (up to SLIDES half box sizes either way), then further out (LEADER_RINGS rings),
+// there slid as well. Made one at a time: most labels take one of the first.
+function* farSpots(label, size, sides) {
+  for (let ring = 0; ring <= LEADER_RINGS; ring++) {
+    for (let step = 0; step <= SLIDES; step++) {
+      if (!ring && !step) continue;
+      for (const side of sides) {
+        yield spot(label, size, side, ring, step);
+        if (step) yield spot(label, size, side, ring, -step);
+      }
+    }
+  }
 }
 
 // The text's size: the widest line, and a line height each; halo included.
