@@ -182,6 +182,12 @@ BAD_FIELDS: list[tuple[dict[str, Any], str, str]] = [
     ({"t": "tour", "ns": ROBOT, "points": []}, "points", "points: a list of 1 to 50"),
     ({"t": "tour", "ns": ROBOT, "points": [[0, 0]] * 51}, "points", "points: a list of 1 to 50"),
     ({"t": "tour", "ns": ROBOT, "points": [[0, 0], [1]]}, "points[1]", "points[1]: [x, y]"),
+    # numbers JSON carries but a float does not hold, or no heading is: an OverflowError each
+    ({"t": "go_pose", "ns": ROBOT, "pose": [0, 0, 1e308]}, "pose", "pose[2] is 1e+308, not a "
+     "heading in radians"),
+    ({"t": "go_pose", "ns": ROBOT, "pose": [10**400, 0]}, "pose", "pose[0] is 1000"),
+    ({"t": "drive", "ns": ROBOT, "vx": 10**400, "wz": 0}, "vx", "not a finite number"),
+    ({"t": "tour", "ns": ROBOT, "points": [[0, 0, -1e300]]}, "points[0]", "not a heading"),
 ]
 
 

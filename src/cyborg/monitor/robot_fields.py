@@ -31,9 +31,18 @@ def short(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+ANGLE_LIMIT = 10 * math.tau
+"""Largest heading a pose may give, in radians either way; it is taken modulo a full turn."""
+
+
 def _finite(value: Any) -> bool:
-    return (not isinstance(value, bool) and isinstance(value, int | float)
-            and math.isfinite(value))
+    """A number that fits a float and is finite (a 400-digit integer does not fit)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
 
 
 def number_field(command: dict[str, Any], field: str) -> float:
@@ -65,7 +74,12 @@ def _pose(value: Any, field: str) -> tuple[float, float, float | None]:
     if max(abs(numbers[0]), abs(numbers[1])) > WORLD_LIMIT:
         raise RobotCommandError(f"{field}: {short(value)} is more than {WORLD_LIMIT / 1000:g} km "
                                 "from the map's origin", field)
-    return numbers[0], numbers[1], numbers[2] if len(numbers) == 3 else None
+    if len(numbers) == 2:
+        return numbers[0], numbers[1], None
+    if abs(numbers[2]) > ANGLE_LIMIT:
+        raise RobotCommandError(f"{field}[2] is {short(value[2])}, not a heading in radians "
+                                f"(at most {ANGLE_LIMIT:.1f} either way)", field)
+    return numbers[0], numbers[1], math.remainder(numbers[2], math.tau)
 
 
 def tour_points(command: dict[str, Any]) -> list[Waypoint]:
