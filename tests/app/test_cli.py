@@ -16,6 +16,7 @@ import pytest
 from cyborg.app.cli import main
 from tests.builders import N, project_json, tree_json
 from tests.conftest import shared_dir
+from tests.doc_commands import ROOT, doc_commands
 from tests.running_system import interruptible
 
 PATROL = shared_dir() / "trees" / "patrol_recharge.b3.json"
@@ -212,25 +213,18 @@ def test_a_run_whose_root_ends_in_error_fails(tmp_path: Path,
 
 
 def test_the_readme_bt_commands_work_as_written(capsys: pytest.CaptureFixture[str]) -> None:
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
-    readme = readme.replace("\\\n", " ")  # continued lines as one
     shown = "../shared/trees/patrol_recharge.b3.json"
-    commands = [line.split("#")[0].split("|")[0].split() for line in readme.splitlines()
-                if line.startswith("cyborg bt ") and shown in line
-                and not line.startswith("cyborg bt serve")]  # serves until stopped
+    commands = [command for command in doc_commands("cyborg", documents=(ROOT / "README.md",))
+                if command.text.startswith("cyborg bt ") and shown in command.text
+                and not command.text.startswith("cyborg bt serve")]  # serves until stopped
     assert len(commands) >= 4
-    for words in commands:
-        args = [str(PATROL) if word == shown else word.strip('"')
-                for word in _joined_quotes(words[1:])]
+    for command in commands:
+        words = shlex.split(command.text.split("|")[0])  # the part before a pipe
+        args = [str(PATROL) if word == shown else word for word in words[1:]]
         if args[1] == "run":
             args.append("--fast")  # the same ticks on simulated time
-        assert main(args) == 0, " ".join(words)
+        assert main(args) == 0, f"{command.where}: {command.text}"
     assert "Traceback" not in capsys.readouterr().err
-
-
-def _joined_quotes(words: list[str]) -> list[str]:
-    """Shell-like words: ``"Patrol`` ``tree"`` -> ``"Patrol tree"``."""
-    return shlex.split(" ".join(words))
 
 
 def test_up_refuses_a_tree_whose_goals_are_not_on_the_map() -> None:
