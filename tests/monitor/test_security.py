@@ -8,6 +8,7 @@ from __future__ import annotations
 import logging
 import os
 import socket
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -171,6 +172,26 @@ def test_the_token_comes_from_a_file_or_the_environment(
     with caplog.at_level(logging.WARNING, "cyborg.monitor"):
         read_token(token_file=secret, environ={})
     assert "other users can read" in caplog.text
+
+
+def test_a_token_file_that_is_a_fifo_or_a_folder_is_refused_at_once(tmp_path: Path) -> None:
+    """Opening a FIFO with no writer waited for one: cyborg monitor and foxglove never started."""
+    fifo = tmp_path / "token.fifo"
+    os.mkfifo(fifo)
+    said: list[str] = []
+
+    def read(path: Path) -> None:
+        with pytest.raises(TokenError) as refused:
+            read_token(token_file=path, environ={})
+        said.append(str(refused.value))
+
+    for path in (fifo, tmp_path):
+        reader = threading.Thread(target=read, args=(path,), daemon=True)
+        reader.start()
+        reader.join(30)
+        assert not reader.is_alive(), f"reading {path} still waits"
+    assert said == [f"token file {fifo}: not a regular file",
+                    f"token file {tmp_path}: Is a directory"]
 
 
 def test_cyborg_monitor_and_up_options(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

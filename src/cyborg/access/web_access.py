@@ -190,7 +190,8 @@ def read_token(token: str | None = None, token_file: str | Path | None = None, *
 
 def _token_from_file(path: Path) -> str:
     try:
-        with path.open("rb") as file:
+        # O_NONBLOCK: opening a FIFO with no writer waited for one, holding the start-up
+        with os.fdopen(os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC), "rb") as file:
             status = os.fstat(file.fileno())
             if not stat.S_ISREG(status.st_mode):
                 raise TokenError(f"token file {path}: not a regular file")
