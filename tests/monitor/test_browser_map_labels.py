@@ -1,10 +1,11 @@
 """The map's labels in headless Chromium (Debian's, driven by Playwright), fed by a stand-in
 monitor (tests/monitor/map_page.py): three robots on the campus map, one docked at the
-charger and the others beside it, and a person the docked robot tracks. Every robot's name, the
-person's and the dock's are drawn, no two label boxes overlap (the page's
-``window.__map.labels()`` gives the boxes its last frame drew) and none lies under the map's
-controls; the Labels layer hides them all; where there is room for one label only, the robot's
-stays and the goal's gives way. Screenshots: map_labels_1400x900.png, map_labels_390x844.png."""
+charger and the others beside it on their way to the same goal, and a person the docked robot
+tracks. Every robot's name, the person's and the dock's are drawn, the goal is named once, no
+two label boxes overlap (the page's ``window.__map.labels()`` gives the boxes its last frame
+drew) and none lies under the map's controls; the Labels layer hides them all; where there is
+room for one label only, the robot's stays and the goal's gives way. Screenshots:
+map_labels_1400x900.png, map_labels_390x844.png."""
 
 from __future__ import annotations
 
@@ -35,13 +36,15 @@ pytestmark = pytest.mark.heavy
 CAMPUS_MAP = Path(__file__).resolve().parents[2] / "src/cyborg/app/data/campus.map"
 CHARGER = (2.0, 1.2)
 """The campus map's dock, "Charger"."""
+TO_OFFICE = {"st": "MOVING_TO_GOAL", "goal": {"name": "Office", "p": [11.0, 3.0, 0.0]}}
+"""Two robots drive to the campus map's goal "Office"."""
 ROBOTS: dict[str, tuple[float, float, float, dict[str, Any]]] = {
     "/cyborg": (*CHARGER, -1.571, {"bat": {"pct": 37, "charging": True, "dock": "DOCKED"},
                                    "node": "Charge"}),
     "/robot2": (2.6, 1.6, 0.0, {"bat": {"pct": 80, "charging": False, "dock": "UNDOCKED"},
-                                "node": "MoveTo Office"}),
+                                "node": "MoveTo Office", **TO_OFFICE}),
     "/robot3": (2.3, 0.7, 3.1, {"bat": {"pct": 55, "charging": False, "dock": "UNDOCKED"},
-                                "node": "MoveTo Library"}),
+                                "node": "MoveTo Office", **TO_OFFICE}),
 }
 PERSON = {"t": "obj", "ns": "/cyborg", "id": 1, "stamp": 0.0,
           "o": [{"id": 4, "label": "person", "x": 2.9, "y": 1.1, "vx": 0.0, "vy": 0.0,
@@ -87,6 +90,7 @@ def test_three_robots_at_the_charger_keep_every_label_clear_of_the_others(
                   if label["kind"] == "robot") == sorted(ROBOTS), texts
     assert "/cyborg · 37 % ⚡ · docked / Charge" in texts
     assert "Charger" in texts, "the dock's label gives way"
+    assert texts.count("Office") == 1, "a goal two robots drive to is named once"
     if on_map(page, "m.view().scale") >= 8:  # tracked objects are labelled from 8 px a metre
         assert "person #4" in texts, "the person's label gives way"
     for a, b in itertools.combinations(labels, 2):

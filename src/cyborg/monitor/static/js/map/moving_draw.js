@@ -57,14 +57,14 @@ export function drawMoving(ctx, scene) {
       if (scene.model.pathShown(robot)) drawn.paths += drawPath(ctx, view, robot);
     }
   }
-  const goalNames = [];
+  const driving = []; // the goals robots drive to: each named once, by the first robot's ring
   for (const robot of scene.robots) {
     if (robot.goal && scene.model.travelling(robot)) {
-      drawn.goals += drawGoal(ctx, view, robot, layout);
-      goalNames.push(robot.goal);
+      drawn.goals += drawGoal(ctx, view, robot, driving.some((goal) => sameGoal(goal, robot.goal)) ? null : layout);
+      driving.push(robot.goal);
     }
   }
-  if (layout && scene.map) addMapLabels(layout, view, scene.map, layers, goalNames);
+  if (layout && scene.map) addMapLabels(layout, view, scene.map, layers, driving);
   if (layers.laser) {
     for (const robot of scene.robots) if (robot.alive) drawn.laser += drawScan(ctx, view, robot);
   }
@@ -114,7 +114,7 @@ function addMapLabels(layout, view, map, layers, driving) {
     if (sx < 0 || sy < 0 || sx > view.width || sy > view.height) continue;
     const point = outline.length < 4;
     const own = point ? layout.marker(sx, sy, MAP_MARKER_PX) : -1;
-    if (!item.name || driving.some((goal) => goal.name === item.name && Math.hypot(goal.x - item.x, goal.y - item.y) < 0.5)) continue;
+    if (!item.name || driving.some((goal) => sameGoal(goal, item))) continue;
     layout.add({
       kind: point ? LABEL_KINDS[item.category] ?? "area" : "area", at: [sx, sy], own,
       gap: point ? MAP_MARKER_PX + 2 : 2, sides: point ? ["E"] : ["SE", "E"],
@@ -169,8 +169,14 @@ function lineTo(ctx, view, x, y, first) {
   else ctx.lineTo(sx, sy);
 }
 
+// Whether two goals ({name, x, y}) are the same: the same name, half a metre apart at most.
+function sameGoal(a, b) {
+  return a.name === b.name && Math.hypot(a.x - b.x, a.y - b.y) < 0.5;
+}
+
 // The goal the robot is on its way to: a ring in its colour, a tick for its heading (when the
-// robot turns to it there), and its name under it when labels are on (`layout`).
+// robot turns to it there), and its name under it when labels are on (`layout`; null for a
+// goal another robot's ring names already).
 function drawGoal(ctx, view, robot, layout) {
   const goal = robot.goal;
   const [sx, sy] = view.toScreen(goal.x, goal.y);
