@@ -9,9 +9,10 @@ Each quick variant runs in a process of its own (``python3 -m benchmarks.NAME --
 a time by default (``--jobs``): a quick variant is a smoke test, not a measurement, so sharing
 the machine does not matter. Each one's output is shown, whole, when it ends; then one line per
 benchmark gives its exit status, its wall time and its CPU time (user and system, its own child
-processes included: on a shared machine the wall time also counts the waits for a core). Exits
-1 when any of them failed, naming it. Full runs are long (the soak takes an hour) and are run
-one by one, as docs/benchmarks.md gives them.
+processes included: on a shared machine the wall time also counts the waits for a core). One
+still running after ``--timeout`` seconds (300) is stopped. Exits 1 when any of them failed,
+naming it. Full runs are long (the soak takes an hour) and are run one by one, as
+docs/benchmarks.md gives them.
 """
 
 from __future__ import annotations
@@ -53,33 +54,44 @@ def parser() -> argparse.ArgumentParser:
                          help="run the quick variants (without it: list the benchmarks)")
     options.add_argument("--jobs", type=int, default=2, metavar="N",
                          help="quick variants run at the same time (default 2)")
+    options.add_argument("--timeout", type=float, default=300.0, metavar="S",
+                         help="a quick variant still running after S seconds is stopped and "
+                              "counts as failed (default 300)")
     options.add_argument("names", nargs="*", metavar="NAME",
                          help="only these benchmarks (default: all)")
     return options
 
 
-def run_one(name: str, printing: threading.Lock) -> QuickRun:
-    """Runs ``python3 -m benchmarks.NAME --quick``; prints its output when it ends."""
+def run_one(name: str, timeout: float, printing: threading.Lock) -> QuickRun:
+    """Runs ``python3 -m benchmarks.NAME --quick``; prints its output when it ends.
+
+    After ``timeout`` seconds the process is killed (its exit status then is -9).
+    """
     started = time.monotonic()
     process = subprocess.Popen([sys.executable, "-m", f"benchmarks.{name}", "--quick"],
                                cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                text=True, errors="replace")
     assert process.stdout is not None
+    watchdog = threading.Timer(timeout, process.kill)
+    watchdog.start()
     output = process.stdout.read()
     process.stdout.close()
     _pid, wait_status, usage = os.wait4(process.pid, 0)  # its CPU, its own children included
+    watchdog.cancel()
     process.returncode = os.waitstatus_to_exitcode(wait_status)
+    if process.returncode == -9:
+        output += f"\nstopped after {timeout:g} s (--timeout)\n"
     with printing:
         print(f"== python3 -m benchmarks.{name} --quick\n{output}", flush=True)
     return QuickRun(name, process.returncode, time.monotonic() - started,
                     usage.ru_utime + usage.ru_stime)
 
 
-def run_quick(names: Sequence[str], jobs: int) -> list[QuickRun]:
+def run_quick(names: Sequence[str], jobs: int, timeout: float) -> list[QuickRun]:
     """Runs the quick variants of ``names``, ``jobs`` at a time; in the order of ``names``."""
     printing = threading.Lock()
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        return list(pool.map(lambda name: run_one(name, printing), names))
+        return list(pool.map(lambda name: run_one(name, timeout, printing), names))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -96,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
               "gives each full run's command and figures")
         return 0
     started = time.monotonic()
-    runs = run_quick(names, args.jobs)
+    runs = run_quick(names, args.jobs, args.timeout)
     for run in runs:
         print(f"{run.name:20} {'ok' if run.status == 0 else f'FAILED (exit {run.status})':16} "
               f"{run.seconds:5.1f} s, CPU {run.cpu:5.1f} s")

@@ -91,6 +91,14 @@ def test_every_quick_variant_runs_through_the_documented_command() -> None:
     assert "Traceback" not in result.stdout, result.stdout[-6000:]
 
 
+def test_a_quick_variant_past_its_time_is_stopped_and_counts_as_failed() -> None:
+    result = subprocess.run([sys.executable, "-m", "benchmarks", "--quick", "--timeout", "0.5",
+                             "modes"], cwd=ROOT, text=True, capture_output=True, timeout=60)
+    assert result.returncode == 1
+    assert "stopped after 0.5 s (--timeout)" in result.stdout
+    assert result.stdout.splitlines()[-1].endswith("; FAILED: modes"), result.stdout
+
+
 def test_a_benchmark_path_is_refused_with_where_it_is_written(tmp_path: Path) -> None:
     page = tmp_path / "page.md"
     page.write_text("Run `python3 benchmarks/bt_tick.py --quick`, or:\n\n```sh\n"
