@@ -4,7 +4,8 @@ charger and the others beside it on their way to the same goal, and a person the
 tracks. Every robot's name, the person's and the dock's are drawn, the goal is named once, no
 two label boxes overlap (the page's ``window.__map.labels()`` gives the boxes its last frame
 drew) and none lies under the map's controls; the Labels layer hides them all; where there is
-room for one label only, the robot's stays and the goal's gives way. Screenshots:
+room for one label only, the robot's stays and the goal's gives way; long names are cut so
+that a robot's label fits a phone. Screenshots:
 map_labels_1400x900.png, map_labels_390x844.png."""
 
 from __future__ import annotations
@@ -127,3 +128,24 @@ def test_where_one_label_fits_the_robot_keeps_it_and_the_goal_gives_way(
     }""")
     assert placed == ["/cyborg · 37 %"]
     assert errors == []
+
+
+def test_long_names_are_cut_so_that_a_robots_label_fits_a_phone(browser: Browser) -> None:
+    arnl_map = read_map(CAMPUS_MAP)
+    blob = pack_map_blob(arnl_map)
+    key = map_key(blob)
+    ns = "/" + "a_very_long_fleet_namespace_" * 3  # 85 characters
+    node = "MoveTo " + "somewhere far away " * 5
+    messages = [map_ref(ns, key, arnl_map),
+                robot_state(ns, 1, *CHARGER, 0.0, beams=11, node=node,
+                            bat={"pct": 37, "charging": True, "dock": "DOCKED"})]
+    with StandInMonitor({key: blob}, on_map=messages) as server:
+        errors: list[str] = []
+        page = open_map_page(browser, server.url, errors, 390, 844)
+        page.wait_for_function("window.__map.moving.names === 1", timeout=10000)
+        [label] = [found for found in on_map(page, "m.labels()") if found["kind"] == "robot"]
+        first, second = label["text"].split(" / ")
+        assert first == f"{ns[:31]}… · 37 % ⚡ · docked"
+        assert second == f"{node[:39]}…"
+        assert 0 <= label["x0"] < label["x1"] <= on_map(page, "m.view().width")
+        assert errors == []

@@ -118,7 +118,7 @@ function addMapLabels(layout, view, map, layers, driving) {
     layout.add({
       kind: point ? LABEL_KINDS[item.category] ?? "area" : "area", at: [sx, sy], own,
       gap: point ? MAP_MARKER_PX + 2 : 2, sides: point ? ["E"] : ["SE", "E"],
-      lines: [{ text: item.name, font: FONT, colour: MAP_TEXT }],
+      lines: [{ text: cut(item.name), font: FONT, colour: MAP_TEXT }],
     });
   }
 }
@@ -195,8 +195,7 @@ function drawGoal(ctx, view, robot, layout) {
   if (layout) {
     const own = layout.marker(sx, sy, GOAL_RING_PX + 1);
     if (goal.name) {
-      const name = goal.name.length > 40 ? `${goal.name.slice(0, 39)}…` : goal.name;
-      layout.add({ kind: "goal", rank: -1, at: [sx, sy], own, gap: GOAL_RING_PX + 3, sides: ["S", "N"], lines: [{ text: name, font: BOLD, colour: robot.colour }] });
+      layout.add({ kind: "goal", rank: -1, at: [sx, sy], own, gap: GOAL_RING_PX + 3, sides: ["S", "N"], lines: [{ text: cut(goal.name), font: BOLD, colour: robot.colour }] });
     }
   }
   return 1;
@@ -296,9 +295,14 @@ function drawRobot(ctx, view, robot, selected) {
 function addName(layout, view, robot, reach, selected) {
   const at = view.toScreen(robot.pose.x, robot.pose.y);
   const own = layout.marker(at[0], at[1], reach);
-  const lines = [{ text: robot.ns + batteryText(robot.battery) + (robot.alive ? "" : " (offline)"), font: ROBOT_FONT, colour: robot.colour }];
-  if (robot.node) lines.push({ text: robot.node.length > 40 ? `${robot.node.slice(0, 39)}…` : robot.node, font: FONT, colour: TEXT });
+  const lines = [{ text: cut(robot.ns, 32) + batteryText(robot.battery) + (robot.alive ? "" : " (offline)"), font: ROBOT_FONT, colour: robot.colour }];
+  if (robot.node) lines.push({ text: cut(robot.node), font: FONT, colour: TEXT });
   layout.add({ kind: "robot", rank: selected ? 0 : 1, at, own, gap: Math.max(NAME_GAP_PX, reach + 4), sides: ["E", "W"], lines });
+}
+
+// `text` cut to `most` characters (the last an ellipsis), so that a label fits a phone.
+function cut(text, most = 40) {
+  return text.length > most ? `${text.slice(0, most - 1)}…` : text;
 }
 
 function batteryText(battery) {
