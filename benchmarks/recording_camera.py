@@ -2,7 +2,7 @@
 
     python3 -m benchmarks.recording_camera                     # 60 s each, three rounds
     python3 -m benchmarks.recording_camera --seconds 10 --rounds 1   # a shorter measure
-    python3 -m benchmarks.recording_camera --quick     # a smoke test: 1 s, one round
+    python3 -m benchmarks.recording_camera --quick     # a smoke test: 0.5 s, one round
     python3 -m benchmarks.recording_camera --markdown          # the rows for docs/benchmarks.md
     python3 -m benchmarks.recording_camera --chunks            # the writer alone, flat out:
                                                                # chunk sizes x compressions
@@ -344,7 +344,7 @@ def chunks_report(frame: Frame, args: argparse.Namespace, folder: Path) -> None:
 
 def parser() -> argparse.ArgumentParser:
     """The benchmark's options."""
-    options = benchmark_options(__doc__, quick="--seconds 1 --rounds 1")
+    options = benchmark_options(__doc__, quick="--seconds 0.5 --rounds 1")
     options.add_argument("--seconds", type=float, default=60.0,
                          help="seconds of camera stream per measure (default 60)")
     options.add_argument("--rounds", type=int, default=3,
@@ -366,7 +366,7 @@ def parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> None:
     args = parser().parse_args(argv)
     if args.quick:
-        args.seconds, args.rounds = 1.0, 1
+        args.seconds, args.rounds = 0.5, 1
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     if not args.default_malloc:
         keep_large_buffers()  # as `cyborg record` does

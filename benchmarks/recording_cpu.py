@@ -2,7 +2,7 @@
 
     python3 -m benchmarks.recording_cpu               # 60 s each way, after a 10 s warm-up
     python3 -m benchmarks.recording_cpu --seconds 20  # a shorter measure
-    python3 -m benchmarks.recording_cpu --quick       # a smoke test: 1 s each way, after 2 s
+    python3 -m benchmarks.recording_cpu --quick       # a smoke test: 1 s each way, after 1 s
     python3 -m benchmarks.recording_cpu --markdown    # the rows for docs/benchmarks.md
     python3 -m benchmarks.recording_cpu --profile     # and where the in-process recorder's
                                                       # thread spends it (cProfile)
@@ -160,7 +160,7 @@ def describe(cost: Cost) -> tuple[str, str]:
 
 def parser() -> argparse.ArgumentParser:
     """The benchmark's options."""
-    options = benchmark_options(__doc__, quick="--seconds 1 --warm-up 2")
+    options = benchmark_options(__doc__, quick="--seconds 1 --warm-up 1")
     options.add_argument("--seconds", type=float, default=60.0,
                          help="wall seconds measured each way (default 60)")
     options.add_argument("--warm-up", type=float, default=10.0,
@@ -173,7 +173,7 @@ def parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> None:
     args = parser().parse_args(argv)
     if args.quick:
-        args.seconds, args.warm_up = 1.0, 2.0
+        args.seconds, args.warm_up = 1.0, 1.0
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     with tempfile.TemporaryDirectory() as folder:
         inside = in_process(args.seconds, args.warm_up, Path(folder), args.profile)

@@ -1,7 +1,7 @@
 """Soak: the whole `cyborg up` system as fast as the machine allows, for a wall-clock time.
 
     python3 -m benchmarks.soak [--minutes 60] [--markdown] [--detector]
-    python3 -m benchmarks.soak --quick     # a smoke test: 6 s (--minutes 0.1)
+    python3 -m benchmarks.soak --quick     # a smoke test: 3 s (--minutes 0.05)
 
 Starts what `cyborg up` starts — the simulated Pioneer LX on the bundled campus map, the tree
 runner with the bundled mission on modes on simulated time, the web monitor (on a free
@@ -101,7 +101,7 @@ def soak(minutes: float, detector: bool) -> dict[str, float]:
 
 def parser() -> argparse.ArgumentParser:
     """The benchmark's options."""
-    options = benchmark_options(__doc__, quick="--minutes 0.1")
+    options = benchmark_options(__doc__, quick="--minutes 0.05")
     options.add_argument("--minutes", type=float, default=60.0, help="wall-clock minutes")
     options.add_argument("--detector", action="store_true", help="run the camera and detector")
     return options
@@ -110,7 +110,7 @@ def parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> None:
     args = parser().parse_args(argv)
     if args.quick:
-        args.minutes = 0.1
+        args.minutes = 0.05
     limit_malloc_arenas()  # as `cyborg` does on start (cyborg.app.memory)
     result = soak(args.minutes, args.detector)
     verdict = "meets" if result["growth"] <= 1.10 and result["collisions"] == 0 else "MISSES"
