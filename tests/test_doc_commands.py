@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import importlib.util
 import io
 import os
 import re
@@ -138,6 +139,27 @@ def test_every_cyborg_command_of_a_code_block_is_one_the_command_line_takes() ->
                     refused.append(f"{command.where}: {command.text}\n    {errors.getvalue()}")
     assert parsed >= 50, "the README and docs give dozens of cyborg commands"
     assert not refused, "\n".join(refused)
+
+
+def test_every_other_python_command_names_modules_and_files_that_exist() -> None:
+    """``python3 -m MODULE`` names an importable module, and a file or folder it is given (a
+    word with a slash or a file suffix) is in the checkout; what each does is tested where its
+    module is."""
+    checked, missing = 0, []
+    for command in doc_commands("python3"):
+        for part in command.text.split("&&"):
+            words = shlex.split(part)
+            if words[:1] != ["python3"] or "benchmarks" in part:
+                continue
+            checked += 1
+            if words[1] == "-m" and importlib.util.find_spec(words[2]) is None:
+                missing.append(f"{command.where}: no module {words[2]}")
+            files = [word for word in words[1:] if not word.startswith(("-", "."))
+                     and ("/" in word or word.endswith((".py", ".txt", ".toml")))]
+            missing += [f"{command.where}: no {name}" for name in files
+                        if not (ROOT / name).exists()]
+    assert checked >= 5
+    assert not missing, "\n".join(missing)
 
 
 def test_a_synopsis_and_a_pipe_are_read_as_the_shell_reads_them() -> None:
