@@ -4,6 +4,9 @@ and the progress bars (`cyborg detect` on a video, `cyborg detect models fetch`)
 from __future__ import annotations
 
 import io
+import logging
+import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -11,7 +14,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cyborg.app.progress import ProgressBar, Unit
+from cyborg.app.rate_window import FallingBehind, PaceWindow
 from cyborg.app.status_line import StatusLine, fit_status
+from cyborg.app.terminal import NamesRobot
 from cyborg.bt import Status, Tree, load_tree, loads_tree
 from cyborg.bt.snapshot import TickSnapshot
 from tests.builders import N, project_json, registry, tree_json
@@ -163,3 +168,144 @@ def test_a_bar_ends_its_line_only_when_it_drew_one() -> None:
     bar.finish()
     assert "[" + "#" * 39 in terminal.getvalue() and "3.8/3.8 MB" in terminal.getvalue()
     assert terminal.getvalue().endswith("\n"), "what is printed next starts on its own line"
+
+
+# ------------------------------------------------------------- the terminal the line shares
+class Screen(Terminal):
+    """A terminal that keeps its rows as a screen shows them: ``\\r`` goes back to the row's
+    start, ``ESC [ K`` wipes the rest of it, ``\\n`` starts a new row, text overwrites."""
+
+    def rows(self) -> list[str]:
+        rows: list[str] = [""]
+        row: list[str] = []
+        column = 0
+        text = self.getvalue()
+        index = 0
+        while index < len(text):
+            if text.startswith("\x1b[K", index):
+                del row[column:]
+                index += 3
+                continue
+            char = text[index]
+            index += 1
+            if char == "\r":
+                column = 0
+            elif char == "\n":
+                rows[-1] = "".join(row)
+                rows.append("")
+                row, column = [], 0
+            else:
+                row[column:column + 1] = [char]
+                column += 1
+        rows[-1] = "".join(row)
+        return [line.rstrip() for line in rows if line.strip()]
+
+
+def test_log_records_and_prints_start_on_a_row_of_their_own_below_which_the_line_is_redrawn(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("COLUMNS", "60")
+    tree = load_tree(write_tree(tmp_path, {"name": "Runner", "title": "MoveTo room1"}))
+    screen = Screen()
+    root = logging.getLogger()
+    handler = logging.StreamHandler(screen)  # stderr, on the same terminal
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    monkeypatch.setattr(root, "handlers", [handler])
+    monkeypatch.setattr(sys, "stdout", screen)
+    clock = iter(range(100))
+    line = StatusLine(tree, screen, wall=lambda: float(next(clock)))
+    line.attach()
+    line.update(tree.tick())
+    logging.getLogger("cyborg.robot").warning("MoveTo room1: the way is blocked")
+    print("a node says", end="")  # a line in two writes, as print writes it
+    print(" hello")
+    line.update(tree.tick())
+    line.finish()
+    assert "tick      1  RUNNING  Test tree > MoveTo room1" in screen.getvalue()
+    rows = screen.rows()  # the warning took the line's row; the line is drawn again below
+    assert rows[0] == "WARNING cyborg.robot: MoveTo room1: the way is blocked", rows
+    assert rows[1] == "a node says hello", rows
+    assert rows[2] == "tick      2  RUNNING  Test tree > MoveTo room1", rows
+    assert rows[3].startswith("done after 2 ticks"), rows
+    for row in rows:
+        assert not ("tick " in row and ("WARNING" in row or "hello" in row)), rows
+    assert sys.stdout is screen and root.handlers == [handler], "put back when it ends"
+
+
+def test_a_fleets_log_records_name_their_robot() -> None:
+    stream = io.StringIO()
+    handler = logging.StreamHandler(stream)
+    handler.addFilter(NamesRobot(["/robot1", "/robot2", "/robot10"]))
+    logger = logging.getLogger("test.fleet")
+    logger.addHandler(handler)
+    logger.propagate = False
+
+    def log_from(thread_name: str, message: str) -> None:
+        thread = threading.Thread(target=logger.warning, args=(message,), name=thread_name)
+        thread.start()
+        thread.join()
+
+    try:
+        log_from("cyborg-tree /robot2/bt/tree_runner", "MoveTo room1: stalled")
+        log_from("/robot10/bt/tree_runner[cancel]", "cancel failed")
+        log_from("cyborg-tree /robot1/bt/tree_runner", "/robot1 is docked")  # named already
+        log_from("simulation", "a person walks")  # no robot's thread
+    finally:
+        logger.removeHandler(handler)
+    assert stream.getvalue().splitlines() == [
+        "/robot2: MoveTo room1: stalled", "/robot10: cancel failed", "/robot1 is docked",
+        "a person walks"]
+
+
+# ------------------------------------------------------------------ the pace of simulated time
+def test_the_pace_is_simulated_seconds_per_wall_second_over_the_window() -> None:
+    wall = [0.0]
+    pace = PaceWindow(lambda: wall[0], window=5.0)
+    assert pace.pace() is None
+    for step in range(21):  # 10 s at 30x, then 10 s at 7x
+        wall[0] = step * 0.5
+        pace.add(step * 0.5 * 30)
+    assert pace.pace() == pytest.approx(30.0)
+    for step in range(1, 21):
+        wall[0] = 10 + step * 0.5
+        pace.add(300 + step * 0.5 * 7)
+    assert pace.pace() == pytest.approx(7.0)
+
+
+def test_falling_behind_is_said_once_after_it_lasted_naming_the_load_and_what_to_do() -> None:
+    wall = [0.0]
+    behind = FallingBehind(30.0, lambda: wall[0], patience=10.0, load=lambda: (5.25, 2))
+    said = []
+    for step in range(60):
+        wall[0] = step * 0.5
+        pace = 29.0 if step < 4 else 7.1 if step < 40 else 6.0
+        if step == 10:
+            pace = 16.0  # above half the asked pace: the 10 s start again
+        said.append(behind.check(pace))
+    warnings = [(step, text) for step, text in enumerate(said) if text]
+    assert len(warnings) == 1
+    step, text = warnings[0]
+    assert step == 31  # below half from step 11 on (wall 5.5 s), 10 s later
+    assert "runs at " in text and "below half the 30x asked (--speed)" in text
+    assert "load average 5.2 on 2 CPUs" in text
+    assert "--speed 7" in text and "--speed 0" in text
+    assert FallingBehind(0.0, lambda: 0.0).check(0.5) is None, "as fast as possible: never"
+
+
+def test_the_live_line_shows_the_pace_reached_and_warns_once_when_it_falls_behind(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        caplog: pytest.LogCaptureFixture) -> None:
+    monkeypatch.setenv("COLUMNS", "80")
+    tree = load_tree(write_tree(tmp_path, {"name": "Runner", "title": "MoveTo room1"}))
+    wall = [0.0]
+    terminal = Screen()
+    line = StatusLine(tree, terminal, speed=30.0, wall=lambda: wall[0])
+    line.behind = FallingBehind(30.0, lambda: wall[0], load=lambda: (3.0, 2))
+    snapshot = tree.tick()
+    for step in range(300):  # 30 s of wall time at 7x
+        wall[0] = step * 0.1
+        snapshot.time = step * 0.1 * 7
+        line.update(snapshot)
+    rows = terminal.rows()
+    assert "7.0x/30x" in rows[-1], rows[-1]
+    warnings = [record for record in caplog.records if "runs at 7.0x" in record.getMessage()]
+    assert len(warnings) == 1 and warnings[0].levelno == logging.WARNING

@@ -11,6 +11,7 @@ from typing import Any, TextIO
 
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.status_line import StatusLine
+from cyborg.app.terminal import errors_on_one_line
 from cyborg.bt import (
     Clock,
     ManualClock,
@@ -200,7 +201,9 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
              until_done: bool = False, stream: TextIO | None = None) -> int:
     """Ticks ``tree`` in the foreground with a status line until done or Ctrl-C.
 
-    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0.
+    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0. A
+    node that raises is reported in one line (its id, label, the error and where it was
+    raised), and log records and the nodes' prints are written above the live line.
     """
     stream = stream or sys.stdout
     runner = TickLoop(tree, rate_hz=rate_hz)
@@ -210,14 +213,16 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
           "Ctrl-C stops", file=stream)
     previous = signal.signal(signal.SIGTERM, interrupt)
     interrupted = False
+    line.attach()
     try:
-        runner.run(max_ticks=max_ticks, until_done=until_done)
+        with errors_on_one_line():  # a node's error: one line naming it, never a traceback
+            runner.run(max_ticks=max_ticks, until_done=until_done)
     except KeyboardInterrupt:
         interrupted = True
         runner.stop()
     finally:
         signal.signal(signal.SIGTERM, previous)
-    line.finish(interrupted=interrupted)
+        line.finish(interrupted=interrupted)
     if interrupted:
         return 130
     return 1 if tree.last is not None and tree.last.status is Status.ERROR else 0

@@ -300,7 +300,9 @@ class TreeRunnerNode:
             raise RuntimeError("the tree runner is already started")
         if not self._enabled:
             self.runner.pause()
-        self._thread = threading.Thread(target=self._run, name="cyborg-tree", daemon=True)
+        # named after the node: a fleet's log records name their robot by it (app.terminal)
+        self._thread = threading.Thread(target=self._run, name=f"cyborg-tree {self.node.fq_name}",
+                                        daemon=True)
         self._thread.start()
 
     def _run(self) -> None:
