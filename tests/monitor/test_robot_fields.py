@@ -41,18 +41,19 @@ def test_any_field_is_taken_finite_or_refused_naming_it(vx: Any, pose: Any,
     try:
         x, y, theta = pose_field({"pose": pose}, "pose")
         assert max(abs(x), abs(y)) <= WORLD_LIMIT
-        assert theta is None or -math.pi <= theta <= math.pi
+        assert theta is None or abs(theta) <= math.tau
     except RobotCommandError as error:
         assert _refused_naming(error, "pose")
     try:
         for x, y, theta in tour_points({"points": points}):
             assert max(abs(x), abs(y)) <= WORLD_LIMIT
-            assert theta is None or abs(theta) <= math.pi
+            assert theta is None or abs(theta) <= math.tau
     except RobotCommandError as error:
         assert _refused_naming(error, "points")
 
 
-def test_a_heading_is_taken_modulo_a_full_turn_up_to_its_limit() -> None:
-    assert pose_field({"pose": [1, 2, 3 * math.pi]}, "pose")[2] == math.remainder(
-        3 * math.pi, math.tau)
+def test_a_heading_past_a_full_turn_is_taken_modulo_one_up_to_its_limit() -> None:
+    assert pose_field({"pose": [1, 2, 3.1416]}, "pose")[2] == 3.1416
+    assert pose_field({"pose": [1, 2, 5 * math.pi]}, "pose")[2] == math.remainder(
+        5 * math.pi, math.tau)
     assert pose_field({"pose": [1, 2, -ANGLE_LIMIT]}, "pose")[2] is not None

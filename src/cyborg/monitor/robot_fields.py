@@ -32,7 +32,8 @@ def short(value: Any) -> str:
 
 
 ANGLE_LIMIT = 10 * math.tau
-"""Largest heading a pose may give, in radians either way; it is taken modulo a full turn."""
+"""Largest heading a pose may give, in radians either way; past a full turn it is taken
+modulo one."""
 
 
 def _finite(value: Any) -> bool:
@@ -79,7 +80,9 @@ def _pose(value: Any, field: str) -> tuple[float, float, float | None]:
     if abs(numbers[2]) > ANGLE_LIMIT:
         raise RobotCommandError(f"{field}[2] is {short(value[2])}, not a heading in radians "
                                 f"(at most {ANGLE_LIMIT:.1f} either way)", field)
-    return numbers[0], numbers[1], math.remainder(numbers[2], math.tau)
+    heading = numbers[2]
+    return numbers[0], numbers[1], heading if abs(heading) <= math.tau else math.remainder(
+        heading, math.tau)
 
 
 def tour_points(command: dict[str, Any]) -> list[Waypoint]:

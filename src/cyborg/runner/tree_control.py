@@ -26,9 +26,7 @@ a reload or anything else the node does never delays them.
 
 from __future__ import annotations
 
-import json
 import logging
-import math
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -52,6 +50,7 @@ from cyborg.bus.services import Responder
 from cyborg.bus.wire import EntityKind, gid
 from cyborg.interfaces import tree_runner
 from cyborg.interfaces.tree_runner import HookAction, HookStatus
+from cyborg.runner.blackboard_view import blackboard_json
 
 log = logging.getLogger("cyborg.runner")
 
@@ -186,26 +185,9 @@ class TreeControl:
         return self._trigger(stepped, "stepping" if stepped else "no tick is waiting")
 
     def _on_blackboard(self, _request: GetBlackboard_Request) -> GetBlackboard_Response:
-        scopes = self.current().blackboard.as_dict()
-        return GetBlackboard.Response(
-            json=json.dumps(jsonable(scopes), sort_keys=True))
+        return GetBlackboard.Response(json=blackboard_json(self.current().blackboard.as_dict()))
 
     def destroy(self) -> None:
         """Stop following clients in the graph; the services go with the runner's node."""
         self._stop_watching()
 
-
-def jsonable(value: Any) -> Any:
-    """``value`` made into strict JSON, so that any blackboard can be shown.
-
-    Keys become strings, inf and nan strings too, other objects their repr.
-    """
-    if isinstance(value, dict):
-        return {str(key): jsonable(item) for key, item in value.items()}
-    if isinstance(value, list | tuple | set | frozenset):
-        return [jsonable(item) for item in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    if value is None or isinstance(value, str | int | float):
-        return value
-    return repr(value)
