@@ -1,7 +1,8 @@
 """The tree and the map speak to each other, in headless Chromium against the stand-in monitor
 (tests/monitor/map_page.py): the running node is written beside the robot, the current goal is
 ringed with its name, and selecting a node that names a goal (MoveTo's ``location``) rings
-that goal on the map and brings it into view; selecting another node clears it."""
+that goal on the map and brings it into view (also from under STOP); selecting another node
+clears it."""
 
 from __future__ import annotations
 
@@ -16,8 +17,10 @@ from tests.monitor.map_page import (
     ROBOT,
     START,
     StandInMonitor,
+    control_boxes,
     on_map,
     open_map_page,
+    overlap,
     pixel,
     robot_state,
 )
@@ -145,3 +148,30 @@ def test_selecting_a_node_that_names_a_goal_rings_it_on_the_map(
     page.wait_for_timeout(100)
     assert not _close(pixel(page, lx, ly - 16), HIGHLIGHT), "the ring is gone"
     assert errors == [], json.dumps(errors)
+
+
+def test_selecting_a_goal_hidden_under_stop_brings_it_out(browser: Browser,
+                                                          server: StandInMonitor) -> None:
+    errors: list[str] = []
+    page = open_map_page(browser, server.url, errors)
+    _show_tree(server)
+    page.wait_for_selector('g.node[data-id="to_goal_1"]')
+    # drag the map until Goal 1 lies under STOP
+    [stop] = control_boxes(page)["stop"]
+    box = page.locator("#map-canvas").bounding_box()
+    assert box is not None
+    gx, gy = on_map(page, f"m.toScreen({GOAL_1[0]}, {GOAL_1[1]})")
+    start = (box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.move(*start)
+    page.mouse.down()
+    target = ((stop[0] + stop[2]) / 2, (stop[1] + stop[3]) / 2)
+    page.mouse.move(start[0] + target[0] - gx, start[1] + target[1] - gy, steps=4)
+    page.mouse.up()
+    gx, gy = on_map(page, f"m.toScreen({GOAL_1[0]}, {GOAL_1[1]})")
+    assert overlap([gx - 5, gy - 5, gx + 5, gy + 5], stop), "under STOP first"
+    page.click('g.node[data-id="to_goal_1"]')
+    page.wait_for_function("window.__map.highlight()?.name === 'Goal 1'")
+    view = on_map(page, "m.view()")
+    assert on_map(page, f"m.toScreen({GOAL_1[0]}, {GOAL_1[1]})") == pytest.approx(
+        [view["width"] / 2, view["height"] / 2], abs=1), "the view pans to the goal"
+    assert errors == []

@@ -5,8 +5,9 @@
 // `location` first); the first of them that names a goal, dock or home of the map shown is the
 // target. It is drawn over everything that moves: two rings in a strong colour that pulse for
 // PULSE_MS after the selection and then stay, steady, until another node is selected (one that
-// names no goal clears it). When the target lies off screen (or within MARGIN_PX of an edge)
-// the view pans to it, once per selection; a map that loads later is searched again.
+// names no goal clears it). When the target lies off screen, within MARGIN_PX of an edge or
+// under one of the map's controls (the toolbar, the actions' bar, STOP: free_area.js), the view
+// pans to it, once per selection; a map that loads later is searched again.
 
 import { CATEGORY } from "./map_model.js";
 
@@ -50,12 +51,14 @@ export class GoalHighlight {
     return this.target;
   }
 
-  // Pans `view` so the target is on screen, once per selection; true when it moved the view.
-  reveal(view) {
+  // Pans `view` so the target is on screen and clear of the boxes `covered` ([x0, y0, x1, y1],
+  // CSS px: the map's controls), once per selection; true when it moved the view.
+  reveal(view, covered = []) {
     if (!this.target || this.revealed || !view.width) return false;
     this.revealed = true;
     const [sx, sy] = view.toScreen(this.target.x, this.target.y);
-    if (sx >= MARGIN_PX && sy >= MARGIN_PX && sx <= view.width - MARGIN_PX && sy <= view.height - MARGIN_PX) return false;
+    const hidden = covered.some(([x0, y0, x1, y1]) => sx + RING_PX > x0 && sx - RING_PX < x1 && sy + RING_PX > y0 && sy - RING_PX < y1);
+    if (!hidden && sx >= MARGIN_PX && sy >= MARGIN_PX && sx <= view.width - MARGIN_PX && sy <= view.height - MARGIN_PX) return false;
     view.centerOn(this.target.x, this.target.y);
     return true;
   }

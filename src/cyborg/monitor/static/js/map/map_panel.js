@@ -359,7 +359,7 @@ export class MapPanel {
     const followed = this.follow ? this.model.robots.get(selected) : null;
     if (followed && followed.pose) this.view.centerOn(followed.pose.x, followed.pose.y);
     this.goalHighlight.resolve(this.model.maps.get(this.shownKey) ?? null);
-    if (this.goalHighlight.reveal(this.view)) {
+    if (this.goalHighlight.reveal(this.view, this.covered)) {
       this.userMoved = true;
       this.follow = false; // the goal asked for is shown, not the robot
       this.hud.setFollow(false);
