@@ -17,12 +17,12 @@
 // detections, names}, labels() (the label boxes the last frame drew, CSS px on the canvas:
 // [{kind, text, x0, y0, x1, y1, leader}], labels.js), warnings, objectTip() (the tracked
 // object's tooltip text, or null), toScreen(x, y), toWorld(sx, sy), view(), colourOf(ns),
-// robot(ns), selected(), fetches, renders, where, frameMs, messageMs}; robot(ns) is a copy of what the page knows of a robot
-// (pose, mount, footprint, battery, alive, state, path and scan sizes, whether its path is
-// drawn and how far its end is, the running node, the current goal, the detector's objects
-// `seen` and the tracker's `tracked`, aged to now), or null; acting() what acting from the map stands
-// at ({robot, canAct, mode, points}); highlight() the goal ringed for the node selected in
-// the tree ({name, x, y, th, category}, or null).
+// robot(ns), selected(), fetches, renders, where, frameMs, messageMs}; robot(ns) is a copy of
+// what the page knows of a robot (pose, mount, footprint, battery, alive, state, path and scan
+// sizes, whether its path is drawn and how far its end is, the running node, the current goal,
+// the detector's objects `seen` and the tracker's `tracked`, aged to now), or null; acting()
+// what acting from the map stands at ({robot, canAct, mode, points}); highlight() the goal
+// ringed for the node selected in the tree ({name, x, y, th, category}, or null).
 
 import { colourOf, onRobotSelected, selectRobot, selectedRobot } from "../robots.js";
 import { MapActions } from "./actions.js";

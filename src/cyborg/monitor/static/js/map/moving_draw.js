@@ -195,7 +195,10 @@ function drawGoal(ctx, view, robot, layout) {
   if (layout) {
     const own = layout.marker(sx, sy, GOAL_RING_PX + 1);
     if (goal.name) {
-      layout.add({ kind: "goal", rank: -1, at: [sx, sy], own, gap: GOAL_RING_PX + 3, sides: ["S", "N"], lines: [{ text: cut(goal.name), font: BOLD, colour: robot.colour }] });
+      layout.add({
+        kind: "goal", rank: -1, at: [sx, sy], own, gap: GOAL_RING_PX + 3, sides: ["S", "N"],
+        lines: [{ text: cut(goal.name), font: BOLD, colour: robot.colour }],
+      });
     }
   }
   return 1;
@@ -246,7 +249,10 @@ function drawDetections(ctx, view, robot, items, layout) {
       const own = layout.marker(sx, sy, DIAMOND_PX);
       if (item.label) {
         const text = item.score === null ? item.label : `${item.label} ${Math.round(item.score * 100)} %`;
-        layout.add({ kind: "detection", rank: -(item.score ?? 0), at: [sx, sy], own, gap: DIAMOND_PX + 3, sides: ["E"], lines: [{ text, font: FONT, colour: TEXT }] });
+        layout.add({
+          kind: "detection", rank: -(item.score ?? 0), at: [sx, sy], own, gap: DIAMOND_PX + 3, sides: ["E"],
+          lines: [{ text, font: FONT, colour: TEXT }],
+        });
       }
     }
     count += 1;
@@ -295,7 +301,8 @@ function drawRobot(ctx, view, robot, selected) {
 function addName(layout, view, robot, reach, selected) {
   const at = view.toScreen(robot.pose.x, robot.pose.y);
   const own = layout.marker(at[0], at[1], reach);
-  const lines = [{ text: cut(robot.ns, 32) + batteryText(robot.battery) + (robot.alive ? "" : " (offline)"), font: ROBOT_FONT, colour: robot.colour }];
+  const name = cut(robot.ns, 32) + batteryText(robot.battery) + (robot.alive ? "" : " (offline)");
+  const lines = [{ text: name, font: ROBOT_FONT, colour: robot.colour }];
   if (robot.node) lines.push({ text: cut(robot.node), font: FONT, colour: TEXT });
   layout.add({ kind: "robot", rank: selected ? 0 : 1, at, own, gap: Math.max(NAME_GAP_PX, reach + 4), sides: ["E", "W"], lines });
 }
