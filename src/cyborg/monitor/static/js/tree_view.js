@@ -6,9 +6,9 @@
 // user folded it by hand. Status updates only change class names, so a 1,000-node tree takes
 // a live stream without redrawing.
 //
-// The tree is shown to be read, as Groot2 and rqt_bt show it: at READABLE_SCALE (labels at
-// 12 px), placed with its root at the top and the running path in view; the user pans (drag,
-// wheel) and zooms, "Fit in view" fits on request. Where the tree is larger than the view an
+// The tree is shown to be read, as Groot2 shows it: at READABLE_SCALE (labels at 12 px),
+// placed with its root at the top and the running path in view; the user pans (drag, wheel)
+// and zooms, "Fit all" fits on request. Where the tree is larger than the view an
 // overview (a minimap: every box, the running path, the part in view) sits in the corner; a
 // click or drag there moves the view. When the running path moves off-screen it is scrolled
 // into view, unless the user has panned or zoomed in the last FOLLOW_PAUSE_MS.
@@ -22,7 +22,7 @@ const PAD_PX = 18;
 const SIBLING_GAP = 14;
 const MAX_LABEL = 40;
 const FAR_SCALE = 0.35;
-export const READABLE_SCALE = 1;
+const READABLE_SCALE = 1;
 const FOLLOW_PAUSE_MS = 3000;
 const EDGE_MARGIN = 24;
 const OVERVIEW_WIDTH = 200;
