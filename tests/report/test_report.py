@@ -55,7 +55,11 @@ def test_goals_reached_and_failed_are_counted_with_their_times(
     assert int(tally.attrs["data-failed"]) == recorded.failed == 1
     rows = [[cell.all_text() for cell in row.children]
             for row in page.one("table", "goals").children[1].children]
-    assert rows[1] == ["0:35", "0:55", "20.0", "room2", "failed", "FAILED_MOVE"]
+    assert rows[1] == ["0:35", "0:55", "20.0", "room2", "failed", "FAILED_MOVE", "2.0"]
+    header = [cell.all_text() for cell in page.one("table", "goals").children[0].children[0]
+              .children]
+    assert header == ["start (wall)", "end (wall)", "took (s, wall)", "goal", "outcome",
+                      "path state", "left to go (m)"]  # no /clock: no simulated column
     assert [row[3] for row in rows] == ["room1", "room2", "room3", "dock"]
 
 
@@ -115,8 +119,8 @@ def test_detections_are_counted_per_class_and_minute(run: tuple[Mission, Page]) 
             for row in table.children[1].children}
     assert header == ["minute", "person", "chair"]
     assert rows == {"0": [2, 1], "1": [1, 0], "2": [1, 2], "all": [4, 3]}
-    assert "Counted from /cyborg/detector/detections" in page.section_text("detections",
-                                                                           "robot-0")
+    assert "Detections, counted from /cyborg/detector/detections" in page.section_text(
+        "detections", "robot-0")
 
 
 def test_warnings_list_the_log_and_what_went_wrong(run: tuple[Mission, Page]) -> None:

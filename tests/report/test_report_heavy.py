@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser
 
+from cyborg.report.build import build_report
 from tests.bus.test_multiprocess import free_port
 from tests.report.page_reader import polyline_points, read_page
 from tests.report.recordings import mission
@@ -70,3 +71,23 @@ def test_a_recorded_cyborg_up_run_shows_the_trajectory_and_a_goal(tmp_path: Path
     nodes = [row for row in page.find("tr", robot="robot-0") if "data-node" in row.attrs]
     assert len(nodes) > 5 and int(nodes[0].attrs["data-running"]) > 0
     assert int(page.one("polyline", "charge").attrs["data-points"]) > 5
+
+
+def test_the_page_fits_a_phone_390_px_wide(browser: Browser, tmp_path: Path) -> None:
+    """At 390 x 844 (a phone) nothing makes the page scroll sideways: wide tables scroll inside
+    their own box, charts and the map shrink, long names wrap."""
+    path = tmp_path / "run.mcap"
+    mission(path)
+    (tmp_path / "run.html").write_text(build_report(path), encoding="utf-8")
+    page = browser.new_page(viewport={"width": 390, "height": 844})
+    page.goto((tmp_path / "run.html").as_uri())
+    page.wait_for_load_state("load")
+    widths = page.evaluate("() => [document.documentElement.scrollWidth, "
+                           "document.body.scrollWidth, window.innerWidth]")
+    assert widths[0] <= 390 and widths[1] <= 390 and widths[2] == 390, widths
+    for selector in ("svg.map", "svg.chart", ".scroll:has(table.goals)",
+                     ".scroll:has(table.tree)", "table.meta", "nav"):
+        box = page.locator(selector).first.bounding_box()
+        assert box is not None and box["x"] >= 0 and box["x"] + box["width"] <= 390 + 0.5, (
+            selector, box)
+    page.close()

@@ -4,16 +4,19 @@
 MCAP recording (:mod:`cyborg.record`'s, or any in the rosbag2 layout) and writes a page a user
 opens in a browser, with no server: for each robot its tree with per-node status counts and
 times, the path it drove on its map, its battery over time with the docked and charging
-periods, the goals it reached and failed, what its detector saw per minute, and its warnings;
-a header with the run's metadata and the messages per topic.
+periods, the goals it reached and failed (what each path state means), the objects its
+tracker followed and its detector's detections per minute, and its warnings; a header with the
+run's metadata, its duration on the wall clock and in simulated time, and the messages per
+topic. Every figure says which clock it is on.
 
 * :mod:`cyborg.report.recording` — reading a file, complete or cut, and decoding the topics a
   report uses with the bus's message types;
 * :mod:`cyborg.report.robots` — which robots (namespaces) a recording holds, and their topics;
+* :mod:`cyborg.report.clocks` — the wall clock and simulated time (``/clock``) of a recording;
 * :mod:`cyborg.report.tree_stats` — per-node counts, running time and tick time;
 * :mod:`cyborg.report.goals` — goal attempts and their outcomes from the path state;
 * :mod:`cyborg.report.battery` — the charge, and the charging and docked periods;
-* :mod:`cyborg.report.detections` — objects per class per minute;
+* :mod:`cyborg.report.detections` — tracked objects and detections per class per minute;
 * :mod:`cyborg.report.warnings` — the log's warnings and what went wrong;
 * :mod:`cyborg.report.svg`, :mod:`cyborg.report.map_svg` — charts and the map, as inline SVG;
 * :mod:`cyborg.report.page`, :mod:`cyborg.report.sections` — the page and its sections;

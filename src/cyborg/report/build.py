@@ -3,8 +3,10 @@
 :func:`build_report` reads the recording (:mod:`cyborg.report.recording`), finds its robots
 (:mod:`cyborg.report.robots`) and gives each a section with its tree, its path on the map, its
 battery, its goals, its detections and its warnings; above them a header names the file, the
-run's metadata (cyborg version, start, command, map and tree files), its duration and the
-messages of every topic, and says so when the file was cut. Below them the log's warnings
+run's metadata (cyborg version, start, command, map and tree files), its duration (on the
+wall clock, and in simulated time when a simulator's ``/clock`` was recorded:
+:mod:`cyborg.report.clocks`) and the messages of every topic, and says so when the file was
+cut. Below them the log's warnings
 (``/rosout``, when recorded) and what could not be read. :func:`write_report` writes the page.
 """
 
@@ -16,17 +18,18 @@ from html import escape
 from pathlib import Path
 from typing import Any
 
-from cyborg.interfaces import detector, robot, tree_runner
+from cyborg.interfaces import detector, perception, robot, tree_runner
 from cyborg.interfaces.contract import Topic
 from cyborg.record.recorder import MAP_METADATA, RUN_METADATA
 from cyborg.report import sections
 from cyborg.report.battery import battery_history
-from cyborg.report.detections import detection_counts
-from cyborg.report.goals import goal_attempts
+from cyborg.report.clocks import CLOCK_SAMPLE_NS, RunClock, run_clock
+from cyborg.report.detections import detection_counts, tracked_counts
+from cyborg.report.goals import goal_attempts, measure_left
 from cyborg.report.map_svg import map_svg
 from cyborg.report.page import cell, document, note, row, section, table
 from cyborg.report.recording import Recording, read_recording
-from cyborg.report.robots import LOG_TOPIC, RobotTopics, find_robots, wanted
+from cyborg.report.robots import CLOCK_TOPIC, LOG_TOPIC, RobotTopics, find_robots, wanted
 from cyborg.report.svg import clock, number
 from cyborg.report.tree_stats import tree_history
 from cyborg.report.warnings import log_warnings, robot_warnings
@@ -41,14 +44,20 @@ def build_report(path: Path) -> str:
     Raises :class:`~cyborg.record.playback_source.RecordingError` naming the file when it is no
     recording (empty, foreign, cut inside its header) or cannot be read.
     """
-    return render(read_recording(path, wanted))
+    return render(read(path))
+
+
+def read(path: Path) -> Recording:
+    """The recording at ``path`` as a report reads it: the topics it draws, ``/clock`` sampled."""
+    return read_recording(path, wanted, every={CLOCK_TOPIC: CLOCK_SAMPLE_NS})
 
 
 def render(recording: Recording) -> str:
-    """The report of a recording read with :func:`~cyborg.report.robots.wanted` topics."""
+    """The report of a recording read with :func:`read`."""
     robots = find_robots({name: topic.type_name for name, topic in recording.topics.items()})
-    body = [_header(recording, robots)]
-    body += [_robot(recording, item, index) for index, item in enumerate(robots)]
+    clock = run_clock(recording.stamped(CLOCK_TOPIC))
+    body = [_header(recording, robots, clock)]
+    body += [_robot(recording, item, index, clock) for index, item in enumerate(robots)]
     if not robots:
         body.append(section("robots", "Robots", note(
             "No robot or tree runner in this recording: none of its topics is a robot's "
@@ -60,12 +69,12 @@ def render(recording: Recording) -> str:
 
 def write_report(path: Path, output: Path) -> Recording:
     """Writes the report of ``path`` to ``output``; returns what was read (for a summary)."""
-    recording = read_recording(path, wanted)
+    recording = read(path)
     output.write_text(render(recording), encoding="utf-8")
     return recording
 
 
-def _header(recording: Recording, robots: list[RobotTopics]) -> str:
+def _header(recording: Recording, robots: list[RobotTopics], clock: RunClock | None) -> str:
     run = recording.metadata_named(RUN_METADATA)
     values = run[-1] if run else {}
     rows = [row(f"<th>{escape(label)}</th>", cell(values[key]))
@@ -74,7 +83,7 @@ def _header(recording: Recording, robots: list[RobotTopics]) -> str:
         rows.append(row("<th>map published</th>",
                         cell(f"{item.get('source', '?')} on {item.get('topic', '?')}")))
     rows += [row("<th>file</th>", cell(f"{recording.path.name} ({_size(recording.size)})")),
-             row("<th>duration</th>", cell(clock(recording.duration))),
+             row("<th>duration</th>", cell(_duration(recording.duration, clock))),
              row("<th>messages</th>", cell(f"{recording.message_count:,} on "
                                            f"{len(recording.topics)} topics"))]
     parts = [f"<h1>Run report: {escape(recording.path.name)}</h1>"]
@@ -97,7 +106,7 @@ def _header(recording: Recording, robots: list[RobotTopics]) -> str:
     return "<header>" + "".join(parts) + "</header>"
 
 
-def _robot(recording: Recording, item: RobotTopics, index: int) -> str:
+def _robot(recording: Recording, item: RobotTopics, index: int, clock: RunClock | None) -> str:
     recorded = recording.topics
 
     def name(contract: Topic[Any]) -> str:
@@ -115,8 +124,9 @@ def _robot(recording: Recording, item: RobotTopics, index: int) -> str:
     parts = [sections.tree_section(tree, absent(tree_runner.STRUCTURE, tree_runner.STATUS)
                                    or [name(tree_runner.STRUCTURE)])]
     if item.has_robot:
-        poses = [(float(p.message.x), float(p.message.y))
-                 for p in recording.stamped(name(robot.POSE))]
+        stamped_poses = recording.stamped(name(robot.POSE))
+        measure_left(goals, stamped_poses)
+        poses = [(float(p.message.x), float(p.message.y)) for p in stamped_poses]
         maps = recording.stamped(name(robot.MAP_GEOMETRY))
         geometry = maps[-1].message if maps else None
         parts.append(sections.map_section(
@@ -127,15 +137,29 @@ def _robot(recording: Recording, item: RobotTopics, index: int) -> str:
             recording.duration, start, name(robot.BATTERY_STATUS)))
         parts.append(sections.goals_section(
             goals, start, [name(robot.PATH_STATE), name(robot.CURRENT_GOAL)],
-            absent(robot.PATH_STATE, robot.CURRENT_GOAL)))
+            absent(robot.PATH_STATE, robot.CURRENT_GOAL), clock))
         counts = detection_counts(
             (name(detector.DETECTIONS), recording.stamped(name(detector.DETECTIONS))),
             (name(detector.PREDICTIONS), recording.stamped(name(detector.PREDICTIONS))), start)
+        tracked = tracked_counts(name(perception.OBJECTS),
+                                 recording.stamped(name(perception.OBJECTS)), start)
         parts.append(sections.detections_section(
-            counts, recording.duration, [name(detector.DETECTIONS), name(detector.PREDICTIONS)]))
+            tracked, counts, recording.duration, name(perception.OBJECTS),
+            [name(detector.DETECTIONS), name(detector.PREDICTIONS)]))
     parts.append(sections.warnings_section(
         robot_warnings(goals, tree, recording.stamped(name(robot.BUMPER_STATE))), start))
     return section("robot", item.title, "".join(parts), level=2, anchor=f"robot-{index}")
+
+
+def _duration(wall: float, run: RunClock | None) -> str:
+    """The recording's duration on the wall clock, and in simulated time where that differs."""
+    text = f"{clock(wall)} wall clock (first to last message)"
+    if run is None:
+        return text + "; no /clock recorded: every time in this report is wall time"
+    if not run.differs:
+        return text + "; simulated time (/clock) kept the wall clock's pace"
+    return (f"{text}; {clock(run.duration)} simulated time (/clock), {number(run.pace, 1)}x "
+            "the wall clock")
 
 
 def _size(size: int) -> str:

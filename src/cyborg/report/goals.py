@@ -15,6 +15,8 @@ without ``arnl_path_state`` each named goal is an attempt whose outcome is unkno
 
 from __future__ import annotations
 
+import bisect
+import math
 from dataclasses import dataclass
 from enum import StrEnum
 
@@ -38,6 +40,25 @@ class Outcome(StrEnum):
     """Ended, but no path state says how (``arnl_path_state`` was not recorded)."""
 
 
+PATH_STATES: dict[str, str] = {
+    PathState.REACHED_GOAL: "reached: the navigator brought the robot to the goal",
+    PathState.FAILED_PLAN: "failed to plan: the map has no way to the goal from where the "
+                           "robot was (walls, forbidden areas)",
+    PathState.FAILED_MOVE: "failed on the way: the robot made no headway for too long (stuck, "
+                           "or people or objects in its way longer than it waits)",
+    PathState.ABORTED_PATHPLAN: "cancelled before the navigator finished: in cyborg most often "
+                                "a success, as MoveTo stops the robot once it is within its "
+                                "radius of the goal (see how far it was left to go); also when "
+                                "a higher branch of the tree took over (recharging, a greeting), "
+                                "MoveTo sent the goal again after no progress, or STOP",
+    PathState.INVALID: "invalid: the navigator could not take the goal",
+    PathState.PLANNING_PATH: "still planning when the recording ended",
+    PathState.MOVING_TO_GOAL: "still driving when the recording ended",
+    PathState.WAITING_FOR_PATH: "waiting for people or objects to make way when the recording "
+                                "ended",
+}
+"""What each path state a goal ends in means, in plain words (the report's legend)."""
+
 _OUTCOMES = {PathState.REACHED_GOAL: Outcome.REACHED, PathState.FAILED_PLAN: Outcome.FAILED,
              PathState.FAILED_MOVE: Outcome.FAILED, PathState.ABORTED_PATHPLAN: Outcome.CANCELLED,
              PathState.INVALID: Outcome.FAILED}
@@ -55,6 +76,9 @@ class GoalAttempt:
     """The path state it ended in (``REACHED_GOAL``, ``FAILED_MOVE``, ...)."""
     position: tuple[float, float] | None = None
     """Where the goal is (m, map frame), from ``current_goal``; None when not named there."""
+    left: float | None = None
+    """Metres from the robot to the goal where it stopped when the attempt ended
+    (:func:`measure_left`); None without an end, a goal position or a pose."""
 
 
 def goal_attempts(path_states: list[Stamped], goals: list[Stamped]) -> list[GoalAttempt]:
@@ -126,6 +150,23 @@ def _state(value: str) -> PathState | None:
         return PathState(value)
     except ValueError:
         return None
+
+
+def measure_left(attempts: list[GoalAttempt], poses: list[Stamped]) -> None:
+    """Sets each ended attempt's :attr:`~GoalAttempt.left` from the robot's pose then.
+
+    The robot stops when an attempt ends (reached, failed or cancelled), so the first pose at
+    or after the end is where it stopped (the last before it when none follows): a pose
+    published a few times a second under a fast simulator may lie metres behind the robot
+    just before. ``poses`` are ``geometry_msgs/Pose2D`` messages in log-time order.
+    """
+    times = [item.log_time for item in poses]
+    for attempt in attempts:
+        if attempt.end is None or attempt.position is None or not poses:
+            continue
+        index = min(bisect.bisect_left(times, attempt.end), len(poses) - 1)
+        pose = poses[index].message
+        attempt.left = math.dist((float(pose.x), float(pose.y)), attempt.position)
 
 
 def tally(attempts: list[GoalAttempt]) -> dict[Outcome, int]:

@@ -24,13 +24,20 @@ h1 { font-size: 22px; margin: 8px 0 4px; } h2 { font-size: 18px; margin: 32px 0 
   margin: 20px 0 6px; }
 table { border-collapse: collapse; margin: 6px 0; } th, td { padding: 2px 10px 2px 0;
   text-align: left; vertical-align: top; border-bottom: 1px solid var(--line); }
+.scroll { max-width: 100%; overflow-x: auto; } thead th { vertical-align: bottom; }
+.meta td { overflow-wrap: anywhere; } .meta th { white-space: nowrap; }
+td.state[title] { text-decoration: underline dotted; cursor: help; }
+dl.legend { margin: 6px 0; font-size: 13px; } dl.legend dt { font-weight: 600; }
+dl.legend dd { margin: 0 0 4px 16px; color: var(--muted); }
+@media (max-width: 600px) { body { padding: 8px 10px 32px; } h1 { font-size: 18px; }
+  h1, p, .note, .missing, summary { overflow-wrap: anywhere; } }
 td.n, th.n { text-align: right; font-variant-numeric: tabular-nums; }
 .meta th { color: var(--muted); font-weight: normal; }
 .cut, .missing, .note { padding: 6px 10px; border-radius: 4px; margin: 6px 0; }
 .cut { background: #fdecea; border-left: 4px solid var(--red); }
 .missing { background: #f4f6f7; color: var(--muted); border-left: 4px solid var(--line); }
 .note { color: var(--muted); }
-nav a { margin-right: 12px; }
+nav { display: flex; flex-wrap: wrap; gap: 4px 12px; }
 svg { display: block; width: 100%; height: auto; margin: 6px 0; }
 svg.map { max-height: 640px; background: #fafbfc; border: 1px solid var(--line); }
 .map .points { stroke: #9aa5ad; fill: none; } .map .walls { stroke: #2c3e50; fill: none; }
@@ -100,11 +107,16 @@ def cell(value: object, css: str = "") -> str:
 
 
 def table(headers: Sequence[str], rows: Iterable[str], css: str = "") -> str:
-    """A table with ``headers`` and ready-made ``<tr>`` rows."""
+    """A table with ``headers`` and ready-made ``<tr>`` rows.
+
+    It scrolls sideways in a box of its own when it is wider than the page (on a phone), so
+    the page itself never does.
+    """
     head = "".join(f"<th>{escape(header)}</th>" for header in headers)
     attribute = f' class="{escape(css)}"' if css else ""
     thead = f"<thead><tr>{head}</tr></thead>" if headers else ""
-    return f"<table{attribute}>{thead}<tbody>{''.join(rows)}</tbody></table>"
+    return (f'<div class="scroll"><table{attribute}>{thead}<tbody>{"".join(rows)}</tbody>'
+            "</table></div>")
 
 
 def row(*cells: str, attributes: str = "") -> str:

@@ -8,9 +8,11 @@ bag or a text file named ``.mcap``, a file cut inside its header, a missing file
 is no bag) is refused with :class:`~cyborg.record.playback_source.RecordingError` naming the
 file and what is wrong.
 
-Every message is counted; only those a report draws are decoded (``wanted(topic, type)``),
-with the bus's own message types (:class:`cyborg.bus.MessageTypes`, which learn a type the
-bus does not know from the recording's own definition), from the CDR bytes as they travelled.
+Every message is counted; only those a report draws are decoded (``wanted(topic, type)``;
+of a topic in ``every``, one message per so many nanoseconds of log time and the last: a
+simulator's ``/clock`` comes thousands of times a second), with the bus's own message types
+(:class:`cyborg.bus.MessageTypes`, which learn a type the bus does not know from the
+recording's own definition), from the CDR bytes as they travelled.
 A topic that cannot be read (an unknown type with no usable definition, another encoding), or
 a message that does not decode, is kept as a note in :attr:`Recording.problems`, never an
 error: the rest is still reported.
@@ -18,7 +20,7 @@ error: the rest is still reported.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -93,7 +95,8 @@ class Recording:
 
 
 def read_recording(path: Path, wanted: Callable[[str, str], bool],
-                   types: MessageTypes | None = None) -> Recording:
+                   types: MessageTypes | None = None, every: Mapping[str, int] | None = None
+                   ) -> Recording:
     """Reads ``path``; see the module. RecordingError names the file and what is wrong."""
     types = types or MessageTypes()
     source = open_recording(path, types)
@@ -106,28 +109,45 @@ def read_recording(path: Path, wanted: Callable[[str, str], bool],
         result.skipped = dict(sorted(source.skipped.items()))
         for name, why in result.skipped.items():
             result.problems.append(f"{name}: {why}; not read")
-        _decode(source, result, wanted, types)
+        _decode(source, result, wanted, types, every or {})
     finally:
         source.close()
     return result
 
 
 def _decode(source: Source, result: Recording, wanted: Callable[[str, str], bool],
-            types: MessageTypes) -> None:
-    """Decodes the messages of the wanted topics into ``result``."""
+            types: MessageTypes, every: Mapping[str, int]) -> None:
+    """Decodes the messages of the wanted topics into ``result`` (sampled as ``every`` says)."""
     decoded = {name for name, topic in source.topics.items() if wanted(name, topic.type_name)}
     failures: dict[str, int] = {}
+    taken: dict[str, int] = {}  # log time of the last message decoded, per sampled topic
+    passed: dict[str, Any] = {}  # the last message passed over, per sampled topic
     for played in source.messages():
         if played.topic not in decoded:
             continue
-        type_name = source.topics[played.topic].type_name
-        try:
-            message = types.deserialize(played.data, type_name)
-        except Exception as exc:  # a message the recording holds but our type cannot read
-            failed = failures[played.topic] = failures.get(played.topic, 0) + 1
-            if failed <= MAX_PROBLEMS_PER_TOPIC:
-                result.problems.append(f"{played.topic}: a message at "
-                                       f"{result.seconds(played.log_time):.1f} s does not "
-                                       f"decode as {type_name} ({exc})")
-            continue
-        result.messages.setdefault(played.topic, []).append(Stamped(played.log_time, message))
+        gap = every.get(played.topic)
+        if gap is not None:
+            if played.log_time - taken.get(played.topic, -gap) < gap:
+                passed[played.topic] = played
+                continue
+            taken[played.topic] = played.log_time
+            passed.pop(played.topic, None)
+        _decode_one(source, result, types, played, failures)
+    for played in passed.values():  # a sampled topic's last message, unless taken already
+        _decode_one(source, result, types, played, failures)
+
+
+def _decode_one(source: Source, result: Recording, types: MessageTypes, played: Any,
+                failures: dict[str, int]) -> None:
+    """Decodes one message into ``result``, or notes (the first few times) why it does not."""
+    type_name = source.topics[played.topic].type_name
+    try:
+        message = types.deserialize(played.data, type_name)
+    except Exception as exc:  # a message the recording holds but our type cannot read
+        failed = failures[played.topic] = failures.get(played.topic, 0) + 1
+        if failed <= MAX_PROBLEMS_PER_TOPIC:
+            result.problems.append(f"{played.topic}: a message at "
+                                   f"{result.seconds(played.log_time):.1f} s does not "
+                                   f"decode as {type_name} ({exc})")
+        return
+    result.messages.setdefault(played.topic, []).append(Stamped(played.log_time, message))

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from cyborg.interfaces import detector, robot, tree_runner
+from cyborg.interfaces import detector, perception, robot, tree_runner
 from cyborg.interfaces.contract import Topic
 
 ROBOT_TOPICS: tuple[Topic, ...] = (robot.POSE, robot.BATTERY_STATUS, robot.PATH_STATE,
@@ -25,6 +25,10 @@ ROBOT_TOPICS: tuple[Topic, ...] = (robot.POSE, robot.BATTERY_STATUS, robot.PATH_
 """The robot's topics a report reads (each also tells that a robot is there)."""
 TREE_TOPICS: tuple[Topic, ...] = (tree_runner.STRUCTURE, tree_runner.STATUS)
 DETECTOR_TOPICS: tuple[Topic, ...] = (detector.DETECTIONS, detector.PREDICTIONS)
+TRACKER_TOPICS: tuple[Topic, ...] = (perception.OBJECTS,)
+"""The robot's tracker's topics: its tracked objects, under the robot's namespace."""
+CLOCK_TOPIC = robot.CLOCK.name
+"""Simulated time, when a simulator ran (:mod:`cyborg.report.clocks`)."""
 LOG_TOPIC = "/rosout"
 """ROS 2's log topic; read when a recording holds it."""
 LOG_TYPE = "rcl_interfaces/msg/Log"
@@ -93,5 +97,7 @@ def wanted(topic: str, type_name: str) -> bool:
     """Whether a report decodes ``topic`` (of ``type_name``): the topics above, anywhere."""
     if topic == LOG_TOPIC:
         return type_name == LOG_TYPE
+    if topic == CLOCK_TOPIC:
+        return type_name == robot.CLOCK.type_name
     return any(_namespace_of(topic, type_name, (contract,)) is not None
-               for contract in (*ROBOT_TOPICS, *TREE_TOPICS, *DETECTOR_TOPICS))
+               for contract in (*ROBOT_TOPICS, *TREE_TOPICS, *DETECTOR_TOPICS, *TRACKER_TOPICS))

@@ -10,19 +10,24 @@ tests, find them without parsing the prose.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 from html import escape
 
 from cyborg.report.battery import BatteryHistory
+from cyborg.report.clocks import RunClock
 from cyborg.report.detections import DetectionCounts
-from cyborg.report.goals import GoalAttempt, Outcome, tally
+from cyborg.report.goals import PATH_STATES, GoalAttempt, Outcome, tally
 from cyborg.report.page import cell, missing, note, row, section, table
-from cyborg.report.svg import Periods, Series, clock, number, time_chart
+from cyborg.report.svg import Periods, Series, number, time_chart
+from cyborg.report.svg import clock as m_ss
 from cyborg.report.tree_stats import STATUSES, TreeHistory, TreeRun
 from cyborg.report.warnings import WarningRow
 
 MAX_TABLE_ROWS = 1000
 """The most rows a goals or warnings table lists; the rest are counted under it."""
+WALL_AXIS = "wall time since the recording began"
+"""How a chart names its time axis: every chart is drawn on the recording's wall clock."""
 
 
 def tree_section(history: TreeHistory, topics: Sequence[str]) -> str:
@@ -63,8 +68,8 @@ def _tree_run(run: TreeRun, *, multiple: bool) -> str:
                       if run.root_counts[status])
     body = (f'<p data-ticks="{run.ticks}">{escape(heading)}'
             f'{escape("; the root returned " + roots) if roots else ""}.</p>'
-            + table(["node", "success", "failure", "running", "error", "running time (s)",
-                     "mean tick time (ms)"], rows, "tree"))
+            + table(["node", "success", "failure", "running", "error",
+                     "running time (s, tree clock)", "mean tick time (ms, wall)"], rows, "tree"))
     explained = note("Counts are ticks in which the node returned each status. Running time is "
                      "the tree's clock (simulated time under a simulator) from each tick the "
                      "node returned running to the next tick; tick time is the wall time its "
@@ -96,7 +101,8 @@ def battery_section(history: BatteryHistory, duration: float, start: int, topic:
         return [((a - start) / 1e9, (b - start) / 1e9) for a, b in pairs]
 
     points = [((when - start) / 1e9, value) for when, value in history.charge]
-    chart = time_chart("charge (%)", [Series("charge", "charge", points)], duration=duration,
+    chart = time_chart(f"charge (%) by {WALL_AXIS}", [Series("charge", "charge", points)],
+                       duration=duration,
                        y_range=(0.0, 100.0), y_unit="%",
                        periods=[Periods("charging", "charging", span(history.charging)),
                                 Periods("docked", "docked", span(history.docked))])
@@ -108,8 +114,8 @@ def battery_section(history: BatteryHistory, duration: float, start: int, topic:
 
 
 def goals_section(attempts: list[GoalAttempt], start: int, topics: Sequence[str],
-                  absent: Sequence[str]) -> str:
-    """The goals driven to, with their outcome and times."""
+                  absent: Sequence[str], clock: RunClock | None = None) -> str:
+    """The goals driven to: outcome, times (both clocks where they differ), path states' legend."""
     if len(absent) == len(topics):
         return section("goals", "Goals", missing(absent))
     counts = tally(attempts)
@@ -119,47 +125,98 @@ def goals_section(attempts: list[GoalAttempt], start: int, topics: Sequence[str]
     parts.append(f'<p class="tally" data-reached="{counts[Outcome.REACHED]}" '
                  f'data-failed="{counts[Outcome.FAILED]}" '
                  f'data-cancelled="{counts[Outcome.CANCELLED]}">{escape(summary)}.</p>')
+    simulated = clock is not None and clock.differs
     rows = []
     for attempt in attempts[:MAX_TABLE_ROWS]:
         began = (attempt.start - start) / 1e9
         ended = (attempt.end - start) / 1e9 if attempt.end is not None else None
-        rows.append(row(cell(clock(began)),
-                        cell(clock(ended) if ended is not None else ""),
-                        cell(float(number(ended - began, 1))) if ended is not None else cell(""),
-                        cell(attempt.name or "(unnamed)"),
-                        cell(attempt.outcome.value, f"outcome {attempt.outcome.value}"),
-                        cell(attempt.state),
-                        attributes=f'data-outcome="{attempt.outcome.value}"'))
+        took = [cell(float(number(ended - began, 1))) if ended is not None else cell("")]
+        if simulated:
+            assert clock is not None
+            took.append(cell(float(number(clock.simulated_span(attempt.start, attempt.end), 1)))
+                        if attempt.end is not None else cell(""))
+        meaning = PATH_STATES.get(attempt.state, "")
+        state = (f'<td class="state" title="{escape(meaning)}">{escape(attempt.state)}</td>'
+                 if meaning else cell(attempt.state))
+        rows.append(row(cell(m_ss(began)), cell(m_ss(ended) if ended is not None else ""),
+                        *took, cell(attempt.name or "(unnamed)"),
+                        cell(attempt.outcome.value, f"outcome {attempt.outcome.value}"), state,
+                        cell(float(number(attempt.left, 1))) if attempt.left is not None
+                        else cell(""), attributes=f'data-outcome="{attempt.outcome.value}"'))
     if attempts:
-        parts.append(table(["start", "end", "took (s)", "goal", "outcome", "path state"], rows,
-                           "goals"))
+        headers = ["start (wall)", "end (wall)", "took (s, wall)",
+                   *(["took (s, simulated)"] if simulated else []), "goal", "outcome",
+                   "path state", "left to go (m)"]
+        parts.append(table(headers, rows, "goals"))
     if len(attempts) > MAX_TABLE_ROWS:
         parts.append(note(f"and {len(attempts) - MAX_TABLE_ROWS} more goals"))
+    parts.append(_states_legend([attempt.state for attempt in attempts]))
+    both = (f" Took: on the wall clock (the recorder's), and in simulated time (the "
+            f"simulator's /clock, which ran {number(clock.pace, 1)}x as fast)."
+            if simulated and clock is not None else "")
+    parts.append(note("Start and end are wall time since the recording began (m:ss)." + both
+                      + " Left to go: the robot's distance to the goal when the attempt ended."))
     return section("goals", "Goals", "".join(parts))
 
 
-def detections_section(counts: DetectionCounts, duration: float, topics: Sequence[str]) -> str:
-    """Objects seen per minute and class: a chart of the most frequent classes and a table."""
-    if not counts.source:
-        return section("detections", "Detections", missing(topics))
+def _states_legend(states: Sequence[str]) -> str:
+    """What each path state that ``states`` holds means, the most frequent first."""
+    counts = Counter(state for state in states if state in PATH_STATES)
+    if not counts:
+        return ""
+    items = "".join(f'<dt data-state="{escape(state)}">{escape(state)} ({count})</dt>'
+                    f"<dd>{escape(PATH_STATES[state])}</dd>"
+                    for state, count in counts.most_common())
+    return f'<dl class="legend states">{items}</dl>'
+
+
+def detections_section(tracked: DetectionCounts, detected: DetectionCounts, duration: float,
+                       tracked_topic: str, detected_topics: Sequence[str]) -> str:
+    """What the robot saw per minute and class, two counts each named for what it counts.
+
+    The objects its tracker followed (distinct track ids) and its detector's detections (one
+    per object per camera frame).
+    """
+    parts = []
+    if tracked.source:
+        parts.append(_counts(tracked, duration, "tracked", "objects tracked per minute (distinct "
+                             f"track ids), by {WALL_AXIS}"))
+        if tracked.classes:
+            people = ", ".join(f"{label}: {tracked.totals[label]}" for label in tracked.classes)
+            parts.append(note(f"Tracked objects, counted from {tracked.source}: each object the "
+                              "robot's tracker followed counts once a minute and once in all "
+                              f"({people}); one it lost and found again counts again."))
+    else:
+        parts.append(missing([tracked_topic], "the tracker's objects"))
+    if detected.source:
+        parts.append(_counts(detected, duration, "detections", "detections per minute (one per "
+                             f"object per camera frame), by {WALL_AXIS}"))
+        if detected.classes:
+            parts.append(note(f"Detections, counted from {detected.source}: every object in "
+                              "every camera frame, so one person in view for a minute counts "
+                              "hundreds of times."))
+    else:
+        parts.append(missing(detected_topics))
+    return section("detections", "Detections", "".join(parts))
+
+
+def _counts(counts: DetectionCounts, duration: float, css: str, title: str) -> str:
+    """A chart of the most frequent classes per minute, and a table of all of them."""
     classes = counts.classes
-    minutes = range(int(duration // 60) + 1)
     if not classes:
-        return section("detections", "Detections",
-                       note(f"{counts.source}: recorded, no object seen."))
+        return note(f"{counts.source}: recorded, no object seen.")
+    minutes = range(int(duration // 60) + 1)
     series = [Series(label, f"c{colour}", [(minute * 60.0 + 30.0, float(counts.seen(minute, label)))
                                            for minute in minutes])
               for colour, label in enumerate(classes[:5])]
-    chart = time_chart("objects per minute", series, duration=max(duration, 60.0))
+    chart = time_chart(title, series, duration=max(duration, 60.0))
     rows = [row(cell(f"{minute}"), *(cell(counts.seen(minute, label)) for label in classes),
                 attributes=f'data-minute="{minute}"')
             for minute in minutes if minute in counts.per_minute]
     totals = counts.totals
     rows.append(row(cell("all"), *(cell(totals[label]) for label in classes),
                     attributes='class="total"'))
-    return section("detections", "Detections",
-                   chart + table(["minute", *classes], rows, "detections")
-                   + note(f"Counted from {counts.source}."))
+    return chart + table(["minute", *classes], rows, css)
 
 
 def warnings_section(rows_in: list[WarningRow], start: int) -> str:
@@ -172,7 +229,7 @@ def warnings_section(rows_in: list[WarningRow], start: int) -> str:
 
 def warnings_table(rows_in: list[WarningRow], start: int) -> str:
     """The rows of a warnings table (at most :data:`MAX_TABLE_ROWS`)."""
-    rows = [row(cell(clock((item.log_time - start) / 1e9)), cell(item.level, f"level "
+    rows = [row(cell(m_ss((item.log_time - start) / 1e9)), cell(item.level, f"level "
                                                                  f"{item.level}"),
                 cell(item.source), cell(item.text))
             for item in rows_in[:MAX_TABLE_ROWS]]

@@ -132,11 +132,11 @@ def time_chart(title: str, series: Sequence[Series], *, duration: float,
         text = " ".join(f"{number(x(t))},{number(y(v))}" for t, v in points)
         parts.append(f'<polyline class="line {escape(line.css)}" data-points="{len(points)}" '
                      f'points="{text}"><title>{escape(line.name)}</title></polyline>')
-    legend_x = left + 180
+    legend_x = left  # the legend's line lies between the title's and the plot
     for name, css_class in [(line.name, line.css) for line in series] + \
             [(shaded.name, shaded.css) for shaded in periods if shaded.spans]:
-        parts.append(f'<rect class="key {escape(css_class)}" x="{legend_x}" y="5" width="12" '
-                     f'height="10"/><text class="axis" x="{legend_x + 16}" y="14">'
+        parts.append(f'<rect class="key {escape(css_class)}" x="{legend_x}" y="19" width="12" '
+                     f'height="10"/><text class="axis" x="{legend_x + 16}" y="28">'
                      f'{escape(name)}</text>')
         legend_x += 24 + 7 * len(name)
     parts.append("</svg>")
