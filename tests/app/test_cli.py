@@ -9,11 +9,14 @@ import signal
 import socket
 import subprocess
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
 from cyborg.app.cli import main
+from cyborg.bt import default_registry
 from tests.builders import N, project_json, tree_json
 from tests.conftest import shared_dir
 from tests.doc_commands import ROOT, doc_commands
@@ -80,17 +83,27 @@ def test_validate_unknown_custom_nodes_and_stubs(tmp_path: Path,
     assert main(["bt", "validate", str(path), "--stub-missing", "success"]) == 0
 
 
+@pytest.fixture
+def own_registered(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The test's nodes are registered in a copy of the decorator's registry, dropped after."""
+    from cyborg.bt import registry as registry_module
+
+    default_registry()  # the robot's nodes are in (an entry point), as in any command
+    monkeypatch.setattr(registry_module, "_REGISTERED", registry_module._REGISTERED.copy())
+
+
 def test_validate_with_user_node_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                        capsys: pytest.CaptureFixture[str]) -> None:
-    (tmp_path / "robot_nodes.py").write_text(
+                                        capsys: pytest.CaptureFixture[str],
+                                        own_registered: None) -> None:
+    (tmp_path / "robot_nodes.py").write_text(  # stand-ins for the robot's nodes, on purpose
         "from cyborg.bt import Action, Decorator, Status, register\n"
-        "@register\nclass MoveTo(Action):\n"
+        "@register('MoveTo', override=True)\nclass MoveTo(Action):\n"
         "    def __init__(self, location: str, radius: float = 0.5) -> None: ...\n"
         "    def tick(self) -> Status: return Status.SUCCESS\n"
-        "@register\nclass CheckBattery(Decorator):\n"
+        "@register('CheckBattery', override=True)\nclass CheckBattery(Decorator):\n"
         "    def __init__(self, threshold: float) -> None: ...\n"
         "    def tick(self) -> Status: return Status.FAILURE\n"
-        "@register\nclass Charge(Action):\n"
+        "@register('Charge', override=True)\nclass Charge(Action):\n"
         "    def __init__(self, target: float) -> None: ...\n"
         "    def tick(self) -> Status: return Status.SUCCESS\n")
     monkeypatch.syspath_prepend(str(tmp_path))
@@ -98,6 +111,38 @@ def test_validate_with_user_node_module(tmp_path: Path, monkeypatch: pytest.Monk
     assert main(["bt", "nodes", "--nodes", "robot_nodes"]) == 0
     out = capsys.readouterr().out
     assert "MoveTo" in out and "{location, radius=0.5}" in out
+    monkeypatch.delitem(sys.modules, "robot_nodes")
+
+
+SAY_NODES = """  # a user's Say, as the README's example had it
+from cyborg.bt import Action, Status, register
+
+@register{how}
+class Say(Action):
+    def __init__(self, text: str = "hello") -> None:
+        self.text = text
+    def tick(self) -> Status:
+        print(self.text)
+        return Status.SUCCESS
+"""
+
+
+def test_a_users_node_named_as_a_robot_node_is_refused_naming_both_unless_it_overrides(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+        own_registered: None) -> None:
+    (tmp_path / "my_nodes.py").write_text(SAY_NODES.format(how=""))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert main(["bt", "nodes", "--nodes", "my_nodes"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert "node name 'Say' is taken by cyborg.robot.say.Say (from cyborg.robot.say); " \
+           "my_nodes.Say (from my_nodes) would replace it: register it with override=True" in err
+    monkeypatch.delitem(sys.modules, "my_nodes", raising=False)
+    (tmp_path / "my_nodes.py").write_text(SAY_NODES.format(how="('Say', override=True)"))
+    assert main(["bt", "nodes", "--nodes", "my_nodes"]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("Say ")]
+    assert len(said) == 1 and said[0].endswith("[my_nodes]"), said
+    monkeypatch.delitem(sys.modules, "my_nodes")
 
 
 def test_bad_node_module_is_a_one_line_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -251,3 +296,95 @@ def test_up_refuses_a_tree_whose_goals_are_not_on_the_map() -> None:
                            "--duration", "3"], capture_output=True, text=True, timeout=60)
     assert runs.returncode == 0, runs.stderr
     assert "no goal" not in runs.stderr
+
+
+HOME_NODES = """
+from cyborg.bt import Action, Condition, Status, register
+from cyborg.robot import robot_of
+
+@register("AtHome?")
+class AtHome(Condition):
+    def tick(self) -> bool:                 # True/False mean SUCCESS/FAILURE
+        pose = robot_of(self).pose
+        return pose is not None and abs(pose.x) + abs(pose.y) < 1.0
+
+@register("Broken")
+class Broken(Action):
+    def tick(self) -> Status:
+        raise ValueError("the sensor is unplugged")
+"""
+
+
+def test_a_node_that_calls_robot_of_is_refused_before_the_first_tick_in_one_line(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+        caplog: pytest.LogCaptureFixture, own_registered: None) -> None:
+    (tmp_path / "home_nodes.py").write_text(HOME_NODES)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    path = _write(tmp_path, project_json([tree_json(
+        N("Sequence", N("AtHome?", id="home"), N("Succeeder", id="s"), id="seq"),
+        title="Home")]))
+    assert main(["bt", "run", str(path), "--nodes", "home_nodes", "--ticks", "3"]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1, captured.err
+    assert lines[0].startswith(f"{path}: 1 node (AtHome?) need a robot"), lines[0]
+    assert "tick" not in captured.out, "nothing was ticked"
+    assert main(["bt", "run", str(path), "--nodes", "home_nodes", "--ticks", "2",
+                 "--stub-missing", "success", "--fast"]) == 0
+    assert "node 'AtHome?' needs a 'robot' resource and this tree has none; a stub stands in" \
+        in caplog.text
+    assert "done after 2 ticks; last root status SUCCESS" in capsys.readouterr().out
+    sys.modules.pop("home_nodes", None)
+
+
+def test_a_node_that_raises_in_bt_run_is_one_line_naming_it_never_a_traceback(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+        own_registered: None) -> None:
+    (tmp_path / "sensor_nodes.py").write_text(HOME_NODES)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    path = _write(tmp_path, project_json([tree_json(N("Broken", id="b", title="Read sensor"),
+                                                    title="Broken")]))
+    with _root_log_to_stderr():
+        code = main(["bt", "run", str(path), "--nodes", "sensor_nodes", "--ticks", "2", "--fast"])
+    assert code == 1  # the root ends in ERROR
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    errors = [line for line in err.splitlines() if "raised in tick" in line]
+    assert len(errors) == 1, err  # said once: the second tick raises the same again
+    assert "node b (Read sensor, Broken) raised in tick" in errors[0]
+    assert "ValueError: the sensor is unplugged (at " in errors[0]
+    assert "sensor_nodes.py:" in errors[0] and "in tick)" in errors[0]
+    sys.modules.pop("sensor_nodes", None)
+
+
+@contextmanager
+def _root_log_to_stderr() -> Iterator[None]:
+    """The root logger writes to this test's stderr, as `cyborg` configures it."""
+    import logging
+
+    root = logging.getLogger()
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    saved = root.handlers
+    root.handlers = [handler]
+    try:
+        yield
+    finally:
+        root.handlers = saved
+
+
+def test_the_readmes_node_package_loads_beside_the_robots_nodes_and_its_tree_is_refused(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+        own_registered: None) -> None:
+    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    block = readme.split("# my_robot/nodes.py\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "readme_nodes.py").write_text(block)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert main(["bt", "nodes", "--nodes", "readme_nodes"]) == 0
+    listed = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()}
+    assert listed["Say"].endswith("[cyborg.robot.say]"), "the robot's Say stays the robot's"
+    assert listed["Shout"].endswith("[readme_nodes]") and "AtHome?" in listed  # as it says
+    path = _write(tmp_path, project_json([tree_json(N("AtHome?", id="home"), title="Home")]))
+    assert main(["bt", "run", str(path), "--nodes", "readme_nodes", "--ticks", "1"]) == 2
+    assert "1 node (AtHome?) need a robot" in capsys.readouterr().err
+    sys.modules.pop("readme_nodes", None)

@@ -203,6 +203,21 @@ def test_a_bad_v1_time_is_named_as_the_file_names_it(tmp_path: Path, name: str, 
     assert fragment in error.message and "milliseconds" not in error.message
 
 
+def test_messages_about_a_renamed_v1_arg_name_it_as_the_file_does(tmp_path: Path) -> None:
+    """A v1 Wait's ``time`` is cyborg's ``milliseconds``, behavior3lua's RepeatUntilSuccess's
+    ``maxLoop`` cyborg's ``count``: a warning or error names the file's arg, never ours."""
+    path = _write(tmp_path, "renamed.json", _node(1, "Sequence",
+                  _node(2, "Wait", args={"time": 1, "random": 0.5}),
+                  _node(3, "RepeatUntilSuccess", _node(4, "JustSuccess"), args={"maxLoop": "x"})))
+    problems = {p.node_id: p for p in check_file(path) if p.field != "input"}
+    wait, repeat = problems["2"], problems["3"]
+    assert "unknown property 'random' is ignored (known: time)" in wait.message
+    assert (repeat.field, repeat.is_error) == ("maxLoop", True)
+    assert repeat.message.startswith("property 'maxLoop': expected")
+    assert not any(word in p.message for p in problems.values()
+                   for word in ("milliseconds", "'count'"))
+
+
 def test_a_v1_time_written_as_text_is_read_as_seconds(tmp_path: Path) -> None:
     path = _write(tmp_path, "wait.json", _node(1, "Wait", args={"time": "1.5"}))
     assert load_tree(path).by_uid["1"].properties == {"milliseconds": 1500}

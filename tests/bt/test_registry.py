@@ -142,6 +142,18 @@ def test_custom_decorator_node() -> None:
     assert tree.tick().status is Status.SUCCESS
 
 
+def _installed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, module: str,
+               entry_points: str) -> None:
+    """The module ``module`` (already written in ``tmp_path``) installed as pip installs a
+    package: its dist-info declares ``entry_points``, and it is on the path."""
+    dist = tmp_path / f"{module}-1.0.dist-info"
+    dist.mkdir()
+    name = module.replace("_", "-")
+    (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text(entry_points)
+    monkeypatch.syspath_prepend(str(tmp_path))
+
+
 def test_entry_points_add_nodes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     (tmp_path / "greeting_nodes.py").write_text(textwrap.dedent("""
         from cyborg.bt import Action, Status, register
@@ -157,13 +169,9 @@ def test_entry_points_add_nodes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch)
             def tick(self) -> Status:
                 return Status.RUNNING
         """))
-    dist = tmp_path / "greeting_nodes-1.0.dist-info"
-    dist.mkdir()
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: greeting-nodes\nVersion: 1.0\n")
-    (dist / "entry_points.txt").write_text(
-        "[cyborg.nodes]\nmodule = greeting_nodes\nGreet = greeting_nodes:Greet\n"
-        "broken = greeting_nodes_missing\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
+    _installed(tmp_path, monkeypatch, "greeting_nodes",
+               "[cyborg.nodes]\nmodule = greeting_nodes\nGreet = greeting_nodes:Greet\n"
+               "broken = greeting_nodes_missing\n")
     reg = default_registry(entry_points=False)
     problems = reg.load_entry_points()
     assert reg.get("Greet") is not None
@@ -185,3 +193,108 @@ def test_import_modules_names_the_failing_module() -> None:
     with pytest.raises(NodeModuleError, match=r"cannot import node module 'no_such_nodes': "
                                                r"ModuleNotFoundError"):
         reg.import_modules(["no_such_nodes"])
+
+
+# ------------------------------------------------------------------------- names already taken
+@pytest.fixture
+def own_registered(monkeypatch: pytest.MonkeyPatch) -> NodeRegistry:
+    """A copy of the decorator's registry for the test, so that its registrations stay there."""
+    from cyborg.bt import registry as registry_module
+
+    copy = registry_module._REGISTERED.copy()
+    monkeypatch.setattr(registry_module, "_REGISTERED", copy)
+    return copy
+
+
+def test_a_stock_nodes_name_is_refused_naming_both_classes_and_where_each_comes_from() -> None:
+    from cyborg.bt.named_registry import NameTakenError
+
+    class Sequence(Action):
+        def tick(self) -> Status:
+            return Status.SUCCESS
+
+    reg = default_registry(entry_points=False)
+    with pytest.raises(NameTakenError) as refused:
+        reg.add(Sequence)
+    message = str(refused.value)
+    assert "node name 'Sequence' is taken by cyborg.bt.composites.Sequence (from stock)" in message
+    assert f"{__name__}.{Sequence.__qualname__} (from {__name__}) would replace it" in message
+    assert "override=True" in message
+    assert reg.get("Sequence").cls.__module__ == "cyborg.bt.composites"  # type: ignore[union-attr]
+    assert reg.add(Sequence, override=True).cls is Sequence
+    assert reg.get("Sequence").cls is Sequence  # type: ignore[union-attr]
+
+
+def test_the_decorator_refuses_a_taken_name_unless_told_to_override(
+        own_registered: NodeRegistry) -> None:
+    from cyborg.bt.named_registry import NameTakenError
+
+    with pytest.raises(NameTakenError, match=r"'Succeeder' is taken by cyborg\.bt\.leaves"):
+        @register("Succeeder")
+        class Quiet(Action):
+            def tick(self) -> Status:
+                return Status.FAILURE
+
+    @register("Succeeder", override=True)
+    class Loud(Action):
+        def tick(self) -> Status:
+            return Status.FAILURE
+
+    assert own_registered.get("Succeeder").cls is Loud  # type: ignore[union-attr]
+    assert default_registry(entry_points=False).get("Succeeder").cls is Loud  # type: ignore[union-attr]
+
+
+def test_an_override_keeps_the_name_whichever_class_is_registered_first() -> None:
+    class Mine(Action):
+        def tick(self) -> Status:
+            return Status.SUCCESS
+
+    class BuiltIn(Action):
+        def tick(self) -> Status:
+            return Status.SUCCESS
+
+    reg = NodeRegistry()
+    reg.add(Mine, "Speak", override=True)
+    assert reg.add(BuiltIn, "Speak").cls is Mine  # registered later, not overriding: kept out
+    assert reg.copy().add(BuiltIn, "Speak").cls is Mine
+    assert reg.add(Mine, "Speak").cls is Mine  # the same class again is no conflict
+
+
+def test_an_entry_point_registering_a_taken_name_is_skipped_with_a_message_naming_both(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, own_registered: NodeRegistry) -> None:
+    (tmp_path / "clashing_nodes.py").write_text(textwrap.dedent("""
+        from cyborg.bt import Action, Status, register
+
+        @register("Wait")
+        class Wait(Action):
+            def tick(self) -> Status:
+                return Status.SUCCESS
+        """))
+    _installed(tmp_path, monkeypatch, "clashing_nodes",
+               "[cyborg.nodes]\nclashing = clashing_nodes\n")
+    reg = default_registry(entry_points=False)
+    problems = [problem for problem in reg.load_entry_points() if "clashing" in problem]
+    assert len(problems) == 1
+    assert "NameTakenError: node name 'Wait' is taken by cyborg.bt.leaves.Wait (from stock); " \
+           "clashing_nodes.Wait (from clashing_nodes) would replace it" in problems[0]
+    assert reg.get("Wait").cls.__module__ == "cyborg.bt.leaves"  # type: ignore[union-attr]
+    monkeypatch.delitem(sys.modules, "clashing_nodes", raising=False)
+
+
+def test_a_service_name_taken_is_refused_too() -> None:
+    from cyborg.bt import Service
+    from cyborg.bt.named_registry import NameTakenError
+    from cyborg.bt.service_registry import ServiceRegistry
+    from cyborg.bt.services import ServiceBoard
+
+    class Watch(Service):
+        def run(self, blackboard: ServiceBoard) -> None: ...
+
+    class OtherWatch(Service):
+        def run(self, blackboard: ServiceBoard) -> None: ...
+
+    services = ServiceRegistry()
+    services.add(Watch, "Watch")
+    with pytest.raises(NameTakenError, match=r"service name 'Watch' is taken by .*Watch"):
+        services.add(OtherWatch, "Watch")
+    assert services.add(OtherWatch, "Watch", override=True).cls is OtherWatch

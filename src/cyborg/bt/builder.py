@@ -330,7 +330,7 @@ class _Builder:
             same_kind = NodeDefinition(spec.name, node_type.category.value, spec.title, {})
             return stub_class(spec, same_kind, self.stub_missing)()
         properties = attaching.without_services(node_type.cls, spec.properties)
-        binding = bind(node_type.signature, properties)
+        binding = bind(node_type.signature, properties, spec.arg_names)
         for level, said in ((Severity.WARNING, binding.warnings), (Severity.NOTE, binding.notes)):
             for field, message in said:
                 self.report(message, tree, spec, field, level)

@@ -329,11 +329,11 @@ class V1Reader:
             return self.reference(spec, path, tree, source, depth)
         equivalent = EQUIVALENTS.get(spec.name)
         if equivalent is not None:
+            spec.name, spec.arg_names = equivalent.name, dict(equivalent.renamed)
             try:
-                spec.name, spec.properties = equivalent.name, equivalent.convert(args)
+                spec.properties = equivalent.convert(args)
             except ArgError as exc:
                 self.problem(str(exc), source, tree=tree, node=spec, field=exc.arg)
-                spec.name = equivalent.name
         else:
             spec.properties = dict(args)
             spec.foreign = NO_EQUIVALENT.get(spec.name, "")

@@ -85,6 +85,8 @@ class Equivalent:
     note: str = ""
     convert: Callable[[Args], Args] = field(default=_same)
     """The file's args as the node's properties; raises :class:`ArgError` for a bad one."""
+    renamed: dict[str, str] = field(default_factory=dict)
+    """Property -> the file's arg it comes from, where the names differ."""
 
 
 EQUIVALENTS: dict[str, Equivalent] = {
@@ -98,13 +100,14 @@ EQUIVALENTS: dict[str, Equivalent] = {
     "AlwaysFail": Equivalent("ForceFailure", "behavior3lua's name"),
     "JustSuccess": Equivalent("Succeeder"),
     "JustFailure": Equivalent("Failer"),
-    "Wait": Equivalent("Wait", "time in seconds -> milliseconds", _seconds("time")),
+    "Wait": Equivalent("Wait", "time in seconds -> milliseconds", _seconds("time"),
+                       {"milliseconds": "time"}),
     "Timeout": Equivalent("Timeout", "time in seconds -> milliseconds",
-                          _seconds("time", required=True)),
+                          _seconds("time", required=True), {"milliseconds": "time"}),
     "RepeatUntilSuccess": Equivalent("RetryUntilSuccess", "behavior3lua's name; maxLoop -> count",
-                                     _renamed("maxLoop", "count")),
+                                     _renamed("maxLoop", "count"), {"count": "maxLoop"}),
     "RepeatUntilFailure": Equivalent("RetryUntilFailure", "behavior3lua's name; maxLoop -> count",
-                                     _renamed("maxLoop", "count")),
+                                     _renamed("maxLoop", "count"), {"count": "maxLoop"}),
 }
 """v1 name -> cyborg node. Names not here are looked up as they are: most v1 stock nodes
 (IfElse, Race, Switch, Case, Watchdog, Once, Repeat, RetryUntilSuccess, Check, Let, ...) are

@@ -154,8 +154,14 @@ def _unannotated(hint: Any) -> tuple[Any, Unbounded | None]:
     return hint.__origin__, marks[0] if marks else None
 
 
-def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
-    """Matches editor ``properties`` against ``signature``, converting and checking each value."""
+def bind(signature: Signature, properties: dict[str, Any],
+         file_names: dict[str, str] | None = None) -> Binding:
+    """Matches editor ``properties`` against ``signature``, converting and checking each value.
+
+    ``file_names`` name properties as the file does where a reader renamed them (a v1 Wait's
+    ``milliseconds`` is the file's ``time``).
+    """
+    names = file_names or {}
     by_name: dict[str, Param] = {}
     for param in signature.params:
         by_name[param.name] = param
@@ -167,30 +173,32 @@ def bind(signature: Signature, properties: dict[str, Any]) -> Binding:
     notes: list[tuple[str, str]] = []
     for key, value in properties.items():
         match = by_name.get(key) or by_name.get(snake_case(key))
+        said = names.get(key, key)  # the key as the file wrote it
         if match is None:
             if signature.takes_any:
                 kwargs[key] = value
             else:
-                known = ", ".join(p.editor_name for p in signature.params) or "none"
-                warnings.append((key, f"unknown property {key!r} is ignored (known: {known})"))
+                known = ", ".join(names.get(p.editor_name, p.editor_name)
+                                  for p in signature.params) or "none"
+                warnings.append((said, f"unknown property {said!r} is ignored (known: {known})"))
             continue
         if match.name in source:
-            errors.append((key, f"property {key!r} repeats {source[match.name]!r}"))
+            errors.append((said, f"property {said!r} repeats {source[match.name]!r}"))
             continue
-        source[match.name] = key
+        source[match.name] = said
         if match.unbounded is not None and _is_positive_infinity(value):
             kwargs[match.name] = match.unbounded.means
-            notes.append((key, f"property {key!r} is infinity, which behavior3js runs as no "
-                               f"end: read as {json.dumps(match.unbounded.means)} (forever)"))
+            notes.append((said, f"property {said!r} is infinity, which behavior3js runs as no "
+                                f"end: read as {json.dumps(match.unbounded.means)} (forever)"))
             continue
         try:
             kwargs[match.name] = convert(value, match.hint, infinite=match.allows_infinity)
         except ValueError as exc:
-            errors.append((key, f"property {key!r}: {exc}"))
+            errors.append((said, f"property {said!r}: {exc}"))
     for param in signature.params:
         if param.required and param.name not in source:
-            errors.append((param.editor_name,
-                           f"missing property {param.editor_name!r} ({describe(param.hint)})"))
+            said = names.get(param.editor_name, param.editor_name)
+            errors.append((said, f"missing property {said!r} ({describe(param.hint)})"))
     return Binding(kwargs, errors, warnings, notes)
 
 

@@ -19,6 +19,11 @@ the group ``cyborg.nodes`` (in its ``pyproject.toml``)::
 
 :func:`default_registry` holds the stock nodes, everything registered with the decorator and
 every entry point's nodes.
+
+A name is kept by the class that took it: registering another class under a stock or robot
+node's name (``Say``, ``Sequence``) raises :class:`~cyborg.bt.named_registry.NameTakenError`,
+which names both classes and where each comes from, unless you mean it:
+``@register("Say", override=True)``.
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ from cyborg.bt import (
 from cyborg.bt.named_registry import NamedRegistry
 from cyborg.bt.node import Category, Node
 from cyborg.bt.properties import Signature, signature_of
+from cyborg.bt.resources import requirements_of
 
 ENTRY_POINT_GROUP = "cyborg.nodes"
 
@@ -63,17 +69,25 @@ class NodeType:
         """The node class's category (action, condition, composite or decorator)."""
         return self.cls.category
 
+    @property
+    def requires(self) -> tuple[str, ...]:
+        """The resources the node needs: declared, or fetched (``robot_of``; bt.resources)."""
+        return requirements_of(self.cls)
+
 
 class NodeRegistry(NamedRegistry[NodeType]):
     """Maps editor node names to node classes."""
 
     kind = Node
 
-    def add(self, cls: type, name: str | None = None, *, origin: str = "") -> NodeType:
-        """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
+    def add(self, cls: type, name: str | None = None, *, origin: str = "",
+            override: bool = False) -> NodeType:
+        """Registers ``cls`` under ``name`` (default: the class name); returns what holds it.
 
-        Returns the entry. Raises :class:`TypeError` for a class that is not a node of one of
-        the four categories, :class:`ValueError` for an empty name.
+        Raises :class:`TypeError` for a class that is not a node of one of the four
+        categories, :class:`ValueError` for an empty name, and
+        :class:`~cyborg.bt.named_registry.NameTakenError` for a name another class has, unless
+        ``override`` (:meth:`~cyborg.bt.named_registry.NamedRegistry.enter`).
         """
         if not (inspect.isclass(cls) and issubclass(cls, Node)):
             raise TypeError(f"{cls!r} is not a Node subclass")
@@ -85,8 +99,7 @@ class NodeRegistry(NamedRegistry[NodeType]):
         if not key:
             raise ValueError("a node name cannot be empty")
         node_type = NodeType(key, cls, signature_of(cls), origin or cls.__module__)
-        self._types[key] = node_type
-        return node_type
+        return self.enter(node_type, override=override)
 
     def types(self) -> list[NodeType]:
         """All registered nodes, sorted by name."""
@@ -125,15 +138,19 @@ _REGISTERED = NodeRegistry()
 @overload
 def register(name: N, /) -> N: ...
 @overload
-def register(name: str | None = None, /) -> Callable[[N], N]: ...
-def register(name: Any = None, /) -> Any:
-    """Class decorator: makes a node available to trees under ``name`` (default: class name)."""
+def register(name: str | None = None, /, *, override: bool = False) -> Callable[[N], N]: ...
+def register(name: Any = None, /, *, override: bool = False) -> Any:
+    """Class decorator: makes a node available to trees under ``name`` (default: class name).
+
+    A name another class has (a stock or robot node's) is refused with
+    :class:`~cyborg.bt.named_registry.NameTakenError` unless ``override=True``.
+    """
     if inspect.isclass(name) and issubclass(name, Node):
         _REGISTERED.add(name)
         return name
 
     def decorate(cls: N) -> N:
-        _REGISTERED.add(cls, name)
+        _REGISTERED.add(cls, name, override=override)
         return cls
 
     return decorate

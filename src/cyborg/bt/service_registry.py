@@ -52,12 +52,14 @@ class ServiceRegistry(NamedRegistry[ServiceType]):
 
     kind = Service
 
-    def add(self, cls: type, name: str | None = None, *, origin: str = "") -> ServiceType:
-        """Registers ``cls`` under ``name`` (default: the class name), replacing an older entry.
+    def add(self, cls: type, name: str | None = None, *, origin: str = "",
+            override: bool = False) -> ServiceType:
+        """Registers ``cls`` under ``name`` (default: the class name); returns what holds it.
 
         Raises :class:`TypeError` for a class that is not a :class:`Service`,
         :class:`ValueError` for a name that is not an identifier (a declaration could not
-        name it).
+        name it), and :class:`~cyborg.bt.named_registry.NameTakenError` for a name another
+        class has, unless ``override``.
         """
         if not (inspect.isclass(cls) and issubclass(cls, Service)):
             raise TypeError(f"{cls!r} is not a Service subclass")
@@ -66,8 +68,7 @@ class ServiceRegistry(NamedRegistry[ServiceType]):
             raise ValueError(f"a service name is letters, digits and '_' (not starting with a "
                              f"digit), so a declaration can name it; not {key!r}")
         service_type = ServiceType(key, cls, signature_of(cls), origin or cls.__module__)
-        self._types[key] = service_type
-        return service_type
+        return self.enter(service_type, override=override)
 
     def registered(self) -> ServiceRegistry:
         """Where :func:`register_service` puts services."""
@@ -99,18 +100,20 @@ from it."""
 @overload
 def register_service(name: S, /) -> S: ...
 @overload
-def register_service(name: str | None = None, /) -> Callable[[S], S]: ...
-def register_service(name: Any = None, /) -> Any:
+def register_service(name: str | None = None, /, *,
+                     override: bool = False) -> Callable[[S], S]: ...
+def register_service(name: Any = None, /, *, override: bool = False) -> Any:
     """Class decorator: makes a service available to declarations under ``name``.
 
     ``name`` defaults to the class name; ``@register_service`` works without parentheses too.
+    A name another service has is refused unless ``override=True``, as for nodes.
     """
     if inspect.isclass(name) and issubclass(name, Service):
         _REGISTERED.add(name)
         return name
 
     def decorate(cls: S) -> S:
-        _REGISTERED.add(cls, name)
+        _REGISTERED.add(cls, name, override=override)
         return cls
 
     return decorate

@@ -57,6 +57,9 @@ class NodeSpec:
     foreign: str = ""
     """behavior3 v1: what the file's stock node of this name does, when cyborg has no node
     that means the same (see :mod:`cyborg.bt.editor_v1_names`)."""
+    arg_names: dict[str, str] = field(default_factory=dict)
+    """behavior3 v1: the file's name of each property the reader renamed (``milliseconds``:
+    ``time``), so that messages name what the file says."""
 
     @property
     def label(self) -> str:

@@ -28,6 +28,7 @@ from cyborg.bt.blackboard import Blackboard
 from cyborg.bt.clock import Clock, MonotonicClock
 from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.node import Node, TickRecord
+from cyborg.bt.resources import requirements_of
 from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot, TreeStructure
 from cyborg.bt.status import RUNNING, Status
@@ -153,13 +154,14 @@ class Tree:
     def missing_resources(self) -> dict[str, list[Node]]:
         """Resource key -> the nodes that need it but find none in the blackboard's resources.
 
-        A node needs the keys of its :attr:`Node.requires <cyborg.bt.node.Node.requires>`, and
-        a composite those of its services' ``requires``. The dict is empty when every node has
+        A node needs the keys of its :attr:`Node.requires <cyborg.bt.node.Node.requires>` and
+        those its code fetches (:func:`~cyborg.bt.resources.requirements_of`), and a composite
+        those of its services' ``requires``. The dict is empty when every node has
         what it needs.
         """
         missing: dict[str, list[Node]] = {}
         for node in self.nodes:
-            for key in node.requires:
+            for key in requirements_of(type(node)):
                 if key not in self.blackboard.resources:
                     missing.setdefault(key, []).append(node)
         for scheduled in self.services.services if self.services is not None else ():

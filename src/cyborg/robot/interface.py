@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from cyborg.bt import Node
+from cyborg.bt.resources import fetches_resource
 from cyborg.interfaces.robot import DockState as DockState
 from cyborg.interfaces.robot import MoveOutcome as MoveOutcome
 from cyborg.nav.geometry import Pose2D
@@ -123,8 +124,13 @@ class RobotError(RuntimeError):
     """The robot could not do what was asked (not reachable, rejected the request)."""
 
 
+@fetches_resource(ROBOT)
 def robot_of(node: Node) -> Robot:
-    """The robot the tree of ``node`` acts on; a clear error when the tree has none."""
+    """The robot the tree of ``node`` acts on; a clear error when the tree has none.
+
+    A node class that calls it needs the robot as if it declared ``requires = (ROBOT,)``
+    (:mod:`cyborg.bt.resources`): a tree without one is refused before its first tick.
+    """
     robot: Robot | None = node.blackboard.resources.get(ROBOT)
     if robot is None:
         raise RobotError(
