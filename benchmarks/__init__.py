@@ -16,6 +16,7 @@ the documentation's commands are checked (tests/test_doc_commands.py).
 
 import argparse
 import os
+import sys
 from pathlib import Path
 
 SHARED = Path(os.environ.get("CYBORG_SHARED", Path(__file__).resolve().parents[2] / "shared"))
@@ -49,7 +50,10 @@ def benchmark_options(doc: str | None, *, quick: str) -> argparse.ArgumentParser
     ``doc``: the benchmark's docstring (its first line describes the command); ``quick``: what
     its ``--quick`` does, for the help. A benchmark adds its own options to the parser.
     """
-    options = argparse.ArgumentParser(description=(doc or "").strip().splitlines()[0])
+    running = getattr(sys.modules.get("__main__"), "__spec__", None)  # python3 -m NAME
+    prog = f"python3 -m {running.name}" if running and running.name.startswith("benchmarks.") \
+        else None  # its usage line says how it is run
+    options = argparse.ArgumentParser(prog=prog, description=(doc or "").strip().splitlines()[0])
     options.add_argument("--quick", action="store_true",
                          help=f"a smoke test, not a measurement ({quick}); exits 0 whatever "
                               "the figures say of the goals")
