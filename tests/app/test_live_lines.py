@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from cyborg.app.progress import ProgressBar, Unit
 from cyborg.app.rate_window import FallingBehind, PaceWindow
 from cyborg.app.status_line import StatusLine, fit_status
-from cyborg.app.terminal import NamesRobot
+from cyborg.app.terminal import FLEET_WIDE, NamesRobot
 from cyborg.bt import Status, Tree, load_tree, loads_tree
 from cyborg.bt.snapshot import TickSnapshot
 from tests.builders import N, project_json, registry, tree_json
@@ -249,11 +249,16 @@ def test_a_fleets_log_records_name_their_robot() -> None:
         log_from("/robot10/bt/tree_runner[cancel]", "cancel failed")
         log_from("cyborg-tree /robot1/bt/tree_runner", "/robot1 is docked")  # named already
         log_from("simulation", "a person walks")  # no robot's thread
+        thread = threading.Thread(target=logger.warning, args=("the simulation runs at 7x",),
+                                  kwargs={"extra": {FLEET_WIDE: True}},
+                                  name="cyborg-tree /robot1/bt/tree_runner")
+        thread.start()
+        thread.join()
     finally:
         logger.removeHandler(handler)
     assert stream.getvalue().splitlines() == [
         "/robot2: MoveTo room1: stalled", "/robot10: cancel failed", "/robot1 is docked",
-        "a person walks"]
+        "a person walks", "the simulation runs at 7x"]
 
 
 # ------------------------------------------------------------------ the pace of simulated time

@@ -22,7 +22,7 @@ from typing import TextIO
 
 from cyborg.app.progress import terminal_width
 from cyborg.app.rate_window import FallingBehind, PaceWindow
-from cyborg.app.terminal import LiveTerminal
+from cyborg.app.terminal import FLEET_WIDE, LiveTerminal
 from cyborg.bt import Status, Tree
 from cyborg.bt.snapshot import TickSnapshot
 
@@ -136,8 +136,8 @@ class StatusLine:
         if self.pace is not None and self.behind is not None:
             self.pace.add(snapshot.time)
             warning = self.behind.check(self.pace.pace())
-            if warning is not None:
-                log.warning(warning)
+            if warning is not None:  # of the whole simulation, not of one robot
+                log.warning(warning, extra={FLEET_WIDE: True})
         if self.live:
             now = self._wall()
             if now - self._drawn_at >= self._interval:

@@ -177,12 +177,16 @@ def errors_on_one_line() -> Iterator[None]:
             handler.setFormatter(formatter)
 
 
+FLEET_WIDE = "fleet_wide"
+"""A record's attribute (``extra={FLEET_WIDE: True}``) that says it is about every robot."""
+
+
 class NamesRobot(logging.Filter):
     """Puts the robot first (``/robot2: …``) in a record logged for one robot of a fleet.
 
     The robot is the namespace in the name of the thread that logged the record (a tree
-    runner's thread, a bus node's callback thread); a record that names it already, or that
-    comes from no robot's thread, is left as it is.
+    runner's thread, a bus node's callback thread); a record that names it already, that
+    comes from no robot's thread, or that is :data:`FLEET_WIDE`, is left as it is.
     """
 
     def __init__(self, namespaces: Sequence[str]) -> None:
@@ -191,6 +195,8 @@ class NamesRobot(logging.Filter):
 
     def filter(self, record: logging.LogRecord) -> bool:
         """Adds the robot to the message where it is missing; never drops a record."""
+        if getattr(record, FLEET_WIDE, False):
+            return True
         robot = next((namespace for namespace in self.namespaces
                       if f"{namespace}/" in f"{record.threadName}/"), None)
         if robot is not None:
