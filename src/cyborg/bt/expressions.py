@@ -58,13 +58,14 @@ from cyborg.bt.js_values import (
     strict_equal,
     truthy,
 )
+from cyborg.bt.limits import MAX_VALUE_SIZE
 from cyborg.bt.status import NodeError
 
 MAX_LENGTH = 1000
 """Longest expression text accepted, in characters."""
 MAX_DEPTH = 50
 """Deepest nesting accepted: parentheses, operators applied to operators, member chains."""
-MAX_TEXT = 1 << 20
+MAX_TEXT = MAX_VALUE_SIZE
 """Longest text an expression makes, in characters: ``s + s`` ticked over and over doubles."""
 
 _TOKEN = re.compile(r"""

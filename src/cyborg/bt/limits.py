@@ -53,6 +53,9 @@ MAX_VALUE_DEPTH = 32
 MAX_INT_DIGITS = 1000
 """Most digits an integer literal in a tree file may have: far below Python's limit of 4,300
 for turning an int into text, so that values computed from one still print."""
+MAX_VALUE_SIZE = 1 << 20
+"""Most characters of a text, or items of a list or object, that a node may write to the
+blackboard: a Concat of a list with itself 25 times took 2.1 GB in one tick."""
 FRAMES_PER_LEVEL = 4
 """Python frames one tree level takes while ticking, with hooks on every node."""
 STACK_RESERVE = 400

@@ -37,6 +37,7 @@ from typing_extensions import override
 
 from cyborg.bt.expressions import Expression
 from cyborg.bt.js_values import describe, is_number, js_text, read_member, strict_equal, truthy
+from cyborg.bt.limits import MAX_VALUE_SIZE
 from cyborg.bt.node import Action, Condition, Node
 from cyborg.bt.status import FAILURE, SUCCESS, NodeError, Status
 
@@ -184,6 +185,9 @@ class Push(Action):
     def tick(self) -> Status:
         array = array_input(self, "array", to_change=True)
         assert isinstance(array, list)
+        if len(array) >= MAX_VALUE_SIZE:
+            raise NodeError(f"input 'array' holds {len(array):,} items, the most a blackboard "
+                            "value may hold")
         array.append(self.read("element"))
         return SUCCESS
 
