@@ -10,7 +10,7 @@
     cyborg bt json FILE            the tree's structure as JSON
     cyborg bt nodes                list the node types trees can use
     cyborg bt serve FILE           run a tree on the bus (topics, enable, control services)
-    cyborg bt reload|enable|disable   control a running tree runner
+    cyborg bt reload|enable|disable|stop   control a running tree runner (stop: until enabled)
     cyborg router                  run a Zenoh router (the bus's meeting point)
     cyborg node list|info          nodes on the bus (ours and ROS 2 peers)
     cyborg topic list|echo|pub|hz  topics on the bus
