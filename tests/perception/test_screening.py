@@ -34,13 +34,13 @@ def test_each_bad_prediction_is_dropped_and_counted_under_its_reason() -> None:
            prediction(column=-50.0), prediction(column=CAMERA.width + 1.0),
            prediction(column=math.nan), prediction(confidence=math.nan),
            prediction(confidence=1.5), prediction(label=""), prediction(label="a\x00b"),
-           prediction(label="x" * 100)]
+           prediction(label="x" * 100), prediction(label=" "), prediction(label="\u3000")]
     kept, rejected = screen(bad)
     assert kept == []
     assert dict(rejected.counts) == {NO_DISTANCE: 4, OUT_OF_RANGE: 1, OUTSIDE_IMAGE: 3,
-                                     BAD_CONFIDENCE: 2, UNKNOWN_LABEL: 3}
+                                     BAD_CONFIDENCE: 2, UNKNOWN_LABEL: 5}
     assert rejected.describe() == ("4 no distance, 1 out of range, 3 outside image, "
-                                   "2 bad confidence, 3 unknown label")
+                                   "2 bad confidence, 5 unknown label")
 
 
 def test_labels_not_tracked_count_as_unknown_when_some_are_named() -> None:

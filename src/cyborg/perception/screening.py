@@ -12,8 +12,9 @@ reason              the prediction
 ``outside image``   has a box whose centre is not finite or lies outside the image's columns,
                     or a box with no corners
 ``bad confidence``  has a confidence that is NaN or outside 0..1
-``unknown label``   has an empty label, one longer than :data:`MAX_LABEL`, one with control
-                    characters, or one not among the labels tracked (when some are named)
+``unknown label``   has an empty label (or only spaces), one longer than :data:`MAX_LABEL`,
+                    one with control characters, or one not among the labels tracked (when
+                    some are named)
 ``flood``           came beyond the :data:`MAX_PER_FRAME` most confident of its message
 ==================  ==========================================================================
 
@@ -71,7 +72,7 @@ class Rejections:
 
 
 def _label_ok(label: str, labels: frozenset[str]) -> bool:
-    if not label or len(label) > MAX_LABEL or not label.isprintable():
+    if not label.strip() or len(label) > MAX_LABEL or not label.isprintable():
         return False
     return not labels or label in labels
 
