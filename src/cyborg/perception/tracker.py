@@ -176,15 +176,14 @@ class Tracker:
         if candidates:
             settings = self.settings
             predicted = np.array([item.predicted(stamp, settings.horizon) for item in candidates])
-            last = np.array([(item.x, item.y) for item in candidates])
-            unseen = np.array([item.last_seen for item in candidates])
+            last = np.array([(item.x, item.y, item.last_seen) for item in candidates])
             seen = np.array([(sighting.x, sighting.y, sighting.distance)
                              for sighting in sightings])
             gaps = np.minimum(  # to the prediction, or to where it was (it stopped, turned)
                 np.hypot(seen[:, None, 0] - predicted[None, :, 0],
                          seen[:, None, 1] - predicted[None, :, 1]),
                 np.hypot(seen[:, None, 0] - last[None, :, 0], seen[:, None, 1] - last[None, :, 1]))
-            rows, cols = np.nonzero(gaps <= self._gates(stamp, unseen, seen[:, 2]))
+            rows, cols = np.nonzero(gaps <= self._gates(stamp, last[:, 2], seen[:, 2]))
             used: set[int] = set()
             for index in np.argsort(gaps[rows, cols], kind="stable"):
                 row, col = int(rows[index]), int(cols[index])
@@ -204,10 +203,9 @@ class Tracker:
         sighting is (its ``distances``).
         """
         settings = self.settings
-        unseen = np.clip(stamp - last_seen, 0.0, settings.horizon)
-        depth = np.nan_to_num(distances, nan=0.0, posinf=0.0)
-        noise = settings.depth_sigmas * settings.camera.depth_sigma(depth)
-        result: np.ndarray = settings.gate + settings.spread * unseen[None, :] + noise[:, None]
+        unseen = np.minimum(np.maximum(stamp - last_seen, 0.0), settings.horizon)
+        noise = settings.depth_sigmas * settings.camera.depth_sigma(distances)  # screened: finite
+        result: np.ndarray = (settings.gate + settings.spread * unseen)[None, :] + noise[:, None]
         return result
 
     def _follow(self, item: TrackedObject, sighting: Sighting, stamp: float) -> None:
