@@ -16,7 +16,7 @@
 const PASSING_IDS = new Set(["map-canvas", "map-static", "map-joystick"]);
 
 // The elements that cover the map's canvas (shown or not: a hidden one covers nothing).
-export function coveringElements(root) {
+function coveringElements(root) {
   const found = [];
   const visit = (parent) => {
     for (const element of parent.children) {

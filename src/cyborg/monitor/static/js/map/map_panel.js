@@ -27,7 +27,7 @@
 import { colourOf, onRobotSelected, selectRobot, selectedRobot } from "../robots.js";
 import { MapActions } from "./actions.js";
 import { Driver } from "./drive.js";
-import { coveringBoxes, coveringElements, freeRect } from "./free_area.js";
+import { coveringBoxes, freeRect } from "./free_area.js";
 import { GoalHighlight } from "./goal_highlight.js";
 import { Hud } from "./hud.js";
 import { labelBoxes } from "./labels.js";
@@ -262,16 +262,17 @@ export class MapPanel {
     this.userMoved = false;
   }
 
-  // When a control over the map changes size (the actions' bar comes with the seat, wraps on a
-  // narrower panel): labels keep off it where it is now, and the map is fitted again unless the
-  // user moved it.
+  // When the toolbar, the actions' bar or STOP changes size (the bar comes with the seat, wraps
+  // on a narrower panel): labels keep off it where it is now, and the map is fitted again unless
+  // the user moved it. What comes and goes while the user looks (a warning) is kept clear of
+  // at the next fit, without moving the map under their eyes.
   watchControls() {
     const observer = new ResizeObserver(() => {
       this.covered = coveringBoxes(this.root, this.canvas);
       if (!this.userMoved) this.fit();
       this.schedule();
     });
-    for (const element of coveringElements(this.root)) observer.observe(element);
+    for (const element of this.root.querySelectorAll(".map-tools, #map-act, #map-stop")) observer.observe(element);
   }
 
   // ------------------------------------------------------------------ maps
