@@ -14,7 +14,9 @@ from cyborg.bus.msgs.geometry_msgs.msg import Point, Vector3
 from cyborg.bus.msgs.rosgraph_msgs.msg import Clock
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.report.build import build_report, read
+from cyborg.report.clocks import run_clock
 from cyborg.report.goals import PATH_STATES
+from cyborg.report.recording import Stamped
 from tests.report.page_reader import Page, read_page
 from tests.report.recordings import RecordingWriter, detections, goal, header, mission
 
@@ -130,3 +132,27 @@ def test_only_a_sample_of_a_simulators_clock_is_decoded(simulated: tuple[Path, P
     last = clock[-1].message.clock
     assert (int(last.sec), int(last.nanosec)) == (1400, 0)
     assert np.all(np.diff([item.log_time for item in clock]) > 0)
+
+
+def _ticks(*pairs: tuple[float, float]) -> list[Stamped]:
+    """``/clock`` messages: (wall seconds, simulated seconds) each."""
+    return [Stamped(round(wall * 1e9), Clock(clock=Time(sec=int(simulated),
+                                                        nanosec=round(simulated % 1 * 1e9))))
+            for wall, simulated in pairs]
+
+
+def test_a_clock_that_went_back_counts_from_its_restart() -> None:
+    """A simulator restarted during the recording starts /clock again at 0: the report's
+    simulated time is the last stretch that only rises."""
+    run = run_clock(_ticks((0, 0), (1, 30), (2, 60), (3, 0), (4, 20), (5, 40)))
+    assert run is not None
+    assert (run.duration, run.pace, run.differs) == (40.0, 20.0, True)
+    assert run.simulated_span(round(3.5e9), round(4.5e9)) == pytest.approx(20.0)
+
+
+def test_too_little_clock_is_no_clock_and_the_same_pace_is_given_once() -> None:
+    assert run_clock([]) is None
+    assert run_clock(_ticks((0, 0))) is None
+    assert run_clock(_ticks((0, 5), (1, 0))) is None  # went back at once: one message left
+    same = run_clock(_ticks((0, 100), (10, 110.1)))
+    assert same is not None and not same.differs  # 1 % off the wall clock's pace
