@@ -3,7 +3,8 @@ Playwright) fed by a stand-in monitor (tests/monitor/map_page.py): on AMROffice,
 room2 and room4 lie along its bottom edge, with the robot docked at the Dock and a page that
 may act (so the actions' bar is shown), no goal, dock, home or robot marker lies under the
 map's toolbar, the actions' bar or STOP after Fit, on a desktop (1400x900) and a phone
-(390x844); the actions' bar coming later fits the map again. Screenshots:
+(390x844); the actions' bar coming later fits the map again; of the rectangles the controls
+leave free, the one that shows the map largest is chosen. Screenshots:
 map_fit_1400x900.png, map_fit_390x844.png."""
 
 from __future__ import annotations
@@ -84,4 +85,28 @@ def test_after_fit_no_marker_lies_under_the_toolbar_or_stop(
     page.click("#map-fit")
     assert _covered_markers(page, with_robot()) == []
     screenshot(page, f"map_fit_{width}x{height}")
+    assert errors == []
+
+
+def test_the_free_rectangle_is_the_one_that_shows_the_map_largest(
+        browser: Browser, amr_office: tuple[ArnlMap, StandInMonitor]) -> None:
+    _arnl_map, server = amr_office
+    errors: list[str] = []
+    page = map_page.open_map_page(browser, server.url, errors)
+    found = page.evaluate("""async () => {
+        const { freeRect } = await import('/static/js/map/free_area.js');
+        // a 400 x 600 canvas: a toolbar along the top right, STOP in the bottom right corner
+        const boxes = [[250, 0, 400, 40], [330, 480, 400, 600]];
+        const fit = (w, h) => (width, height) => Math.min(width / w, height / h);
+        return {
+            tall: freeRect(400, 600, boxes, fit(1, 2)),
+            wide: freeRect(400, 600, boxes, fit(2, 1)),
+            none: freeRect(400, 600, [], fit(1, 1)),
+        };
+    }""")
+    # a tall map: beside STOP, under the toolbar, down to the bottom (scale 280, not 220)
+    assert found["tall"] == {"x0": 0, "y0": 40, "x1": 330, "y1": 600}
+    # a wide map: the whole width, between the toolbar and STOP (scale 200, not 165)
+    assert found["wide"] == {"x0": 0, "y0": 40, "x1": 400, "y1": 480}
+    assert found["none"] == {"x0": 0, "y0": 0, "x1": 400, "y1": 600}
     assert errors == []
