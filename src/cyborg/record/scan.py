@@ -217,13 +217,30 @@ def _keep(result: Scan, opcode: int, content: bytes, offset: int, length: int) -
     return True
 
 
+MAX_CHUNK_BYTES = 256 * 1024 * 1024
+"""Most bytes a chunk may declare uncompressed: ours close at 1 MiB of messages (one camera
+frame may be larger), and the declared size was trusted: 98 KB of zstd declared 3 GiB."""
+
+
 def decompress(chunk: Chunk) -> bytes:
-    """A chunk's records, decompressed and checked; ValueError for a damaged chunk."""
-    if chunk.compression == "zstd":
-        data = zstandard.ZstdDecompressor().decompress(
-            chunk.data, max_output_size=chunk.uncompressed_size)
+    """A chunk's records, decompressed and checked; ValueError for a damaged chunk.
+
+    A chunk declaring more than :data:`MAX_CHUNK_BYTES` uncompressed is refused before any
+    decompression, and none is decompressed past what it declares.
+    """
+    if chunk.uncompressed_size > MAX_CHUNK_BYTES:
+        raise ValueError(f"it declares {chunk.uncompressed_size:,} bytes uncompressed, more than "
+                         f"the {MAX_CHUNK_BYTES // 2**20} MiB a chunk may hold")
+    if chunk.compression == "zstd":  # a frame's own content size is not trusted either
+        parts, wanted = [], chunk.uncompressed_size + 1
+        with zstandard.ZstdDecompressor().stream_reader(chunk.data) as reader:
+            while wanted > 0 and (part := reader.read(wanted)):
+                parts.append(part)
+                wanted -= len(part)
+        data = b"".join(parts)
     elif chunk.compression == "lz4":
-        data = lz4.frame.decompress(chunk.data)
+        data = lz4.frame.LZ4FrameDecompressor().decompress(
+            chunk.data, max_length=chunk.uncompressed_size)
     elif chunk.compression == "":
         data = chunk.data
     else:
