@@ -54,6 +54,36 @@ RUNNING_END_ON_SCREEN = """() => {
 in the tree view; null while no path is drawn."""
 
 
+PATH_OFF_SCREEN = """() => {
+  const view = document.getElementById('tree').getBoundingClientRect();
+  return [...document.querySelectorAll('g.node.active')].some((g) => {
+    const box = g.getBoundingClientRect();
+    return box.right < view.left || box.left > view.right || box.bottom < view.top
+      || box.top > view.bottom;
+  });
+}"""
+"""Whether a node of the running path is wholly outside the tree view."""
+
+
+def _assert_path_bar(page: Page) -> None:
+    """The path bar is shown exactly while part of the running path is off-screen; its first
+    name brings the root into view."""
+    bar = page.locator("#tree-path")
+    page.wait_for_function(f"({PATH_OFF_SCREEN})() === !document.getElementById('tree-path')"
+                           ".hidden")
+    if bar.is_hidden():
+        return
+    names = bar.locator("button").all_text_contents()
+    assert len(names) == page.locator("g.node.active").count()
+    bar.locator("button").first.click()
+    root = page.locator("g.node.active").first
+    page.wait_for_function("(() => { const view = document.getElementById('tree')"
+                           ".getBoundingClientRect(); const box = document.querySelector("
+                           "'g.node.active').getBoundingClientRect(); return box.left >= view.left"
+                           " && box.right <= view.right && box.top >= view.top; })()")
+    assert root.text_content() == names[0]
+
+
 @pytest.fixture(scope="module")
 def live() -> Iterator[Live]:
     with live_system() as running:
@@ -103,8 +133,14 @@ def test_the_tree_is_drawn_readable_on_a_desktop_and_on_a_phone(browser: Browser
     _assert_readable(phone, 2)
     assert phone.locator("#tree-overview").is_visible()
     screenshot(phone, "readable_phone_tree")
-    # "Fit all" on request: the whole tree, smaller; "1:1" goes back to the readable size
-    drawn = page.evaluate("window.__monitor.drawn")
+    _assert_path_bar(phone)
+    # "Fold" off: every node drawn, at the readable size all the same
+    page.uncheck("#foldfit")
+    nodes = len(list(live.system.runner.tree))
+    page.wait_for_function(f"window.__monitor.drawn === {nodes}")
+    _assert_readable(page, 2)
+    # "Fit all" on request (every node drawn: a layout that stays): the whole tree, smaller,
+    # kept when the window is resized; "1:1" goes back to the readable size
     page.click("#fit")
     inside = page.evaluate("""() => {
       const view = document.getElementById('tree').getBoundingClientRect();
@@ -113,19 +149,14 @@ def test_the_tree_is_drawn_readable_on_a_desktop_and_on_a_phone(browser: Browser
         return box.left >= view.left - 1 && box.right <= view.right + 1;
       }).length;
     }""")
-    assert inside == drawn
+    assert inside == nodes
     assert page.evaluate("document.getElementById('viewport').getCTM().a") < 1
     width = page.evaluate("document.getElementById('tree').clientWidth")
-    page.set_viewport_size({"width": 1300, "height": 900})  # a window resized keeps the fit
+    page.set_viewport_size({"width": 1300, "height": 900})
     page.wait_for_function(f"document.getElementById('tree').clientWidth !== {width}")
     page.evaluate("new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done)))")
     assert page.evaluate("document.getElementById('viewport').getCTM().a") < 1
     page.click("#readable")
-    _assert_readable(page, 2)
-    # "Fold" off: every node drawn, at the readable size all the same
-    page.uncheck("#foldfit")
-    nodes = len(list(live.system.runner.tree))
-    page.wait_for_function(f"window.__monitor.drawn === {nodes}")
     _assert_readable(page, 2)
     assert errors == []
 

@@ -267,7 +267,7 @@ function render(fromFrame = false) {
     dirty = null;
     if (page.selected) showNode(model, page.selected, page.hooks);
   }
-  followRunningPath();
+  followRunningPath(relaid);
   if (relaid) stats.drawMs = performance.now() - started;
   tickInfo();
   // A task queued from an animation frame runs once that frame has been rendered: stamp the
@@ -307,13 +307,14 @@ function runningEnd() {
 }
 
 // When the running path has moved, scroll its end into view if it went off-screen (the view
-// leaves it be while the user pans; "Fit" shows everything anyway).
-function followRunningPath() {
-  if (tickHistory.state || $("autofit").checked) return;
+// leaves it be while the user pans; "Fit" shows everything anyway), and name it in the path bar.
+function followRunningPath(relaid) {
   const end = runningEnd();
-  if (end === followed) return;
+  if (end === followed && !relaid) return;
+  const moved = end !== followed;
   followed = end;
-  if (end) view.reveal(end);
+  view.setPath(tickHistory.state ? [] : model.active.filter((id) => view.elements.has(id)));
+  if (moved && end && !tickHistory.state && !$("autofit").checked) view.reveal(end);
 }
 
 // Folded nodes drawn with part of the running path hidden inside them.

@@ -11,7 +11,9 @@
 // and zooms, "Fit all" fits on request. Where the tree is larger than the view an
 // overview (a minimap: every box, the running path, the part in view) sits in the corner; a
 // click or drag there moves the view. When the running path moves off-screen it is scrolled
-// into view, unless the user has panned or zoomed in the last FOLLOW_PAUSE_MS.
+// into view, unless the user has panned or zoomed in the last FOLLOW_PAUSE_MS; while part of it
+// is off-screen (a parent far to the side of its running child), a bar at the top names the
+// whole path, each name a button that brings its node into view.
 
 import { hierarchy, tree as tidyTree } from "../vendor/d3-hierarchy.min.mjs";
 
@@ -57,6 +59,9 @@ export class TreeView {
     this.lens = this.overview.querySelector(".lens");
     this.overviewScale = { x: 1, y: 1 };
     this.overviewActive = null; // the active set the overview was drawn with
+    this.pathBar = svg.parentNode.querySelector("#tree-path");
+    this.pathIds = []; // the running path as drawn, root first
+    this.pathKey = null; // what the path bar shows
     new ResizeObserver(([entry]) => {
       this.size = { width: entry.contentRect.width, height: entry.contentRect.height };
       this.placeLens();
@@ -188,6 +193,34 @@ export class TreeView {
     // the user zooms in.
     this.svg.classList.toggle("far", k < FAR_SCALE);
     this.placeLens();
+    this.showPathBar();
+  }
+
+  // The running path drawn (`ids`, root first), for the path bar.
+  setPath(ids) {
+    this.pathIds = ids;
+    this.pathKey = null;
+    this.showPathBar();
+  }
+
+  // The path bar: shown while a node of the running path is wholly off-screen; redrawn only
+  // when what it shows changes (apply() calls it at every step of a pan).
+  showPathBar() {
+    const { width, height } = this.size;
+    const { k, x, y } = this.transform;
+    const off = this.pathIds.map((id) => {
+      const d = this.positions.get(id);
+      if (!d || !width) return false;
+      const left = x + (d.x - d.width / 2) * k, top = y + d.y * k;
+      return left + d.width * k < 0 || left > width || top + BOX_HEIGHT * k < 0 || top > height;
+    });
+    const key = `${this.pathIds.join("\u0000")}\u0001${off.join()}`;
+    if (key === this.pathKey) return;
+    this.pathKey = key;
+    this.pathBar.hidden = !off.includes(true);
+    this.pathBar.innerHTML = this.pathBar.hidden ? "" : this.pathIds.map((id, i) =>
+      `<button class="${off[i] ? "off" : "on"}" data-id="${escapeHtml(id)}" title="Show it">${escapeHtml(this.positions.get(id).label)}</button>`,
+    ).join("<span>›</span>");
   }
 
   // The tree at the readable scale, its root at the top, centred when it fits the width, else
@@ -330,9 +363,10 @@ export class TreeView {
     this.apply();
   }
 
-  centerOn(id) {
+  centerOn(id, byUser = false) {
     const d = this.positions.get(id);
     if (!d) return;
+    if (byUser) this.userMovedAt = performance.now();
     if (!this.size.width) this.measure();
     const k = Math.max(this.transform.k, READABLE_SCALE);
     this.transform = { k, x: this.size.width / 2 - d.x * k, y: this.size.height / 3 - d.y * k };
@@ -398,6 +432,12 @@ export class TreeView {
       this.userMovedAt = performance.now();
     };
     this.overview.addEventListener("pointerup", endOverviewDrag);
+    this.pathBar.addEventListener("click", (event) => {
+      const button = event.target.closest("button[data-id]");
+      if (!button) return;
+      this.centerOn(button.dataset.id, true);
+      this.onUserZoom();
+    });
     this.overview.addEventListener("pointercancel", endOverviewDrag);
     this.nodeLayer.addEventListener("click", (event) => {
       const g = event.target.closest("g.node");
