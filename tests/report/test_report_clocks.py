@@ -84,10 +84,13 @@ def test_a_goal_took_as_long_on_each_clock_as_each_clock_says(
                         "ABORTED_PATHPLAN", "0.1"]  # cancelled where MoveTo stops the robot
 
 
-def test_the_tree_names_the_clock_of_each_of_its_times(simulated: tuple[Path, Page]) -> None:
+def test_the_tree_and_the_warnings_name_the_clock_of_their_times(
+        simulated: tuple[Path, Page]) -> None:
     _, page = simulated
     header = _cells(page.one("table", "tree").children[0].children[0])
     assert header[-2:] == ["running time (s, tree clock)", "mean tick time (ms, wall)"]
+    for table in page.find("table", "warnings"):
+        assert _cells(table.children[0].children[0])[0] == "time (wall)"
 
 
 def test_each_path_state_a_goal_ended_in_is_explained_in_plain_words(

@@ -235,5 +235,5 @@ def warnings_table(rows_in: list[WarningRow], start: int) -> str:
             for item in rows_in[:MAX_TABLE_ROWS]]
     extra = (note(f"and {len(rows_in) - MAX_TABLE_ROWS} more")
              if len(rows_in) > MAX_TABLE_ROWS else "")
-    return table(["time", "level", "source", "text"], rows, "warnings") + extra
+    return table(["time (wall)", "level", "source", "text"], rows, "warnings") + extra
 
