@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from cyborg.app.progress import ProgressBar, Unit
+from cyborg.app.progress import LiveLine, ProgressBar, Unit
 from cyborg.app.rate_window import FallingBehind, PaceWindow
 from cyborg.app.status_line import StatusLine, fit_status
 from cyborg.app.terminal import FLEET_WIDE, NamesRobot
@@ -314,3 +314,28 @@ def test_the_live_line_shows_the_pace_reached_and_warns_once_when_it_falls_behin
     assert "7.0x/30x" in rows[-1], rows[-1]
     warnings = [record for record in caplog.records if "runs at 7.0x" in record.getMessage()]
     assert len(warnings) == 1 and warnings[0].levelno == logging.WARNING
+
+
+def test_record_and_plays_live_line_keeps_log_records_off_its_row(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    class Counting(LiveLine):
+        count = 0
+
+        def text(self) -> str:
+            return f"playing  {self.count} msgs"
+
+    screen = Screen()
+    handler = logging.StreamHandler(screen)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    monkeypatch.setattr(logging.getLogger(), "handlers", [handler])
+    line = Counting(screen)
+    line.update()
+    logging.getLogger("cyborg.bus").warning("a subscriber is slow")
+    line.count = 5
+    line._drawn = -1.0  # due again
+    line.update()
+    line.clear()
+    print("played 5 messages", file=screen)
+    assert screen.rows() == ["WARNING cyborg.bus: a subscriber is slow", "played 5 messages"]
+    assert "playing  5 msgs" in screen.getvalue()
+    assert logging.getLogger().handlers == [handler], "put back when the line is cleared"

@@ -13,7 +13,10 @@ from __future__ import annotations
 
 import shutil
 import time
+from contextlib import ExitStack
 from typing import Literal, TextIO
+
+from cyborg.app.terminal import LiveTerminal
 
 Unit = Literal["frames", "bytes"]
 """What a bar counts."""
@@ -118,14 +121,18 @@ class ProgressBar:
 class LiveLine:
     """A line of what a long-running command does now, on ``stream``; :meth:`text` says what.
 
-    Redrawn in place ten times a second on a terminal, cut to its width; into a pipe or file,
-    one line every ten seconds. ``cyborg record`` and ``cyborg play`` show theirs so.
+    Redrawn in place ten times a second on a terminal, cut to its width, with log records and
+    prints written on rows above it from its first drawing to :meth:`clear`
+    (:mod:`cyborg.app.terminal`); into a pipe or file, one line every ten seconds.
+    ``cyborg record`` and ``cyborg play`` show theirs so.
     """
 
     def __init__(self, stream: TextIO) -> None:
         self.stream = stream
         self.live = stream.isatty()
         self._drawn = 0.0
+        self.terminal = LiveTerminal(stream)
+        self._attached: ExitStack | None = None
 
     def text(self) -> str:
         """The line as it is now (a subclass says it)."""
@@ -141,10 +148,19 @@ class LiveLine:
         if now - self._drawn < (0.1 if self.live else 10.0):
             return
         self._drawn = now
-        self.stream.write("\r\x1b[K" + self.text() if self.live else self.text() + "\n")
-        self.stream.flush()
+        if not self.live:
+            self.stream.write(self.text() + "\n")
+            self.stream.flush()
+            return
+        if self._attached is None:
+            self._attached = ExitStack()
+            self._attached.enter_context(self.terminal.attached())
+        self.terminal.draw(self.text())
 
     def clear(self) -> None:
         """Wipes the line drawn in place, so that a summary can take its place."""
         if self.live:
-            self.stream.write("\r\x1b[K")
+            self.terminal.wipe()
+        if self._attached is not None:
+            self._attached.close()
+            self._attached = None

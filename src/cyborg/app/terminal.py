@@ -58,6 +58,14 @@ class LiveTerminal:
                 self.stream.write(self._line)
                 self.stream.flush()
 
+    def wipe(self) -> None:
+        """Wipes the live line, so that what follows takes its row."""
+        with self._lock:
+            if self._line:
+                self.stream.write(CLEAR)
+                self.stream.flush()
+            self._line = ""
+
     def end(self) -> None:
         """Ends the live line: what follows starts on a row of its own."""
         with self._lock:
