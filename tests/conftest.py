@@ -59,8 +59,11 @@ def _models_from_shared() -> Iterator[None]:
 
 @pytest.fixture(autouse=True)
 def _restore_registered_nodes() -> Iterator[None]:
-    """Nodes a test registers with @register do not leak into other tests."""
-    saved = dict(registry._REGISTERED._types)
+    """Nodes a test registers with @register (overriding a name or not) do not leak into other
+    tests."""
+    saved, overridden = dict(registry._REGISTERED._types), set(registry._REGISTERED._overridden)
     yield
     registry._REGISTERED._types.clear()
     registry._REGISTERED._types.update(saved)
+    registry._REGISTERED._overridden.clear()
+    registry._REGISTERED._overridden.update(overridden)
