@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bt.problems import Problem, TreeLoadError
+from cyborg.bt.status import NodeError
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """Default ``max_bytes``: bytes read for one load, all files together."""
@@ -56,6 +57,20 @@ for turning an int into text, so that values computed from one still print."""
 MAX_VALUE_SIZE = 1 << 20
 """Most characters of a text, or items of a list or object, that a node may write to the
 blackboard: a Concat of a list with itself 25 times took 2.1 GB in one tick."""
+
+
+def check_value_size(what: str, value: Any) -> None:
+    """Raises a NodeError naming ``what`` for a value past :data:`MAX_VALUE_SIZE`.
+
+    ``what`` is the place written, ``"output 'result'"``; ``value`` counts as a text's
+    characters, or a list's or object's items.
+    """
+    if isinstance(value, str | list | dict) and len(value) > MAX_VALUE_SIZE:
+        kind = "characters" if isinstance(value, str) else "items"
+        raise NodeError(f"{what} would hold {len(value):,} {kind}, more than the "
+                        f"{MAX_VALUE_SIZE:,} a blackboard value may hold")
+
+
 FRAMES_PER_LEVEL = 4
 """Python frames one tree level takes while ticking, with hooks on every node."""
 STACK_RESERVE = 400

@@ -35,7 +35,7 @@ from enum import StrEnum
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from cyborg.bt.extension import ExtensionPoints, TickRecord
-from cyborg.bt.limits import MAX_VALUE_SIZE
+from cyborg.bt.limits import check_value_size
 from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status
 
 if TYPE_CHECKING:
@@ -150,22 +150,13 @@ class Node(ExtensionPoints):
         return default if key is None else self.blackboard.get(key, default)
 
     def write(self, port: str, value: Any) -> None:
-        """Sets the global key of output ``port`` (unbound: no-op; ``None`` deletes it).
-
-        A text, list or object larger than :data:`~cyborg.bt.limits.MAX_VALUE_SIZE` is refused
-        with a :class:`NodeError` naming the port (the node returns ERROR).
-        """
+        """Sets output ``port``'s key (unbound: no-op; ``None`` deletes; too large: NodeError)."""
         key = self.ports.get(port)
-        if key is None:
-            return
-        if value is None:
+        if key is not None and value is None:
             self.blackboard.globals.pop(key, None)
-            return
-        if isinstance(value, str | list | dict) and len(value) > MAX_VALUE_SIZE:
-            what = "characters" if isinstance(value, str) else "items"
-            raise NodeError(f"output {port!r} would hold {len(value):,} {what}, more than the "
-                            f"{MAX_VALUE_SIZE:,} a blackboard value may hold")
-        self.blackboard[key] = value
+        elif key is not None:
+            check_value_size(f"output {port!r}", value)
+            self.blackboard[key] = value
 
     # ----------------------------------------------------------------- engine
     @property
