@@ -40,10 +40,8 @@ halted as ``enable(false)`` halts it, and it latches ``stopped``,
 The tree stays stopped until someone with the seat enables it again (the page's Resume, the
 Run button, ``cyborg bt enable``); every page, one that comes later included, reads it as
 ``stopped`` in the ``runner`` and ``robots`` messages, and this monitor or any other shows the
-same. The answer's ``stopped`` names the trees stopped. A page that was driving the robot by
-hand when another page stopped it (a key or the joystick still held) is refused its next drive
-commands until it lets go (a zero ``drive``): the held key does not drive the robot on 100 ms
-after the STOP.
+same. The answer's ``stopped`` names the trees stopped. A page still driving by hand when
+another stopped the robot is refused its drives until it lets go (a zero ``drive``).
 
 **Answers.** Each command is answered with ``result`` (``req``, ``ok``, ``message``, and
 ``paused``: the tree paused for it, or null) once the call returns; a goal is answered when
