@@ -1,5 +1,6 @@
-"""`cyborg bt run` in a real terminal (tmux): a node's prints and warnings each start a row of
-their own, and the live status line is drawn below them, never with them on one row."""
+"""`cyborg bt run` in a real terminal (tmux): a node's prints, warnings and errors each start a
+row of their own (an error in one line, no traceback), and the live status line is drawn below
+them, never with them on one row."""
 
 from __future__ import annotations
 
@@ -25,6 +26,8 @@ class Chatty(Action):
         if Chatty.ticks % 5 == 0:
             print(f"said hello {Chatty.ticks}")
             log.warning("the way is blocked %d", Chatty.ticks)
+        if Chatty.ticks == 33:
+            raise ValueError("the sensor is unplugged")
         return Status.RUNNING
 """
 
@@ -45,8 +48,8 @@ def test_prints_and_warnings_never_share_a_row_with_the_status_line(tmp_path: Pa
         deadline = time.monotonic() + 120
         while "EXITED" not in screen and time.monotonic() < deadline:
             time.sleep(0.5)
-            screen = subprocess.run([*tmux, "capture-pane", "-p"], capture_output=True,
-                                    text=True, check=True).stdout
+            screen = subprocess.run([*tmux, "capture-pane", "-p", "-J"],  # wrapped rows joined
+                                    capture_output=True, text=True, check=True).stdout
     finally:
         subprocess.run([*tmux, "kill-server"], check=False)
     rows = [row.rstrip() for row in screen.splitlines() if row.strip()]
@@ -62,3 +65,8 @@ def test_prints_and_warnings_never_share_a_row_with_the_status_line(tmp_path: Pa
     for row in rows:
         assert not ("tick " in row and ("said" in row or "WARNING" in row)), screen
     assert rows.index(status[0]) > rows.index(warned[-1]), "the line stays below them"
+    assert "Traceback" not in screen
+    (error,) = [row for row in rows if "ValueError" in row]  # one line, however long
+    assert error.startswith("ERROR cyborg.bt: node c (MoveTo room1, Chatty) raised in tick"), \
+        screen
+    assert "ValueError: the sensor is unplugged (at " in error

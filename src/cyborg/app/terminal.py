@@ -173,9 +173,13 @@ class OneLineErrors(logging.Formatter):
 
 @contextmanager
 def errors_on_one_line() -> Iterator[None]:
-    """While inside, the root logger's handlers write exceptions on one line (OneLineErrors)."""
+    """While inside, the root logger's handlers write exceptions on one line (OneLineErrors).
+
+    Above a live line too: the handler a wrapper hands records to is the one changed.
+    """
     root = logging.getLogger()
-    formatters = [(handler, handler.formatter) for handler in root.handlers]
+    formatters = [(handler, handler.formatter) for handler in
+                  (_written_by(handler) for handler in root.handlers)]
     for handler, formatter in formatters:
         handler.setFormatter(OneLineErrors(formatter._fmt if formatter is not None else None))
     try:
@@ -187,6 +191,11 @@ def errors_on_one_line() -> Iterator[None]:
 
 FLEET_WIDE = "fleet_wide"
 """A record's attribute (``extra={FLEET_WIDE: True}``) that says it is about every robot."""
+
+
+def _written_by(handler: logging.Handler) -> logging.Handler:
+    """The handler that formats what ``handler`` is given (the one above a live line wraps)."""
+    return handler.handler if isinstance(handler, AboveTheLine) else handler
 
 
 class NamesRobot(logging.Filter):
