@@ -1,36 +1,12 @@
 """The tree runner on the bus: load a behavior3editor tree, tick it, publish what it does.
 
-Under the runner's namespace (``/cyborg/bt`` by default, as in 2018), as
-:mod:`cyborg.interfaces.tree_runner` names them:
-
-==========================  ==================================  ==================================
-name                        type                                what
-==========================  ==================================  ==================================
-``behavior_tree``           cyborg_msgs/BehaviorTree            latched: the structure as JSON
-                                                                (schema cyborg.bt.structure/1),
-                                                                again after every reload
-``behavior_tree_updates``   cyborg_msgs/BehaviorTreeNodes       latched: ids of the active path,
-                                                                published when it changes
-``enabled``                 std_msgs/Bool                       latched: whether the tree ticks
-``stopped``                 std_msgs/Bool                       latched: whether ``stop`` halted it
-                                                                (until ``enable(true)``)
-``status``                  cyborg_msgs/BehaviorTreeStatus      every tick: nodes visited with
-                                                                their status and wall time
-                                                                (timed while someone listens),
-                                                                tick, duration, and the mode
-                                                                that ticked (of a mode file)
-``services``                cyborg_msgs/ServiceStates           latched: the services on the
-                                                                composites, when they change (at
-                                                                most 4 a second;
-                                                                :mod:`cyborg.runner.service_states`)
-``enable``                  std_srvs/SetBool                    service: run or pause the tree
-``stop``                    std_srvs/Trigger                    service: halt the tree and keep
-                                                                it halted until ``enable(true)``
-``reload``                  cyborg_msgs/ReloadTree              service: load the file again
-==========================  ==================================  ==================================
-
-plus the per-node controls of :mod:`cyborg.runner.tree_control` (hooks, breakpoints, blackboard),
-and the node parameter ``reload_timeout`` (seconds, wall time; default 30).
+Under the runner's namespace (``/cyborg/bt`` by default, as in 2018) it serves the topics and
+services that :mod:`cyborg.interfaces.tree_runner` names and describes (structure, active path,
+``enabled``, ``stopped``, ``status`` every tick with each node's wall time while someone
+listens, ``services`` at most 4 a second through :mod:`cyborg.runner.service_states`;
+``enable``, ``stop``, ``reload``), plus the per-node controls of
+:mod:`cyborg.runner.tree_control` (hooks, breakpoints, blackboard), and the node parameter
+``reload_timeout`` (seconds, wall time; default 30).
 
 **Services never wait on each other.** ``enable`` and ``stop`` are answered on a thread
 of its own, the other control services (``control``, ``step``, ``resume``,
@@ -39,36 +15,24 @@ node's own thread does (``/clock``, parameters). A reload loads in the backgroun
 
 **Enable and disable.** Unlike 2018, disabling *halts* the tree: every RUNNING node is halted,
 so a MoveTo cancels its goal and the robot stops. Enabling starts the tree afresh from its root
-(memories of halted nodes are reset, as after any halt). The flag is latched on ``enabled``.
-``stop`` (the monitor's red STOP) disables as ``enable(false)`` does and latches ``stopped``
-true, which only ``enable(true)`` clears: every watcher shows a stopped tree as stopped, not as
-merely paused, until someone resumes it.
-Disabling stops the ticks at once; the halt needs the tick in progress to end, so when a node
-in it waits on a slow robot, ``enable`` answers after :data:`HALT_WAIT` seconds anyway (saying
-so) and the halt follows when that tick ends; ``enable(true)`` meanwhile is refused (the tree
-must not run before its halt), never held up.
+(memories of halted nodes are reset, as after any halt). ``stop`` disables likewise and
+latches ``stopped`` until ``enable(true)``. Disabling stops the ticks at once; the halt needs
+the tick in progress to end, so when a node in it waits on a slow robot, ``enable`` answers
+after :data:`HALT_WAIT` seconds anyway (saying so) and the halt follows when that tick ends;
+``enable(true)`` meanwhile is refused (the tree must not run before its halt), never held up.
 
-**Reload.** The file (or another one) is loaded and checked first, on a thread of its own; a
-file with errors is rejected with every problem in the reply and the running tree keeps running.
-A good file replaces the tree between two ticks: the old tree is halted, the global blackboard
-and the hooks on nodes that still exist are kept, and the new structure is published. A load
-that has not finished after ``reload_timeout`` seconds is answered with ``reload timed out:
-...`` and the running tree keeps running; the load itself cannot be stopped (a thread cannot
-be killed), so it goes on in the background and whatever it ends with is discarded. One reload
-runs at a time, and hanging loads cannot pile up (see
-:mod:`cyborg.runner.background_reload`). The loader itself refuses files that are not regular
-and caps size, nesting and node instances.
+**Reload.** The file (or another one) is loaded and checked on a thread of its own, one at a
+time, answered within ``reload_timeout`` wall seconds (:mod:`cyborg.runner.background_reload`);
+a file with errors is rejected with every problem and the running tree keeps running; a good
+one replaces the tree between two ticks, keeping the global blackboard and the hooks on nodes
+that still exist (docs/controller.md).
 
-**Time.** The tree ticks on the clock it is given: the wall clock, or simulated time from
-``/clock`` (:class:`cyborg.bus.SimClock`) with ``use_sim_time``.
-
-**Modes.** Given a mode file (``*.toml``, docs/modes.md) instead of a tree file, the runner
-ticks a :class:`~cyborg.modes.ModeMachine` and serves :mod:`cyborg.interfaces.modes` as well
-(:mod:`cyborg.runner.mode_endpoints`). Everything above then concerns the current mode's tree:
-``behavior_tree`` is published again, and the per-node controls follow, whenever the mode
-changes (after a condition or time limit, once the status of the tick that led to it is out,
-so watchers never take the tree left's statuses for the tree entered's). A reload reads the
-mode file again (or another mode file; a runner started on a tree file reloads tree files); one
+**Time.** The tree ticks on the wall clock, or on ``/clock`` with ``use_sim_time``. **Modes.**
+Given a mode file (``*.toml``, docs/modes.md) instead of a tree file, the runner ticks a
+:class:`~cyborg.modes.ModeMachine` and serves :mod:`cyborg.interfaces.modes` as well
+(:mod:`cyborg.runner.mode_endpoints`). Everything above then concerns the current mode's tree,
+published again whenever the mode changes (after the status of the tick that led to it, so watchers
+never paint the tree left's statuses on the tree entered). A reload reads a mode file again; one
 that fails republishes the ``mode`` state with the file's problems.
 """
 
@@ -79,8 +43,6 @@ import logging
 import threading
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from cyborg.bt import (
     Blackboard,
@@ -96,11 +58,9 @@ from cyborg.bt.problems import Problem, TreeLoadError
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.tick_loop import DEFAULT_RATE
 from cyborg.bus import Node, SimClock
-from cyborg.bus.msgs.builtin_interfaces.msg import Time
 from cyborg.bus.msgs.cyborg_msgs.msg import (
     BehaviorTree,
     BehaviorTreeNodes,
-    BehaviorTreeStatus,
 )
 from cyborg.bus.msgs.cyborg_msgs.srv import ReloadTree, ReloadTree_Request, ReloadTree_Response
 from cyborg.bus.msgs.std_msgs.msg import Bool
@@ -118,6 +78,7 @@ from cyborg.robot.interface import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
 from cyborg.runner.mode_endpoints import ModeEndpoints
 from cyborg.runner.service_states import ServiceStatesPublisher
+from cyborg.runner.status_message import status_message
 from cyborg.runner.ticked import describe, mode_of, tree_of
 from cyborg.runner.tree_control import TreeControl
 
@@ -125,6 +86,9 @@ log = logging.getLogger("cyborg.runner")
 
 RELOAD_TIMEOUT = 30.0
 """Seconds (wall time) a reload may take before it is answered with an error."""
+STILL_HALTING = ("; ticking has stopped and the tree halts when its current tick ends (a node "
+                 "in it is still waiting, e.g. on the robot)")
+"""What an ``enable(false)`` or ``stop`` answered before the halt adds."""
 HALT_WAIT = 0.5
 """Seconds ``enable(false)`` waits for the halt before it answers (see ``set_enabled``)."""
 MODE_FILE_SUFFIX = ".toml"
@@ -417,15 +381,7 @@ class TreeRunnerNode:
             tree.timing = False  # from the next tick on, nodes run untimed again
             return  # nobody listens: skip building the message
         tree.timing = True  # per-node timings from the next tick on
-        seconds = snapshot.time
-        stamp = Time(sec=int(seconds), nanosec=int((seconds % 1.0) * 1e9) % 1_000_000_000)
-        visited = snapshot.visited
-        self._status.publish(BehaviorTreeStatus(
-            stamp=stamp, tick=snapshot.tick, duration=snapshot.duration,
-            status=int(snapshot.status), visited_ids=[uid for uid, _ in visited],
-            visited_statuses=np.array([int(status) for _, status in visited], np.uint8),
-            visited_durations=np.array(snapshot.visit_durations, np.float32),
-            active_ids=list(active), halted_ids=snapshot.halted, mode=self.mode_of(snapshot)))
+        self._status.publish(status_message(snapshot, self.mode_of(snapshot)))
 
     def mode_of(self, snapshot: TickSnapshot) -> str:
         """The mode whose tree made ``snapshot`` (a tick listener's); empty for a plain tree."""
@@ -444,18 +400,12 @@ class TreeRunnerNode:
                 "not enabled: the tree is still halting, because the tick before the disable "
                 "has not ended (a node in it is waiting, e.g. on the robot); try again"))
         message = "enabled" if self._enabled else "disabled"
-        if not done:
-            message += ("; ticking has stopped and the tree halts when its current tick ends "
-                        "(a node in it is still waiting, e.g. on the robot)")
-        return response(success=True, message=message)
+        return response(success=True, message=message + ("" if done else STILL_HALTING))
 
     def _on_stop(self, _request: Trigger_Request) -> Trigger_Response:
         done = self.stop_tree(wait=HALT_WAIT)
         message = "stopped: the tree is halted until it is enabled again"
-        if not done:
-            message += ("; ticking has stopped and the tree halts when its current tick ends "
-                        "(a node in it is still waiting, e.g. on the robot)")
-        return Trigger_Response(success=True, message=message)
+        return Trigger_Response(success=True, message=message + ("" if done else STILL_HALTING))
 
     def _on_reload(self, request: ReloadTree_Request,
                    responder: Responder[ReloadTree_Response]) -> None:
