@@ -114,6 +114,24 @@ def test_two_robots_swapping_places_never_overlap() -> None:
     assert math.hypot(second.pose.x - 0.8, second.pose.y - 3.0) < 0.2
 
 
+def test_two_robots_meeting_head_on_in_a_doorway_settle_it_and_both_arrive() -> None:
+    fleet = Fleet(parse_map(room_map([])), 2, start=Pose2D(2.5, 3.0, 0.0))
+    first, second = fleet.simulators
+    assert second.set_pose(Pose2D(7.5, 3.0, math.pi)) is None
+    assert first.go_to(Pose2D(8.5, 3.0)).found and second.go_to(Pose2D(1.5, 3.0)).found
+    states = set()
+    while fleet.time < 120 and not (first.navigator.state.finished
+                                    and second.navigator.state.finished):
+        fleet.step()
+        states.add(second.navigator.message)
+        assert polygon_gap(first.outline, second.outline) >= 0.0
+    assert fleet.way_giving.settled >= 1
+    assert "making way for robot 1" in states, "the second in the fleet gave way"
+    assert (first.navigator.state, second.navigator.state) == (robot.PathState.REACHED_GOAL,
+                                                               robot.PathState.REACHED_GOAL)
+    assert first.base.bumps == second.base.bumps == 0
+
+
 @pytest.mark.heavy
 def test_a_fleet_on_the_bus_has_one_clock_and_a_namespace_and_frames_per_robot() -> None:
     with Context(BusConfig.isolated()) as context:

@@ -14,12 +14,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cyborg.nav.arnl_map import ArnlMap, MapError, parse_map, read_map
+from cyborg.nav.footprint import PIONEER_LX
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_at
 from cyborg.sim.people import Crowd
 from cyborg.sim.people_sources import people_on_map, random_people
-from cyborg.sim.person import Gait, PeopleSettings, PersonPlan
+from cyborg.sim.person import Gait, PeopleSettings, Person, PersonPlan
 from cyborg.sim.simulator import Simulator
 from tests.small_maps import room_map
 
@@ -37,6 +38,18 @@ def campus() -> tuple[ArnlMap, Planner]:
 def room(*cairns: str) -> tuple[ArnlMap, Planner]:
     arnl_map = parse_map(room_map([*GOALS, *cairns]), "room.map")
     return arnl_map, Planner(arnl_map)
+
+
+def robot_at(pose: Pose2D) -> np.ndarray:
+    """A Pioneer LX's outline standing at ``pose`` in the room."""
+    return outline_at(PIONEER_LX.polygon(), pose)
+
+
+def beside_a_robot(plan: PersonPlan, pose: Pose2D) -> tuple[Planner, Crowd, Person, np.ndarray]:
+    """One person walking ``plan`` in the room, and a robot's outline standing at ``pose``."""
+    _map, planner = room()
+    crowd = Crowd(planner, [plan], seed=1)
+    return planner, crowd, crowd.people[0], robot_at(pose)
 
 
 def test_a_person_walks_at_their_own_speed_and_pauses_at_each_waypoint() -> None:
@@ -106,9 +119,7 @@ def test_a_person_stops_for_the_robot_and_turns_back_when_it_stays() -> None:
     _map, planner = room()
     crowd = Crowd(planner, [PersonPlan("bo", (2.0, 1.5), ((2.0, 4.5),))], seed=1)
     person = crowd.people[0]
-    robot = outline_at(Simulator(parse_map(room_map(GOALS), "room.map"),
-                                 Pose2D(2.0, 3.2, math.pi / 2)).base.footprint.polygon(),
-                       Pose2D(2.0, 3.2, math.pi / 2))
+    robot = robot_at(Pose2D(2.0, 3.2, math.pi / 2))
     closest, states = math.inf, []
     for _ in range(100):
         crowd.advance(0.1, [robot])
@@ -170,13 +181,48 @@ def test_the_laser_sees_a_person_in_front_of_the_robot() -> None:
 
 
 def test_a_person_steps_out_of_the_way_of_a_robot_coming_at_them() -> None:
-    _map, planner = room()
-    crowd = Crowd(planner, [PersonPlan("cy", (2.0, 4.2), ((2.0, 4.2),))], seed=1)
-    person = crowd.people[0]
     pose = Pose2D(2.0, 3.2, math.pi / 2)
-    robot = outline_at(Simulator(parse_map(room_map(GOALS), "room.map"),
-                                 pose).base.footprint.polygon(), pose)
+    planner, crowd, person, robot = beside_a_robot(
+        PersonPlan("cy", (2.0, 4.2), ((2.0, 4.2),)), pose)
     for _ in range(20):
         crowd.advance(0.1, [robot], [pose.theta])
     assert abs(person.x - 2.0) >= 0.4 + crowd.settings.radius, "aside, out of its way"
     assert planner.grid.clearance_at(planner.wall_clearance, person.x, person.y) >= 0.25
+
+
+def test_nobody_pauses_in_a_doorway_but_in_the_rooms() -> None:
+    _map, planner = room()
+    door, west = (5.0, 3.0), (2.0, 3.0)  # the wall's 1.2 m door, too narrow to pass anyone
+    crowd = Crowd(planner, [PersonPlan("di", west, (door, west))], seed=2)
+    person = crowd.people[0]
+    assert crowd.narrow(*door) and not crowd.narrow(*west)
+    pauses: dict[tuple[float, float], list[float]] = {door: [], west: []}
+    for _ in range(400):
+        crowd.advance(0.1)
+        if person.gait is Gait.PAUSING:
+            stints = pauses[person.goal]
+            stints.append(crowd.time - person.until)  # negative while the pause lasts
+    assert min(pauses[west]) <= -crowd.settings.min_pause + 0.2, "they pause in the room"
+    assert pauses[door] and max(-t for t in pauses[door]) <= 0.0, "not in the door"
+
+
+def test_a_person_walking_past_a_robot_that_stands_walks_on() -> None:
+    # the robot stands facing north at the room's middle; the person walks west to east
+    # across the line ahead of it, where a robot driving at them would have them step aside
+    pose = Pose2D(2.5, 3.2, math.pi / 2)
+    _planner, crowd, person, robot = beside_a_robot(
+        PersonPlan("ed", (1.0, 4.2), ((4.0, 4.2),)), pose)
+    for _ in range(60):
+        crowd.advance(0.1, [robot], [pose.theta], [0.0])
+    assert person.x > 3.5, "they crossed in front of it instead of standing beside its way"
+
+
+def test_a_person_on_the_way_a_robot_waits_to_drive_steps_off_it() -> None:
+    pose = Pose2D(3.0, 3.0, 0.0)  # west of the door, waiting to drive east through it
+    planner, crowd, person, robot = beside_a_robot(
+        PersonPlan("fay", (7.0, 3.0), ((7.0, 3.0),)), pose)
+    way = np.column_stack([np.arange(3.0, 9.0, 0.2), np.full(30, 3.0)])
+    for _ in range(100):
+        crowd.advance(0.1, [robot], [pose.theta], [0.0], [way])
+    gap = float(np.min(np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)))
+    assert gap >= planner.lethal + crowd.settings.radius, "off the way the robot waits to take"

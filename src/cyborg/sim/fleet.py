@@ -7,7 +7,8 @@ steps it meets the others (:meth:`Simulator.meet`): their outlines where they st
 obstacles to its laser, its drive, its navigator and its motion check. Since each robot moves
 while the others stand still, and its drive refuses any step that would make its body overlap
 another's (:mod:`cyborg.sim.bodies`), robots never overlap: one blocked by another stops, and
-its navigator waits and replans around it as ARNL does around any obstacle, or gives up.
+its navigator waits and replans around it as ARNL does around any obstacle, or gives up;
+two that meet head-on settle it, one making way for the other (:mod:`cyborg.sim.giving_way`).
 
 The robots start at distinct free poses (:func:`choose_starts`): the first where a lone robot
 would (:func:`cyborg.sim.start.choose_start`), the others at the free points nearest to it,
@@ -37,6 +38,7 @@ from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
 from cyborg.sim.bodies import KEEP_CLEAR, braking_poses, grown, outline_points, placed
+from cyborg.sim.giving_way import WayGiving
 from cyborg.sim.loop import PacedLoop, SimulationLock
 from cyborg.sim.people import NOBODY, Crowd, Meeting
 from cyborg.sim.simulator import SimSettings, Simulator
@@ -122,6 +124,7 @@ class Fleet:
         self._samples = [outline_points(grown(sim.base.footprint.polygon(), KEEP_CLEAR))
                          for sim in self.simulators]  # around each body, in its own frame
         self.crowd: Crowd | None = None  # people walking among the robots
+        self.way_giving = WayGiving(count)  # robots that meet head-on settle it
         self._met: list[Meeting] = []
 
     @property
@@ -153,7 +156,9 @@ class Fleet:
             sim = self.simulators[0]
             walked = self.crowd.due(self.steps_per_sensor / sim.settings.physics_rate)
             if walked:
-                self.crowd.advance(walked, outlines, [sim.pose.theta for sim in self.simulators])
+                self.crowd.advance(walked, outlines, [sim.pose.theta for sim in self.simulators],
+                                   [sim.base.speed for sim in self.simulators],
+                                   [sim.way_ahead() for sim in self.simulators])
             self._met = [self.crowd.meeting(sim.pose.x, sim.pose.y, sim.laser.spec.range_max)
                          if sim.planner is self.crowd.routes.planner else NOBODY
                          for sim in self.simulators]  # people walk on the fleet's first map
@@ -173,6 +178,8 @@ class Fleet:
                      met.circles if met and sensing else None)
             sim.step()
             outlines[index] = sim.outline  # where the next robot meets it
+        if sensing and len(self.simulators) > 1:
+            self.way_giving.step(self.simulators, self.time)
 
     def _near(self, index: int) -> list[int]:
         """The indices of the robots on ``index``'s map within its laser's reach."""

@@ -18,6 +18,12 @@ passes them, the robot stops and the state is ``WAITING_FOR_PATH``: it plans aga
 ``MOVING_TO_GOAL``, its stall clock started afresh. Waiting is not stalling: only a wait longer
 than ``wait_timeout`` ends the goal (``FAILED_MOVE``). A goal given while the only way is
 blocked so starts out waiting.
+
+**Making way.** Two robots that meet head-on in a doorway wait for each other for good; the
+fleet (:mod:`cyborg.sim.giving_way`) settles it by having one of them :meth:`~Navigator.
+make_way`: it drives a short path to a place beside the other's way and stands there, its goal
+kept and its state ``WAITING_FOR_PATH`` (waiting for the other to pass), until told to
+:meth:`~Navigator.resume`, when it plans to its goal again.
 """
 
 from __future__ import annotations
@@ -29,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from cyborg.interfaces.robot import PathState as PathState
-from cyborg.nav.geometry import Pose2D
+from cyborg.nav.geometry import Path, Pose2D
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.nav.temporary_obstacles import (
     ObstacleSettings,
@@ -89,18 +95,23 @@ class Navigator:
         self._replanned_at = -math.inf
         self._blocked_since: float | None = None
         self._ahead_since: float | None = None  # since when the laser sees the path blocked
+        self._blocked_way: Path | None = None  # the way a wait is for
+        self._aside: PathFollower | None = None  # making way: the path to the place aside
+        self.making_way = False
+        """Whether the robot makes way for another (see :meth:`make_way`)."""
 
     def go_to(self, start: Pose2D, goal: Pose2D, use_heading: bool, now: float) -> PlanResult:
         """Plan and start moving; the result says whether a path was found."""
         self.goal, self.use_heading = goal, use_heading
         self.state, self.follower, self.replans, self.waits = PathState.PLANNING_PATH, None, 0, 0
+        self.making_way, self._aside = False, None
         discs = self._discs(now, start)
         result = self.planner.plan(start, goal, use_heading=use_heading, discs=discs)
         if result.path is None and len(discs):
             unblocked = self.planner.plan(start, goal, use_heading=use_heading)
             if unblocked.path is not None:  # only the objects are in the way: wait for them
                 self.remaining = unblocked.length
-                self._start_waiting(now, len(discs))
+                self._start_waiting(now, len(discs), unblocked.path)
                 return unblocked
         if result.path is None:
             self.state, self.message = PathState.FAILED_PLAN, result.reason
@@ -117,6 +128,21 @@ class Navigator:
         self.remaining = self._best = result.length
         self._progress_at, self._blocked_since = now, None
 
+    def way_ahead(self, pose: Pose2D, reach: float, step: float = 0.2) -> np.ndarray:
+        """Points every ``step`` m along the next ``reach`` m of the way the robot means to take.
+
+        (N, 2), from the point nearest to ``pose`` on: the path it follows, or while it waits
+        for objects to make way, the path they block; empty when it has no goal. What people
+        keep off (:mod:`cyborg.sim.people`).
+        """
+        way = (self.follower.path if self.state is PathState.MOVING_TO_GOAL
+               and self.follower is not None else
+               self._blocked_way if self.state is PathState.WAITING_FOR_PATH else None)
+        if way is None:
+            return np.zeros((0, 2))
+        along, _gap = way.project(pose.x, pose.y)
+        return way.sample(along, along + reach, step)
+
     @property
     def waiting(self) -> bool:
         """Whether the robot stands waiting for a way past temporary obstacles."""
@@ -127,6 +153,26 @@ class Navigator:
         if not self.state.finished:
             self.state, self.message = PathState.ABORTED_PATHPLAN, "cancelled"
         self.follower = None
+        self.making_way, self._aside = False, None
+
+    def make_way(self, aside: Path, now: float, why: str) -> None:
+        """Drive ``aside`` (a short path off another robot's way) and stand at its end.
+
+        The goal is kept; the state is ``WAITING_FOR_PATH`` with ``why`` as the message (a
+        wait for the other to pass, not a stall) until :meth:`resume`.
+        """
+        self.making_way, self._aside = True, PathFollower(aside, False, self.settings.follower)
+        self.state, self.message = PathState.WAITING_FOR_PATH, why
+        self._waiting_since = self._tried_at = now
+        self.follower = None
+
+    def resume(self, now: float, pose: Pose2D) -> None:
+        """Done making way: plan from ``pose`` to the goal again and go on (or wait there)."""
+        if not self.making_way or self.goal is None:
+            return
+        waits = self.waits
+        self.go_to(pose, self.goal, self.use_heading, now)
+        self.waits = waits + 1
 
     def update(self, now: float, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
                hits: np.ndarray, motion: Motion | None = None,
@@ -139,6 +185,8 @@ class Navigator:
         (:func:`cyborg.sim.motion_check.safest_command`). Zero unless moving to a goal;
         braking while waiting for a way past temporary obstacles.
         """
+        if self.making_way:
+            return self._step_aside(pose, ranges, angles, hits, motion, period)
         if self.state is PathState.WAITING_FOR_PATH:
             return self._wait(now, pose, hits, motion, period)
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
@@ -180,6 +228,20 @@ class Navigator:
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
         return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
 
+    def _step_aside(self, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
+                    hits: np.ndarray, motion: Motion | None,
+                    period: float) -> tuple[float, float]:
+        """Drive to the place aside while making way, then stand there."""
+        if self._aside is None:
+            return self._checked(pose, (0.0, 0.0), hits, motion, period)
+        slow, stop = front_ranges(ranges, angles,
+                                  (SLOW_CORRIDOR, self.planner.footprint.width / 2))
+        command = self._aside.update(pose, slow, stop)
+        if command.arrived:
+            self._aside = None
+            return self._checked(pose, (0.0, 0.0), hits, motion, period)
+        return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
+
     def _checked(self, pose: Pose2D, command: tuple[float, float], hits: np.ndarray,
                  motion: Motion | None, period: float) -> tuple[float, float]:
         """``command``, or a gentler one if braking after it would touch what is known."""
@@ -208,8 +270,9 @@ class Navigator:
         return path_blocked(shrunk, ahead, self.planner.lethal,
                             self.settings.blocked_hysteresis)
 
-    def _start_waiting(self, now: float, count: int) -> None:
+    def _start_waiting(self, now: float, count: int, way: Path | None) -> None:
         self.state, self.waits = PathState.WAITING_FOR_PATH, self.waits + 1
+        self._blocked_way = way
         self.message = (f"waiting: {count} object{'s' if count != 1 else ''} seen lately "
                         f"block every way to the goal")
         self._waiting_since = self._tried_at = now
@@ -285,7 +348,7 @@ class Navigator:
             self.follower = PathFollower(result.path, self.use_heading, self.settings.follower)
             self._best = result.length
         elif len(discs):
-            self._start_waiting(now, len(discs))
+            self._start_waiting(now, len(discs), self.follower.path if self.follower else None)
 
 
 @njit(cache=True)

@@ -14,7 +14,12 @@ plus both bodies) is taken by a robot or another person stops and waits. Still b
 :attr:`~PeopleSettings.patience` s, they turn back towards the waypoint they came from, as a
 person in a corridor does when a robot stands in it. Someone standing at their waypoint makes
 it reached (within :data:`ARRIVED_NEAR`). And people make room for robots: whoever is closer
-than :data:`ROOM` to a robot's body steps away from it, if walls and others let them.
+than :data:`ROOM` to a robot's body steps away from it, if walls and others let them; whoever
+stands ahead of a robot steps aside, or, with no room aside, walks on (a pause ends). A person
+walking on their way past a robot that stands still walks on rather than side-step (stepping
+aside from a robot waiting for them, and back onto their way, they would stand there for
+good); and nobody pauses in a doorway or a passage too narrow for a robot to pass them
+(:meth:`Crowd.narrow`): they pause a step further on, where there is room.
 
 A person's body is a circle of :attr:`~PeopleSettings.radius` m, drawn as a regular octagon
 around it (:meth:`Crowd.outlines`): the shape the laser sees and the robot's drive cannot enter,
@@ -74,6 +79,16 @@ AHEAD = 2.5
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
+NO_WAY = np.zeros((0, 2))
+"""The way of a robot that means to drive nowhere."""
+REJOIN = 0.5
+"""Metres within which a person who stepped aside passes over a corner of their way in sight
+of the next (stepping aside again and again, they would otherwise queue a corner per step)."""
+STILL = 0.05
+"""Metres per second under which a robot counts as standing still: people walking on their
+way pass in front of it instead of stepping aside (:meth:`Crowd.advance`)."""
+NARROW_LOOK = 0.4
+"""Metres around a person within which :meth:`Crowd.narrow` looks for room to pass them."""
 OCTAGON = np.array([[math.cos(k * math.pi / 4), math.sin(k * math.pi / 4)] for k in range(8)])
 """A regular octagon of circumradius 1, counter-clockwise."""
 
@@ -92,6 +107,9 @@ class Crowd:
                               float(self._random.uniform(s.min_speed, s.max_speed)),
                               plan.waypoints, leg_from=plan.start) for plan in plans]
         self._clearance = planner.wall_clearance
+        # a robot passes a person where the way is wider than both and the room kept between
+        self._passing = s.radius + ROOM / 2 + planner.lethal
+        self._way_room = planner.lethal + s.radius + ROOM  # from a robot's way to a person
         for person in self.people:
             self._leave(person)
         # the octagon's edges touch the circle of `radius`, so the body is at least that round
@@ -132,11 +150,14 @@ class Crowd:
         points = (positions[close, None, :] + self._samples[None, :, :]).reshape(-1, 2)
         return Meeting(near, points, circles)
 
-    def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float) -> Meeting:
+    def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float,
+               speed: float = math.inf, way: np.ndarray = NO_WAY) -> Meeting:
         """Walk ``dt`` s around one robot and say what it meets.
 
         ``outline`` is K x 2, its first and last corners the front edge's, as
-        :meth:`~cyborg.nav.footprint.Footprint.polygon` gives them.
+        :meth:`~cyborg.nav.footprint.Footprint.polygon` gives them; ``speed`` the robot's
+        (m/s; by default it counts as driving), ``way`` the way it means to drive (see
+        :meth:`advance`).
 
         A robot whose ``planner`` is not the crowd's has switched maps: it meets nobody, and
         nobody walks.
@@ -147,7 +168,7 @@ class Crowd:
         walked = self.due(dt)
         if walked:
             front = (outline[0] + outline[-1]) / 2 - middle  # the middle of the front edge
-            self.advance(walked, [outline], [math.atan2(front[1], front[0])])
+            self.advance(walked, [outline], [math.atan2(front[1], front[0])], [speed], [way])
         return self.meeting(float(middle[0]), float(middle[1]), reach)
 
     def due(self, dt: float) -> float:
@@ -163,12 +184,19 @@ class Crowd:
 
     # ------------------------------------------------------------------ walking
     def advance(self, dt: float, robots: Sequence[np.ndarray] = (),
-                headings: Sequence[float] = ()) -> None:
+                headings: Sequence[float] = (), speeds: Sequence[float] = (),
+                ways: Sequence[np.ndarray] = ()) -> None:
         """Walk everyone ``dt`` seconds, keeping clear of ``robots`` (outlines, K x 2 each).
 
-        With the robots' ``headings`` (rad), people out of their way ahead too.
+        With the robots' ``headings`` (rad), people out of their way ahead too; with their
+        ``speeds`` (m/s), people walking on their way pass in front of one standing still
+        (slower than :data:`STILL`; a robot without a speed counts as driving). With their
+        ``ways`` ((M, 2) points along the way each means to drive, empty for none; see
+        :meth:`~cyborg.sim.navigator.Navigator.way_ahead`), people keep off those instead
+        of the line ahead (:meth:`_keep_off_ways`).
         """
         self.time += dt
+        stepped_off = self._keep_off_ways(dt, ways, speeds) if ways else set()
         walking = []
         for person in self.people:
             if person.gait is Gait.STANDING:
@@ -183,25 +211,127 @@ class Crowd:
             ahead = person.route[0]
             if (ahead[0], ahead[1]) != (person.x, person.y):
                 person.heading = math.atan2(ahead[1] - person.y, ahead[0] - person.x)
-            walking.append(person)
+            if id(person) not in stepped_off:
+                walking.append(person)
         circles = np.empty((len(robots), 3))
         for index, outline in enumerate(robots):
             middle = outline.sum(axis=0) / len(outline)
             circles[index, :2] = middle
             circles[index, 2] = math.sqrt(float(np.max(np.sum((outline - middle) ** 2, axis=1))))
         if walking:
-            for person, blocked in zip(walking, self._blocked(walking, circles), strict=True):
-                self._walk(person, dt, bool(blocked))
+            blocked = self._blocked(walking, circles) | self._onto_ways(walking, dt, ways,
+                                                                         speeds)
+            for person, stopped in zip(walking, blocked, strict=True):
+                self._walk(person, dt, bool(stopped))
         if len(circles):
-            self._make_room(dt, circles, headings)
+            without_way = [not (index < len(ways) and len(ways[index]))
+                           for index in range(len(circles))]
+            self._make_room(dt, circles, [heading if free else math.nan for heading, free
+                                          in zip(headings, without_way, strict=False)],
+                            speeds)
 
-    def _make_room(self, dt: float, robots: np.ndarray, headings: Sequence[float]) -> None:
+    # ------------------------------------------------------------------ robots' ways
+    def _keep_off_ways(self, dt: float, ways: Sequence[np.ndarray],
+                       speeds: Sequence[float]) -> set[int]:
+        """People on the way of a robot that stands step off it; the ``id`` s of those who did.
+
+        On the way means closer to one of its points than the robot's circumscribed radius,
+        their body and :data:`ROOM`: where the robot's wait for them would not end (a robot
+        that drives has people step out of the way as it comes, :meth:`_make_room`). They step
+        aside from it, else on along it (away from the robot, to where there is room aside),
+        squeezing past other people; with neither free, a pause ends.
+        """
+        moved: set[int] = set()
+        for index, way in enumerate(ways):
+            if len(way) < 2 or not self._stands(index, speeds):
+                continue
+            for person in self.people:
+                gaps = np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)
+                nearest = int(np.argmin(gaps))
+                if gaps[nearest] >= self._way_room:
+                    continue
+                moved.add(id(person))
+                if self._step_off(person, way, float(gaps[nearest]), nearest,
+                                  person.speed * dt):
+                    continue
+                if person.gait is Gait.PAUSING:
+                    person.until = self.time  # no room: walk on when the way lets them
+                else:
+                    moved.discard(id(person))  # no room: on their way, if it is free
+        return moved
+
+    def _step_off(self, person: Person, way: np.ndarray, gap: float, nearest: int,
+                  step: float) -> bool:
+        """One step of ``person`` off ``way``: aside, or on along it; whether one was free.
+
+        ``gap`` is their distance to the way, ``nearest`` the index of its point nearest to
+        them. Aside (the side away from the robot, at the way's first point, first) counts
+        only when it takes them almost a whole step further from the way (a bend of the way
+        round them, or a wall, leaves no such step); else they walk on along it, towards a point
+        more than a step further on than the nearest, following its bends to where there is
+        room aside. Squeezing past other people, brushing walls.
+        """
+        ux, uy = way[min(nearest + 1, len(way) - 1)] - way[max(nearest - 1, 0)]
+        norm = math.hypot(ux, uy) or 1.0
+        ux, uy = ux / norm, uy / norm
+        robot = way[0]
+        sides = sorted((1.0, -1.0), key=lambda side: -math.hypot(
+            person.x - side * uy - robot[0], person.y + side * ux - robot[1]))
+        for side in sides:
+            to = (person.x - side * uy * step, person.y + side * ux * step)
+            if (float(np.min(np.hypot(way[:, 0] - to[0], way[:, 1] - to[1])))
+                    >= gap + 0.8 * step and self._free(person, to, squeeze=True)):
+                self._move(person, to)
+                return True
+        spacing = math.hypot(*(way[1] - way[0])) or 1.0
+        onward = min(nearest + 2 + int(step / spacing), len(way) - 1)
+        dx, dy = way[onward, 0] - person.x, way[onward, 1] - person.y  # on along the way
+        length = math.hypot(dx, dy)
+        if length < 1e-9:
+            return False
+        to = (person.x + dx * min(1.0, step / length), person.y + dy * min(1.0, step / length))
+        if not self._free(person, to, squeeze=True):
+            return False
+        self._move(person, to)
+        return True
+
+    @staticmethod
+    def _stands(index: int, speeds: Sequence[float]) -> bool:
+        """Whether robot ``index`` stands (slower than :data:`STILL`; without a speed, no)."""
+        return index < len(speeds) and abs(speeds[index]) < STILL
+
+    def _onto_ways(self, walking: list[Person], dt: float, ways: Sequence[np.ndarray],
+                   speeds: Sequence[float]) -> np.ndarray:
+        """For each of ``walking``: whether their next step enters a standing robot's way.
+
+        They wait for it to be free: the way is taken, as by a body. (Someone on it already,
+        with no room to step off, walks on: anything but stand there.)
+        """
+        onto = np.zeros(len(walking), bool)
+        for index, way in enumerate(ways):
+            if len(way) < 2 or not self._stands(index, speeds):
+                continue
+            for k, person in enumerate(walking):
+                if len(person.route) == 0 or float(np.min(np.hypot(
+                        way[:, 0] - person.x, way[:, 1] - person.y))) < self._way_room:
+                    continue
+                tx, ty = person.route[0]
+                gap = math.hypot(tx - person.x, ty - person.y)
+                share = min(1.0, person.speed * dt / gap) if gap > 1e-9 else 0.0
+                x, y = person.x + (tx - person.x) * share, person.y + (ty - person.y) * share
+                onto[k] |= bool(np.min(np.hypot(way[:, 0] - x, way[:, 1] - y))
+                                < self._way_room)
+        return onto
+
+    def _make_room(self, dt: float, robots: np.ndarray, headings: Sequence[float],
+                   speeds: Sequence[float]) -> None:
         """People step out of robots' way, where walls and other people let them.
 
         Whoever is closer than :data:`ROOM` to a robot's body steps away from it; whoever is
         ahead of it (within :data:`AHEAD` along its heading, and its body and ours and
-        :data:`ROOM` aside) steps aside, else further ahead. A robot stuck beside a person
-        would be stuck for good.
+        :data:`ROOM` aside) steps aside, else further ahead, and with no room for either ends
+        a pause; but someone walking on their way passes in front of a robot standing still.
+        A robot stuck beside a person would be stuck for good.
         """
         s = self.settings
         for index, (cx, cy, radius) in enumerate(robots):
@@ -210,24 +340,31 @@ class Crowd:
                                     cx, cy, need,
                                     headings[index] if index < len(headings) else math.nan,
                                     AHEAD)
+            driving = index >= len(speeds) or abs(speeds[index]) >= STILL
+            heading = headings[index] if index < len(headings) else math.nan
             for person in (self.people[k] for k in np.flatnonzero(touched)):
-                self._room_for(person, cx, cy, need,
-                               headings[index] if index < len(headings) else None, dt)
+                self._room_for(person, cx, cy, need, None if math.isnan(heading) else heading,
+                               driving, dt)
 
     def _room_for(self, person: Person, cx: float, cy: float, need: float,
-                  heading: float | None, dt: float) -> None:
+                  heading: float | None, driving: bool, dt: float) -> None:
         """``person`` steps out of the way of a robot at ``(cx, cy)`` heading ``heading``.
 
-        ``need`` is the gap (m, centre to centre) the person keeps from the robot.
+        ``need`` is the gap (m, centre to centre) the person keeps from the robot; ``driving``
+        whether it moves (else someone walking on their way walks on past it).
         """
         dx, dy = person.x - cx, person.y - cy
         distance = math.hypot(dx, dy)
-        if heading is not None:
+        passing = person.gait is Gait.WALKING and not driving
+        if heading is not None and not passing:
             ux, uy = math.cos(heading), math.sin(heading)
             along, across = dx * ux + dy * uy, uy * dx - ux * dy
             if 0.0 < along <= AHEAD and abs(across) < need:
                 side = heading + (-math.pi / 2 if across >= 0 else math.pi / 2)
-                self._step_away(person, side, person.speed * dt, (0.0, math.pi / 4, math.pi / 2))
+                if (not self._step_away(person, side, person.speed * dt,
+                                        (0.0, math.pi / 4, math.pi / 2))
+                        and person.gait is Gait.PAUSING):
+                    person.until = self.time  # no room aside: walk on instead
                 return
         if distance >= need:
             return
@@ -237,30 +374,45 @@ class Crowd:
                         SIDESTEPS)
 
     def _step_away(self, person: Person, away: float, step: float,
-                   turns: tuple[float, ...]) -> None:
+                   turns: tuple[float, ...], squeeze: bool = False) -> bool:
         """Step ``step`` m towards ``away`` (rad), or the first of ``turns`` from it that is free.
 
-        Each turn is tried to the left and then to the right.
+        Each turn is tried to the left and then to the right. Whether a step was free; with
+        ``squeeze``, of walls only (people squeeze past each other to clear a robot's way).
         """
         for turn in turns:
             for sign in ((1.0, -1.0) if turn else (1.0,)):
                 to = (person.x + step * math.cos(away + sign * turn),
                       person.y + step * math.sin(away + sign * turn))
-                if self._free(person, to):
-                    here = (person.x, person.y)
-                    person.trail.append(here)  # the way back passes here
-                    if len(person.route) and not self._clear(to, person.route[0]):
-                        person.route = np.vstack([here, person.route])  # and the way on
-                    person.x, person.y = to
-                    return
+                if self._free(person, to, squeeze):
+                    self._move(person, to)
+                    return True
+        return False
 
-    def _free(self, person: Person, to: Point) -> bool:
-        """Whether ``person`` may step to ``to``: clear of walls and other people."""
+    def _move(self, person: Person, to: Point) -> None:
+        """Put ``person`` at ``to``, a step off their way: the way back and on pass here."""
+        here = (person.x, person.y)
+        person.trail.append(here)
+        route = person.route  # corners close by in sight of the next are passed over
+        while (len(route) > 1 and math.dist(route[0], to) <= REJOIN
+               and self._clear(to, route[1], 0.0)):
+            route = route[1:]
+        if len(route) and not self._clear(to, route[0], 0.0):
+            route = np.vstack([here, route])
+        person.route = route
+        person.x, person.y = to
+
+    def _free(self, person: Person, to: Point, squeeze: bool = False) -> bool:
+        """Whether ``person`` may step to ``to``: clear of walls and other people.
+
+        With ``squeeze``, of walls only, brushing past them.
+        """
         s = self.settings
-        if not self._clear((person.x, person.y), np.array(to)):
+        if not self._clear((person.x, person.y), np.array(to), 0.0 if squeeze else 0.05):
             return False
-        return not any(other is not person and math.hypot(other.x - to[0], other.y - to[1])
-                       < 2 * s.radius for other in self.people)
+        return squeeze or not any(other is not person and math.hypot(other.x - to[0],
+                                                                      other.y - to[1])
+                                  < 2 * s.radius for other in self.people)
 
     def _walk(self, person: Person, dt: float, blocked: bool) -> None:
         if blocked:
@@ -301,12 +453,30 @@ class Crowd:
         return in_the_way(here, self.positions, s.radius, robots, s.look_ahead)
 
     def _arrive(self, person: Person) -> None:
-        """Pause at the waypoint (or as near it as they got), then go on to the next."""
+        """Pause at the waypoint (or as near it as they got), then go on to the next.
+
+        Where the way is :meth:`narrow` there is no pause: they go on at once.
+        """
         s = self.settings
         person.gait = Gait.PAUSING
         person.leg_from = person.goal
         person.trail = person.trail[-1:] if len(person.route) == 0 else []
-        person.until = self.time + float(self._random.uniform(s.min_pause, s.max_pause))
+        pause = float(self._random.uniform(s.min_pause, s.max_pause))
+        person.until = self.time + (0.0 if self.narrow(person.x, person.y) else pause)
+
+    def narrow(self, x: float, y: float) -> bool:
+        """Whether ``(x, y)`` lies in a passage too narrow for a robot to pass a person there.
+
+        A doorway, a narrow corridor: within :data:`NARROW_LOOK` m of the point no place
+        is further from the walls than half the width a robot passing a person needs (both
+        bodies and half of :data:`ROOM`).
+        """
+        grid = self.routes.planner.grid
+        row, column = grid.cell(x, y)
+        reach = math.ceil(NARROW_LOOK / grid.resolution)
+        window = self._clearance[max(row - reach, 0):row + reach + 1,
+                                 max(column - reach, 0):column + reach + 1]
+        return window.size == 0 or float(window.max()) < self._passing
 
     def _leave(self, person: Person) -> bool:
         """Set off for waypoint ``then``, or the next one that can be reached; whether any.
@@ -335,12 +505,15 @@ class Crowd:
         person.gait, person.route = Gait.STANDING, np.zeros((0, 2))
         return False
 
-    def _clear(self, start: Point, end: np.ndarray) -> bool:
-        """Whether a person walks from ``start`` to ``end`` in a straight line clear of walls."""
+    def _clear(self, start: Point, end: np.ndarray, spare: float = 0.05) -> bool:
+        """Whether a person walks from ``start`` to ``end`` in a straight line clear of walls.
+
+        Clear: their body and ``spare`` m from every wall.
+        """
         grid = self.routes.planner.grid
         return bool(line_clear(self._clearance, grid.origin_x, grid.origin_y, grid.resolution,
                                 float(start[0]), float(start[1]), float(end[0]), float(end[1]),
-                                self.settings.radius + 0.05))
+                                self.settings.radius + spare))
 
     def _turn_back(self, person: Person) -> None:
         """Blocked for too long: walk back the way they came, to try again after a pause.

@@ -192,6 +192,16 @@ class Simulator:
             return None
         return self._target
 
+    def way_ahead(self) -> np.ndarray:
+        """The way the robot means to drive next, as far as objects it waits for may lie.
+
+        (N, 2) points (:meth:`~cyborg.sim.navigator.Navigator.way_ahead`), twice the
+        navigator's ``obstacle_range`` along it (a way winds: an object that range away as
+        the crow flies may lie further along it); empty without a goal. People keep off it
+        (:mod:`cyborg.sim.people`).
+        """
+        return self.navigator.way_ahead(self.pose, 2 * self.settings.navigator.obstacle_range)
+
     # ------------------------------------------------------------------ requests
     def resolve(self, goal: Pose2D | str, use_heading: bool | None = None) -> tuple[Pose2D, bool]:
         """A goal name or pose as ``(pose, use_heading)``; a name's kind decides the heading."""
@@ -313,7 +323,8 @@ class Simulator:
         if self._steps % self.steps_per_sensor == 0:
             if self.crowd is not None:
                 self.meet(*self.crowd.beside(self.planner, self.outline, self._period,
-                                             self.laser.spec.range_max))
+                                             self.laser.spec.range_max, self.base.speed,
+                                             self.way_ahead()))
             self._sense()
             self._command = self._decide()
         self._steps += 1
