@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from cyborg.nav.arnl_map import parse_map
+from cyborg.nav.arnl_map import parse_map, read_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.sim.navigator import NavigatorSettings, PathState
 from cyborg.sim.simulator import SimSettings, Simulator
@@ -141,3 +142,20 @@ def test_someone_who_stays_on_the_path_is_planned_around() -> None:
     settings = sim.navigator.settings
     stays = settings.blocked_persistence + settings.replan_interval + 0.5
     assert laser_sees_for(sim, (sim.pose.x + 2.0, 1.8), stays) >= 1
+
+
+def test_a_wait_ends_where_the_laser_sees_only_the_maps_walls(shared: Path) -> None:
+    # AMROffice's passages are hardly wider than the robot: its walls, seen again as laser
+    # returns a cell off the map's, closed every plan past what the laser sees, so a wait for
+    # a person never ended there, though the person had long gone (a minute, then FAILED_MOVE)
+    sim = Simulator(read_map(shared / "maps" / "AMROffice.map"), "room2")
+    assert sim.go_to("room1").found
+    while sim.time < 3.0:  # someone in the corridor ahead, for a while; then gone
+        sim.navigator.obstacles.see(1, -7.45, -1.2, sim.time)
+        sim.step()
+    states = [sim.navigator.state]
+    while not sim.navigator.state.finished and sim.time < 60.0:
+        sim.step()
+        if sim.navigator.state is not states[-1]:
+            states.append(sim.navigator.state)
+    assert sim.navigator.state is PathState.REACHED_GOAL, (states, sim.navigator.message)

@@ -46,6 +46,10 @@ from cyborg.nav.temporary_obstacles import (
 from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
 from cyborg.sim.motion_check import Motion, Surroundings, safest_command
 
+MAPPED = 0.15
+"""Metres from a mapped wall within which a laser return is that wall (see
+:meth:`Navigator._unmapped`)."""
+
 
 @dataclass(frozen=True)
 class NavigatorSettings:
@@ -293,11 +297,26 @@ class Navigator:
                 self._follow(result, now)
         return self._checked(pose, (0.0, 0.0), hits, motion, period)
 
-    def _plan_around(self, pose: Pose2D, hits: np.ndarray, discs: np.ndarray) -> PlanResult:
-        """A plan from ``pose`` past the laser's near returns and the discs."""
-        assert self.goal is not None
+    def _unmapped(self, pose: Pose2D, hits: np.ndarray) -> np.ndarray:
+        """The returns within ``sensed_range`` of ``pose`` that the map does not explain.
+
+        A return on a mapped wall (within :data:`MAPPED` m of it) is that wall, which the
+        planner keeps clear of already; taken again as a point, sampled a cell off the
+        planner's own, it would close a passage that the robot only just clears (AMROffice's
+        doors) to every plan past what it does not know.
+        """
         near = hits[np.hypot(hits[:, 0] - pose.x, hits[:, 1] - pose.y)
                     < self.settings.sensed_range]
+        if len(near) == 0:
+            return near
+        rows, columns = self.planner.grid.cells_of(near)
+        unmapped: np.ndarray = near[self.planner.wall_clearance[rows, columns] > MAPPED]
+        return unmapped
+
+    def _plan_around(self, pose: Pose2D, hits: np.ndarray, discs: np.ndarray) -> PlanResult:
+        """A plan from ``pose`` past the laser's near returns the map lacks and the discs."""
+        assert self.goal is not None
+        near = self._unmapped(pose, hits)
         return self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near,
                                  discs=discs)
 
@@ -314,8 +333,8 @@ class Navigator:
         path, settings = self.follower.path, self.settings
         along, _gap = path.project(pose.x, pose.y)
         beyond = Pose2D(*path.point_at(along + settings.look_ahead + 1.0))
-        near = hits[np.hypot(hits[:, 0] - pose.x, hits[:, 1] - pose.y) < settings.sensed_range]
-        return self.planner.passable_near(pose, beyond, near, settings.detour_margin)
+        return self.planner.passable_near(pose, beyond, self._unmapped(pose, hits),
+                                          settings.detour_margin)
 
     def _blocked_for(self, now: float, pose: Pose2D, hits: np.ndarray) -> float:
         """Seconds the laser has seen the path ahead blocked without a break (0: clear now).
