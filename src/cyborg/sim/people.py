@@ -13,13 +13,11 @@ Nobody walks into anybody: a person whose way ahead (:attr:`~PeopleSettings.look
 plus both bodies) is taken by a robot or another person stops and waits. Still blocked after
 :attr:`~PeopleSettings.patience` s, they turn back towards the waypoint they came from, as a
 person in a corridor does when a robot stands in it. Someone standing at their waypoint makes
-it reached (within :data:`ARRIVED_NEAR`). And people make room for robots: whoever is closer
-than :data:`ROOM` to a robot's body steps away from it, if walls and others let them; whoever
-stands ahead of a robot steps aside, or, with no room aside, walks on (a pause ends). A person
-walking on their way past a robot that stands still walks on rather than side-step (stepping
-aside from a robot waiting for them, and back onto their way, they would stand there for
-good); and nobody pauses in a doorway or a passage too narrow for a robot to pass them
-(:meth:`Crowd.narrow`): they pause a step further on, where there is room.
+it reached (within :data:`ARRIVED_NEAR`). And people make room for robots
+(:mod:`cyborg.sim.room_for_robots`): they step away from a robot's body, out of the way of a
+robot that drives at them, off the way a robot that stands waits to take; a person walking
+on their way past a robot that stands walks on. Nobody pauses in a doorway or a passage too
+narrow for a robot to pass them (:meth:`Crowd.narrow`): they walk on at once.
 
 A person's body is a circle of :attr:`~PeopleSettings.radius` m, drawn as a regular octagon
 around it (:meth:`Crowd.outlines`): the shape the laser sees and the robot's drive cannot enter,
@@ -41,9 +39,10 @@ import numpy as np
 
 from cyborg.nav.planner import Planner
 from cyborg.sim.bodies import outline_points
-from cyborg.sim.crowd_geometry import in_robots_way, in_the_way, line_clear
+from cyborg.sim.crowd_geometry import in_the_way, line_clear
 from cyborg.sim.people_routes import Point, RouteBook
 from cyborg.sim.person import Gait, PeopleSettings, Person, PersonPlan
+from cyborg.sim.room_for_robots import ROOM, RoomForRobots
 
 NEAR = 3.0
 """Metres from a robot within which people are bodies its drive cannot enter, and points its
@@ -66,34 +65,21 @@ class Meeting(NamedTuple):
 
 NOBODY = Meeting((), np.zeros((0, 2)), np.zeros((0, 3)))
 """What a robot meets where no one walks."""
-ROOM = 0.3
-"""Metres people keep between their bodies and a robot's when they can: closer, they step
-away from it (the robot's body counted as the circle around its outline)."""
-SIDESTEPS = (0.0, math.pi / 4, -math.pi / 4, math.pi / 2, -math.pi / 2)
-"""Turns (rad) from straight away from a robot that a person making room for it tries."""
 WALK_PERIOD = 0.2
 """Seconds between two steps of the crowd: 30 cm at 1.5 m/s, fine enough for walking people
 and half the work of stepping them with the robots' 10 Hz sensors."""
-AHEAD = 2.5
-"""Metres ahead of a robot within which people step out of its way."""
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
 NO_WAY = np.zeros((0, 2))
 """The way of a robot that means to drive nowhere."""
-REJOIN = 0.5
-"""Metres within which a person who stepped aside passes over a corner of their way in sight
-of the next (stepping aside again and again, they would otherwise queue a corner per step)."""
-STILL = 0.05
-"""Metres per second under which a robot counts as standing still: people walking on their
-way pass in front of it instead of stepping aside (:meth:`Crowd.advance`)."""
 NARROW_LOOK = 0.4
 """Metres around a person within which :meth:`Crowd.narrow` looks for room to pass them."""
 OCTAGON = np.array([[math.cos(k * math.pi / 4), math.sin(k * math.pi / 4)] for k in range(8)])
 """A regular octagon of circumradius 1, counter-clockwise."""
 
 
-class Crowd:
+class Crowd(RoomForRobots):
     """People walking on a map; see the module doc. ``seed`` makes their speeds and pauses."""
 
     def __init__(self, planner: Planner, plans: Sequence[PersonPlan],
@@ -120,11 +106,6 @@ class Crowd:
     def __len__(self) -> int:
         """How many people walk."""
         return len(self.people)
-
-    @property
-    def positions(self) -> np.ndarray:
-        """Every person's position, (N, 2) metres in the map frame."""
-        return np.array([(p.x, p.y) for p in self.people], dtype=np.float64).reshape(-1, 2)
 
     def outlines(self) -> np.ndarray:
         """Every person's body as an octagon: (N, 8, 2) map coordinates."""
@@ -190,7 +171,8 @@ class Crowd:
 
         With the robots' ``headings`` (rad), people out of their way ahead too; with their
         ``speeds`` (m/s), people walking on their way pass in front of one standing still
-        (slower than :data:`STILL`; a robot without a speed counts as driving). With their
+        (slower than :data:`~cyborg.sim.room_for_robots.STILL`; a robot without a speed
+        counts as driving). With their
         ``ways`` ((M, 2) points along the way each means to drive, empty for none; see
         :meth:`~cyborg.sim.navigator.Navigator.way_ahead`), people keep off those instead
         of the line ahead (:meth:`_keep_off_ways`).
@@ -229,190 +211,6 @@ class Crowd:
             self._make_room(dt, circles, [heading if free else math.nan for heading, free
                                           in zip(headings, without_way, strict=False)],
                             speeds)
-
-    # ------------------------------------------------------------------ robots' ways
-    def _keep_off_ways(self, dt: float, ways: Sequence[np.ndarray],
-                       speeds: Sequence[float]) -> set[int]:
-        """People on the way of a robot that stands step off it; the ``id`` s of those who did.
-
-        On the way means closer to one of its points than the robot's circumscribed radius,
-        their body and :data:`ROOM`: where the robot's wait for them would not end (a robot
-        that drives has people step out of the way as it comes, :meth:`_make_room`). They step
-        aside from it, else on along it (away from the robot, to where there is room aside),
-        squeezing past other people; with neither free, a pause ends.
-        """
-        moved: set[int] = set()
-        for index, way in enumerate(ways):
-            if len(way) < 2 or not self._stands(index, speeds):
-                continue
-            for person in self.people:
-                gaps = np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)
-                nearest = int(np.argmin(gaps))
-                if gaps[nearest] >= self._way_room:
-                    continue
-                moved.add(id(person))
-                if self._step_off(person, way, float(gaps[nearest]), nearest,
-                                  person.speed * dt):
-                    continue
-                if person.gait is Gait.PAUSING:
-                    person.until = self.time  # no room: walk on when the way lets them
-                else:
-                    moved.discard(id(person))  # no room: on their way, if it is free
-        return moved
-
-    def _step_off(self, person: Person, way: np.ndarray, gap: float, nearest: int,
-                  step: float) -> bool:
-        """One step of ``person`` off ``way``: aside, or on along it; whether one was free.
-
-        ``gap`` is their distance to the way, ``nearest`` the index of its point nearest to
-        them. Aside (the side away from the robot, at the way's first point, first) counts
-        only when it takes them almost a whole step further from the way (a bend of the way
-        round them, or a wall, leaves no such step); else they walk on along it, towards a point
-        more than a step further on than the nearest, following its bends to where there is
-        room aside. Squeezing past other people, brushing walls.
-        """
-        ux, uy = way[min(nearest + 1, len(way) - 1)] - way[max(nearest - 1, 0)]
-        norm = math.hypot(ux, uy) or 1.0
-        ux, uy = ux / norm, uy / norm
-        robot = way[0]
-        sides = sorted((1.0, -1.0), key=lambda side: -math.hypot(
-            person.x - side * uy - robot[0], person.y + side * ux - robot[1]))
-        for side in sides:
-            to = (person.x - side * uy * step, person.y + side * ux * step)
-            if (float(np.min(np.hypot(way[:, 0] - to[0], way[:, 1] - to[1])))
-                    >= gap + 0.8 * step and self._free(person, to, squeeze=True)):
-                self._move(person, to)
-                return True
-        spacing = math.hypot(*(way[1] - way[0])) or 1.0
-        onward = min(nearest + 2 + int(step / spacing), len(way) - 1)
-        dx, dy = way[onward, 0] - person.x, way[onward, 1] - person.y  # on along the way
-        length = math.hypot(dx, dy)
-        if length < 1e-9:
-            return False
-        to = (person.x + dx * min(1.0, step / length), person.y + dy * min(1.0, step / length))
-        if not self._free(person, to, squeeze=True):
-            return False
-        self._move(person, to)
-        return True
-
-    @staticmethod
-    def _stands(index: int, speeds: Sequence[float]) -> bool:
-        """Whether robot ``index`` stands (slower than :data:`STILL`; without a speed, no)."""
-        return index < len(speeds) and abs(speeds[index]) < STILL
-
-    def _onto_ways(self, walking: list[Person], dt: float, ways: Sequence[np.ndarray],
-                   speeds: Sequence[float]) -> np.ndarray:
-        """For each of ``walking``: whether their next step enters a standing robot's way.
-
-        They wait for it to be free: the way is taken, as by a body. (Someone on it already,
-        with no room to step off, walks on: anything but stand there.)
-        """
-        onto = np.zeros(len(walking), bool)
-        for index, way in enumerate(ways):
-            if len(way) < 2 or not self._stands(index, speeds):
-                continue
-            for k, person in enumerate(walking):
-                if len(person.route) == 0 or float(np.min(np.hypot(
-                        way[:, 0] - person.x, way[:, 1] - person.y))) < self._way_room:
-                    continue
-                tx, ty = person.route[0]
-                gap = math.hypot(tx - person.x, ty - person.y)
-                share = min(1.0, person.speed * dt / gap) if gap > 1e-9 else 0.0
-                x, y = person.x + (tx - person.x) * share, person.y + (ty - person.y) * share
-                onto[k] |= bool(np.min(np.hypot(way[:, 0] - x, way[:, 1] - y))
-                                < self._way_room)
-        return onto
-
-    def _make_room(self, dt: float, robots: np.ndarray, headings: Sequence[float],
-                   speeds: Sequence[float]) -> None:
-        """People step out of robots' way, where walls and other people let them.
-
-        Whoever is closer than :data:`ROOM` to a robot's body steps away from it; whoever is
-        ahead of it (within :data:`AHEAD` along its heading, and its body and ours and
-        :data:`ROOM` aside) steps aside, else further ahead, and with no room for either ends
-        a pause; but someone walking on their way passes in front of a robot standing still.
-        A robot stuck beside a person would be stuck for good.
-        """
-        s = self.settings
-        for index, (cx, cy, radius) in enumerate(robots):
-            need = radius + s.radius + ROOM
-            touched = in_robots_way(self.positions,  # as the robots before this one left them
-                                    cx, cy, need,
-                                    headings[index] if index < len(headings) else math.nan,
-                                    AHEAD)
-            driving = index >= len(speeds) or abs(speeds[index]) >= STILL
-            heading = headings[index] if index < len(headings) else math.nan
-            for person in (self.people[k] for k in np.flatnonzero(touched)):
-                self._room_for(person, cx, cy, need, None if math.isnan(heading) else heading,
-                               driving, dt)
-
-    def _room_for(self, person: Person, cx: float, cy: float, need: float,
-                  heading: float | None, driving: bool, dt: float) -> None:
-        """``person`` steps out of the way of a robot at ``(cx, cy)`` heading ``heading``.
-
-        ``need`` is the gap (m, centre to centre) the person keeps from the robot; ``driving``
-        whether it moves (else someone walking on their way walks on past it).
-        """
-        dx, dy = person.x - cx, person.y - cy
-        distance = math.hypot(dx, dy)
-        passing = person.gait is Gait.WALKING and not driving
-        if heading is not None and not passing:
-            ux, uy = math.cos(heading), math.sin(heading)
-            along, across = dx * ux + dy * uy, uy * dx - ux * dy
-            if 0.0 < along <= AHEAD and abs(across) < need:
-                side = heading + (-math.pi / 2 if across >= 0 else math.pi / 2)
-                if (not self._step_away(person, side, person.speed * dt,
-                                        (0.0, math.pi / 4, math.pi / 2))
-                        and person.gait is Gait.PAUSING):
-                    person.until = self.time  # no room aside: walk on instead
-                return
-        if distance >= need:
-            return
-        if distance < 1e-9:
-            dx, dy, distance = -math.cos(person.heading), -math.sin(person.heading), 1.0
-        self._step_away(person, math.atan2(dy, dx), min(need - distance, person.speed * dt),
-                        SIDESTEPS)
-
-    def _step_away(self, person: Person, away: float, step: float,
-                   turns: tuple[float, ...], squeeze: bool = False) -> bool:
-        """Step ``step`` m towards ``away`` (rad), or the first of ``turns`` from it that is free.
-
-        Each turn is tried to the left and then to the right. Whether a step was free; with
-        ``squeeze``, of walls only (people squeeze past each other to clear a robot's way).
-        """
-        for turn in turns:
-            for sign in ((1.0, -1.0) if turn else (1.0,)):
-                to = (person.x + step * math.cos(away + sign * turn),
-                      person.y + step * math.sin(away + sign * turn))
-                if self._free(person, to, squeeze):
-                    self._move(person, to)
-                    return True
-        return False
-
-    def _move(self, person: Person, to: Point) -> None:
-        """Put ``person`` at ``to``, a step off their way: the way back and on pass here."""
-        here = (person.x, person.y)
-        person.trail.append(here)
-        route = person.route  # corners close by in sight of the next are passed over
-        while (len(route) > 1 and math.dist(route[0], to) <= REJOIN
-               and self._clear(to, route[1], 0.0)):
-            route = route[1:]
-        if len(route) and not self._clear(to, route[0], 0.0):
-            route = np.vstack([here, route])
-        person.route = route
-        person.x, person.y = to
-
-    def _free(self, person: Person, to: Point, squeeze: bool = False) -> bool:
-        """Whether ``person`` may step to ``to``: clear of walls and other people.
-
-        With ``squeeze``, of walls only, brushing past them.
-        """
-        s = self.settings
-        if not self._clear((person.x, person.y), np.array(to), 0.0 if squeeze else 0.05):
-            return False
-        return squeeze or not any(other is not person and math.hypot(other.x - to[0],
-                                                                      other.y - to[1])
-                                  < 2 * s.radius for other in self.people)
 
     def _walk(self, person: Person, dt: float, blocked: bool) -> None:
         if blocked:
@@ -469,7 +267,7 @@ class Crowd:
 
         A doorway, a narrow corridor: within :data:`NARROW_LOOK` m of the point no place
         is further from the walls than half the width a robot passing a person needs (both
-        bodies and half of :data:`ROOM`).
+        bodies and half of :data:`~cyborg.sim.room_for_robots.ROOM`).
         """
         grid = self.routes.planner.grid
         row, column = grid.cell(x, y)

@@ -193,13 +193,7 @@ class Simulator:
         return self._target
 
     def way_ahead(self) -> np.ndarray:
-        """The way the robot means to drive next, as far as objects it waits for may lie.
-
-        (N, 2) points (:meth:`~cyborg.sim.navigator.Navigator.way_ahead`), twice the
-        navigator's ``obstacle_range`` along it (a way winds: an object that range away as
-        the crow flies may lie further along it); empty without a goal. People keep off it
-        (:mod:`cyborg.sim.people`).
-        """
+        """The next (N, 2) points of its way, 2 ``obstacle_range`` on (a way winds); or none."""
         return self.navigator.way_ahead(self.pose, 2 * self.settings.navigator.obstacle_range)
 
     # ------------------------------------------------------------------ requests
