@@ -226,3 +226,13 @@ def test_a_person_on_the_way_a_robot_waits_to_drive_steps_off_it() -> None:
         crowd.advance(0.1, [robot], [pose.theta], [0.0], [way])
     gap = float(np.min(np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)))
     assert gap >= planner.lethal + crowd.settings.radius, "off the way the robot waits to take"
+
+
+def test_a_person_squeezed_against_a_wall_can_still_step_out_of_a_robots_way() -> None:
+    pose = Pose2D(1.15, 3.0, math.pi)  # a robot right in front of them, facing the wall
+    _planner, crowd, person, robot = beside_a_robot(
+        PersonPlan("gus", (0.27, 3.0), ((0.27, 3.0),)), pose)  # 2 cm closer than they keep
+    for _ in range(20):
+        crowd.advance(0.1, [robot], [pose.theta])
+    assert abs(person.y - 3.0) > 0.3, "along the wall, out of its way"
+    assert person.x >= 0.27 - 1e-6, "no closer to the wall than they were"

@@ -306,12 +306,14 @@ class Crowd(RoomForRobots):
     def _clear(self, start: Point, end: np.ndarray, spare: float = 0.05) -> bool:
         """Whether a person walks from ``start`` to ``end`` in a straight line clear of walls.
 
-        Clear: their body and ``spare`` m from every wall.
+        Clear: their body and ``spare`` m from every wall, or, from a start closer than that
+        (someone squeezed past), no closer than there: else they could never move again.
         """
         grid = self.routes.planner.grid
+        here = grid.clearance_at(self._clearance, float(start[0]), float(start[1]))
         return bool(line_clear(self._clearance, grid.origin_x, grid.origin_y, grid.resolution,
                                 float(start[0]), float(start[1]), float(end[0]), float(end[1]),
-                                self.settings.radius + spare))
+                                min(self.settings.radius + spare, here - 1e-6)))
 
     def _turn_back(self, person: Person) -> None:
         """Blocked for too long: walk back the way they came, to try again after a pause.
