@@ -236,3 +236,21 @@ def test_a_person_squeezed_against_a_wall_can_still_step_out_of_a_robots_way() -
         crowd.advance(0.1, [robot], [pose.theta])
     assert abs(person.y - 3.0) > 0.3, "along the wall, out of its way"
     assert person.x >= 0.27 - 1e-6, "no closer to the wall than they were"
+
+
+def test_a_person_in_a_niche_beside_a_waiting_robots_way_goes_on_along_it(
+        shared: Path) -> None:
+    # AMROffice: a robot at the junction waits to drive up the corridor north and on east; a
+    # person in the niche where the corridor turns, a step off its way, has no room aside
+    # and used to step into the niche and back onto their way for good
+    arnl_map = read_map(shared / "maps" / "AMROffice.map")
+    sim = Simulator(arnl_map, Pose2D(-5.9, 1.07, 2.33))
+    assert sim.go_to("Outside").found
+    way, pose = sim.way_ahead(), sim.pose
+    crowd = Crowd(sim.planner, [PersonPlan("hal", (-6.14, 5.29), ((2.471, -2.473),))], seed=1)
+    person = crowd.people[0]
+    person.route = np.array([(-6.21, 5.49), (-7.21, 5.44), (-7.41, 1.74)])  # down the corridor
+    for _ in range(150):
+        crowd.advance(0.2, [sim.outline], [pose.theta], [0.0], [way])
+    gap = float(np.min(np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)))
+    assert gap >= sim.planner.lethal + crowd.settings.radius, (person.x, person.y, gap)

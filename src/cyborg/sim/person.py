@@ -72,6 +72,7 @@ class Person:
     trail: list[Point] = field(default_factory=list)
     until: float = 0.0  # when a pause ends, simulated seconds
     waited: float = 0.0  # seconds blocked so far
+    pocket: tuple[float, float] | None = None  # where no step off a robot's way was free
 
     @property
     def pose(self) -> Pose2D:

@@ -28,6 +28,9 @@ AHEAD = 2.5
 REJOIN = 0.5
 """Metres within which a person who stepped aside passes over a corner of their way in sight
 of the next (stepping aside again and again, they would otherwise queue a corner per step)."""
+POCKET = 1.0
+"""Metres a person who found no way on beside a robot's way (a pocket, a niche) goes on along
+the way before stepping aside again."""
 STILL = 0.05
 """Metres per second under which a robot counts as standing still: people walking on their
 way pass in front of it instead of stepping aside (:meth:`Crowd.advance`)."""
@@ -69,6 +72,8 @@ class RoomForRobots:
                 nearest = int(np.argmin(gaps))
                 if gaps[nearest] >= self._way_room:
                     continue
+                if person.pocket and math.dist(person.pocket, (person.x, person.y)) > POCKET:
+                    person.pocket = None  # well on along the way: aside again
                 moved.add(id(person))
                 if self._step_off(person, way, float(gaps[nearest]), nearest,
                                   person.speed * dt):
@@ -96,7 +101,7 @@ class RoomForRobots:
         robot = way[0]
         sides = sorted((1.0, -1.0), key=lambda side: -math.hypot(
             person.x - side * uy - robot[0], person.y + side * ux - robot[1]))
-        for side in sides:
+        for side in sides if person.pocket is None else ():
             to = (person.x - side * uy * step, person.y + side * ux * step)
             if (float(np.min(np.hypot(way[:, 0] - to[0], way[:, 1] - to[1])))
                     >= gap + 0.8 * step and self._free(person, to, squeeze=True)):
@@ -110,7 +115,17 @@ class RoomForRobots:
             return False
         to = (person.x + dx * min(1.0, step / length), person.y + dy * min(1.0, step / length))
         if not self._free(person, to, squeeze=True):
-            return False
+            # in a pocket beside the way: back to the way, and on along it without stepping
+            # aside into the pocket again until well on
+            person.pocket = (person.x, person.y)
+            dx, dy = way[nearest, 0] - person.x, way[nearest, 1] - person.y
+            length = math.hypot(dx, dy)
+            if length < 1e-9:
+                return False
+            to = (person.x + dx * min(1.0, step / length),
+                  person.y + dy * min(1.0, step / length))
+            if not self._free(person, to, squeeze=True):
+                return False
         self._move(person, to)
         return True
 
