@@ -32,7 +32,7 @@ exactly as another robot's outline (:mod:`cyborg.sim.bodies`). The crowd steps e
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -132,13 +132,14 @@ class Crowd(RoomForRobots):
         return Meeting(near, points, circles)
 
     def beside(self, planner: Planner, outline: np.ndarray, dt: float, reach: float,
-               speed: float = math.inf, way: np.ndarray = NO_WAY) -> Meeting:
+               speed: float = math.inf,
+               way: Callable[[], np.ndarray] = lambda: NO_WAY) -> Meeting:
         """Walk ``dt`` s around one robot and say what it meets.
 
         ``outline`` is K x 2, its first and last corners the front edge's, as
         :meth:`~cyborg.nav.footprint.Footprint.polygon` gives them; ``speed`` the robot's
-        (m/s; by default it counts as driving), ``way`` the way it means to drive (see
-        :meth:`advance`).
+        (m/s; by default it counts as driving), ``way`` gives the way it means to drive (see
+        :meth:`advance`; asked only when people walk).
 
         A robot whose ``planner`` is not the crowd's has switched maps: it meets nobody, and
         nobody walks.
@@ -149,7 +150,7 @@ class Crowd(RoomForRobots):
         walked = self.due(dt)
         if walked:
             front = (outline[0] + outline[-1]) / 2 - middle  # the middle of the front edge
-            self.advance(walked, [outline], [math.atan2(front[1], front[0])], [speed], [way])
+            self.advance(walked, [outline], [math.atan2(front[1], front[0])], [speed], [way()])
         return self.meeting(float(middle[0]), float(middle[1]), reach)
 
     def due(self, dt: float) -> float:

@@ -318,7 +318,7 @@ class Simulator:
             if self.crowd is not None:
                 self.meet(*self.crowd.beside(self.planner, self.outline, self._period,
                                              self.laser.spec.range_max, self.base.speed,
-                                             self.way_ahead()))
+                                             self.way_ahead))
             self._sense()
             self._command = self._decide()
         self._steps += 1
