@@ -322,7 +322,7 @@ class _Builder:
             self.report(f"unknown node name {spec.name!r}{declared}; registered: "
                         f"{', '.join(self.registry.names())}", tree, spec, "name")
             return None
-        absent = [key for key in node_type.cls.requires if key not in self.blackboard.resources]
+        absent = [key for key in node_type.requires if key not in self.blackboard.resources]
         if absent and self.stub_missing is not None:
             needs = " and ".join(repr(key) for key in absent)
             self.report(f"node {spec.name!r} needs a {needs} resource and this tree has none; a "
