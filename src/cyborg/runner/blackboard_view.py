@@ -18,6 +18,8 @@ import json
 import math
 from typing import Any
 
+from cyborg.bt.js_values import js_number
+
 MAX_CHARACTERS = 1 << 20
 """Text the whole blackboard may take, about: what comes after is not shown."""
 MAX_DEPTH = 32
@@ -26,8 +28,6 @@ MAX_ITEMS = 1000
 """Items of one list or object shown; the rest are counted."""
 MAX_TEXT = 10_000
 """Characters of one text shown; the rest are counted."""
-SAFE_INTEGER = 2**53
-"""Integers beyond are shown as the nearest double (as JavaScript holds them), or not at all."""
 
 
 def blackboard_json(scopes: dict[str, Any]) -> str:
@@ -61,13 +61,12 @@ class _Shower:
         return self.text(repr(value))
 
     def integer(self, value: int) -> Any:
+        """As JavaScript holds it (:func:`~cyborg.bt.js_values.js_number`), or not at all."""
         self.left -= 20
-        if -SAFE_INTEGER <= value <= SAFE_INTEGER:
-            return value
-        try:
-            return float(value)
-        except OverflowError:
-            return f"(not shown: an integer of about {int(value.bit_length() * 0.30103):,} digits)"
+        shown = js_number(value)
+        if math.isfinite(shown):
+            return shown
+        return f"(not shown: an integer of about {int(value.bit_length() * 0.30103):,} digits)"
 
     def text(self, value: str) -> str:
         shown = value if len(value) <= MAX_TEXT else (
