@@ -6,6 +6,8 @@ cd "$(dirname "$0")/.."
 
 need_debian=()
 command -v dot >/dev/null || need_debian+=(graphviz)
+# the live-line tests run `cyborg bt run` in a real terminal
+command -v tmux >/dev/null || need_debian+=(tmux)
 # the monitor's browser tests drive Debian's Chromium (never a downloaded browser)
 command -v chromium >/dev/null || need_debian+=(chromium fonts-dejavu-core)
 if [ ${#need_debian[@]} -gt 0 ]; then

@@ -201,14 +201,21 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
              until_done: bool = False, stream: TextIO | None = None) -> int:
     """Ticks ``tree`` in the foreground with a status line until done or Ctrl-C.
 
-    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR, else 0. A
-    node that raises is reported in one line (its id, label, the error and where it was
-    raised), and log records and the nodes' prints are written above the live line.
+    The exit status: 130 after Ctrl-C, 1 when the root's last status is ERROR or a tick
+    overran its limit (the tree is halted), else 0. A node that raises is reported in one line
+    (its id, label, the error and where it was raised), and log records and the nodes' prints
+    are written above the live line.
     """
     stream = stream or sys.stdout
     runner = TickLoop(tree, rate_hz=rate_hz)
     line = StatusLine(tree, stream)
     runner.add_listener(line.update)
+    overran: list[str] = []
+
+    def end_after_overrun(reason: str) -> None:
+        overran.append(reason)
+        runner.stop()
+    runner.add_interrupt_listener(end_after_overrun)
     print(f"running {tree.title!r} from {tree.source} ({len(tree)} nodes) at {rate_hz:g} Hz; "
           "Ctrl-C stops", file=stream)
     previous = signal.signal(signal.SIGTERM, interrupt)
@@ -225,6 +232,8 @@ def run_tree(tree: Tree, *, rate_hz: float, max_ticks: int | None = None,
         line.finish(interrupted=interrupted)
     if interrupted:
         return 130
+    if overran:
+        return 1  # the loop has logged why, naming the node
     return 1 if tree.last is not None and tree.last.status is Status.ERROR else 0
 
 

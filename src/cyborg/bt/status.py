@@ -51,3 +51,16 @@ class NodeError(Exception):
     line, naming the node, with no traceback. Any other exception is a fault in the node's code:
     it is logged with its traceback, which is what finding that fault takes.
     """
+
+
+class TickInterrupted(BaseException):
+    """Raised inside a tick that its loop interrupts (:mod:`cyborg.bt.tick_guard`); says why.
+
+    A :class:`BaseException`, so a node's own ``except Exception`` does not swallow it. Each
+    node it passes through is left RUNNING, so the halt that follows reaches it: a node cut off
+    after it asked the robot for something (a goal sent) cancels it in ``on_halt``.
+    """
+
+    def __init__(self, reason: str = "interrupted") -> None:
+        super().__init__(reason)
+        self.reason = reason

@@ -22,6 +22,14 @@ services in the ticking thread, and goes back to sleep, so a service's interval 
 when it is shorter than the tick period. While paused, services do not run either. Service
 listeners (:meth:`TickLoop.add_service_listener`) hear of each such run, and of a halt that
 stopped services, as tick listeners hear of ticks.
+
+**A tick that does not end.** Nothing a node does may take away the stop. A tick (or a services
+run) longer than ``tick_limit`` wall seconds (:data:`TICK_LIMIT` unless told otherwise) is
+interrupted (:mod:`cyborg.bt.tick_guard`), reported with the node it was in, and the tree is
+halted and the loop paused; interrupt listeners (:meth:`TickLoop.add_interrupt_listener`) hear
+why. A halting :meth:`~TickLoop.pause` or a :meth:`~TickLoop.stop` that finds a tick still computing
+after :data:`INTERRUPT_AFTER` seconds interrupts it likewise, so the halt follows at once (one
+that waits on the robot is waited for: see :mod:`cyborg.bt.tick_guard`).
 """
 
 from __future__ import annotations
@@ -36,15 +44,22 @@ from cyborg.bt.clock import Clock
 from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot
-from cyborg.bt.status import RUNNING
+from cyborg.bt.status import RUNNING, TickInterrupted
+from cyborg.bt.tick_guard import TickGuard
 
 log = logging.getLogger("cyborg.bt")
 
 Listener = Callable[[TickSnapshot], None]
 ServiceListener = Callable[[ServiceRunner], None]
+InterruptListener = Callable[[str], None]
 
 DEFAULT_RATE = 10.0
 """Ticks per second unless told otherwise, as in 2018."""
+TICK_LIMIT = 10.0
+"""Wall seconds a tick may take before it is interrupted and the tree halted (more than any
+robot call waits for its answer)."""
+INTERRUPT_AFTER = 0.1
+"""Wall seconds a halt or stop waits for the tick in progress before interrupting it."""
 
 
 class Tickable(Protocol):
@@ -85,15 +100,21 @@ T = TypeVar("T", bound=Tickable)
 class TickLoop(Generic[T]):
     """Ticks a :class:`~cyborg.bt.tree.Tree` (or another :class:`Tickable`) at ``rate_hz``.
 
-    The default rate is 10 Hz, as in 2018.
+    The default rate is 10 Hz, as in 2018. ``tick_limit`` (wall seconds; None: none) bounds
+    a tick, see the module docstring.
     """
 
     def __init__(self, tree: T, *, rate_hz: float = DEFAULT_RATE,
-                 clock: Clock | None = None) -> None:
+                 clock: Clock | None = None, tick_limit: float | None = TICK_LIMIT) -> None:
         if not rate_hz > 0:
             raise ValueError(f"the tick rate must be more than 0 Hz, not {rate_hz}")
+        if tick_limit is not None and not tick_limit > 0:
+            raise ValueError(f"the tick limit must be more than 0 s, not {tick_limit}")
         self.tree = tree
         self.rate_hz = rate_hz
+        self.tick_limit = tick_limit
+        self._guard = TickGuard()
+        self._interrupt_listeners: list[InterruptListener] = []
         self.clock: Clock = clock or tree.clock
         self._listeners: list[Listener] = []
         self._service_listeners: list[ServiceListener] = []
@@ -102,7 +123,8 @@ class TickLoop(Generic[T]):
         self._wake = threading.Event()
         self._paused = False
         self._stopped = False
-        self._thread: threading.Thread | None = None
+        self._thread: threading.Thread | None = None  # of start()
+        self._running_in: threading.Thread | None = None  # the thread in run(), whoever's
 
     # ------------------------------------------------------------------ observers
     def add_listener(self, listener: Listener) -> Callable[[], None]:
@@ -126,6 +148,15 @@ class TickLoop(Generic[T]):
         self._service_listeners.append(listener)
         return lambda: self._service_listeners.remove(listener)
 
+    def add_interrupt_listener(self, listener: InterruptListener) -> Callable[[], None]:
+        """Calls ``listener(reason)`` after a tick that overran ``tick_limit`` was interrupted.
+
+        The tree is halted and the loop paused by then (:meth:`resume` ticks again); called
+        in the ticking thread. Returns a function that removes the listener.
+        """
+        self._interrupt_listeners.append(listener)
+        return lambda: self._interrupt_listeners.remove(listener)
+
     @property
     def paused(self) -> bool:
         """Whether :meth:`pause` holds the loop (until :meth:`resume`)."""
@@ -140,18 +171,37 @@ class TickLoop(Generic[T]):
     def pause(self, *, halt: bool = False) -> None:
         """Stops ticking; with ``halt`` also halts the RUNNING nodes (a moving robot stops).
 
-        A tick waiting at a breakpoint is let go first, and ends before the pause.
+        A tick waiting at a breakpoint is let go first, and ends before the pause. A halt
+        interrupts a tick still going after :data:`INTERRUPT_AFTER` seconds.
         """
         with self._state:
             self._paused = True
             self._wake.set()
         self.tree.hooks.release()  # a tick waiting at a breakpoint ends before the pause
         if halt:
-            with self._tick_lock:
+            self._lock_ticks("halted")
+            try:
                 self.tree.halt()
                 services = self.tree.services
                 if services is not None:
                     self._services_changed(services)
+            finally:
+                self._tick_lock.release()
+
+    def _lock_ticks(self, why: str) -> None:
+        """Takes the tick lock, interrupting a tick that computes past :data:`INTERRUPT_AFTER`.
+
+        A tick that waits (on the robot) is waited for: it ends by itself.
+        """
+        cpu_before = self._guard.cpu_time()
+        if self._tick_lock.acquire(timeout=INTERRUPT_AFTER):
+            return
+        where = self._guard.where()
+        if self._guard.computing(cpu_before, INTERRUPT_AFTER) and \
+                self._guard.interrupt(f"{why} while busy{' in ' + where if where else ''}"):
+            log.warning("the tick in progress did not end within %g s; interrupted%s so the "
+                        "tree can halt", INTERRUPT_AFTER, " in " + where if where else "")
+        self._tick_lock.acquire()
 
     def resume(self) -> None:
         """Ticks again at the set rate."""
@@ -160,8 +210,15 @@ class TickLoop(Generic[T]):
             self._state.notify_all()
 
     def step(self) -> TickSnapshot:
-        """Ticks once now, in the calling thread; meant for a paused runner."""
-        return self._tick()
+        """Ticks once now, in the calling thread; meant for a paused runner.
+
+        A tick interrupted on its way (a halt or stop came) raises :class:`RuntimeError`.
+        """
+        try:
+            return self._tick()
+        except TickInterrupted as exc:
+            self._interrupted(exc)
+            raise RuntimeError(f"the tick was interrupted: {exc.reason}") from None
 
     def stop(self, timeout: float | None = 5.0) -> None:
         """Ends the loop and halts every RUNNING node. Waits for a background loop to end.
@@ -173,9 +230,16 @@ class TickLoop(Generic[T]):
             self._wake.set()
             self._state.notify_all()
         self.tree.hooks.release()
-        thread = self._thread
+        thread = self._thread or self._running_in
         if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout)
+            cpu_before = self._guard.cpu_time()
+            first = INTERRUPT_AFTER if timeout is None else min(timeout, INTERRUPT_AFTER)
+            thread.join(first)
+            if thread.is_alive():
+                if self._guard.computing(cpu_before, first):
+                    where = self._guard.where()
+                    self._guard.interrupt(f"stopped while busy{' in ' + where if where else ''}")
+                thread.join(None if timeout is None else max(timeout - first, 0.0))
         if thread is None:
             with self._tick_lock:
                 self.tree.halt()
@@ -223,6 +287,11 @@ class TickLoop(Generic[T]):
         anchor = now = clock.now()  # ticks are due at anchor + slot * period (no drift)
         slot = 0
         done = 0
+        ended = threading.Event()
+        self._running_in = threading.current_thread()
+        if self.tick_limit is not None:
+            threading.Thread(target=self._watch, args=(self.tick_limit, ended), daemon=True,
+                             name=f"bt-watch:{self.tree.title}").start()
         try:
             while True:
                 with self._state:
@@ -232,7 +301,11 @@ class TickLoop(Generic[T]):
                     if self._stopped:
                         break
                     self._wake.clear()
-                snapshot = self._tick()
+                try:
+                    snapshot = self._tick()
+                except TickInterrupted as exc:
+                    self._interrupted(exc)
+                    continue
                 done += 1
                 if max_ticks is not None and done >= max_ticks:
                     break
@@ -243,10 +316,43 @@ class TickLoop(Generic[T]):
                 before, now = now, clock.now()
                 if due < now or now < before:  # overran, or the clock went back (a restarted
                     anchor, slot, due = now, 0, now  # simulation): restart the schedule
-                self._sleep_until(due)
+                try:
+                    self._sleep_until(due)
+                except TickInterrupted as exc:  # in services run between two ticks
+                    self._interrupted(exc)
         finally:
+            ended.set()
             with self._tick_lock:
                 self.tree.halt()
+
+    def _watch(self, limit: float, ended: threading.Event) -> None:
+        """Interrupts a tick (or services run) that takes longer than ``limit`` wall seconds."""
+        while not ended.wait(min(limit / 4, 0.25)):
+            busy = self._guard.busy_for()
+            if busy is not None and busy > limit:
+                where = self._guard.where()
+                self._guard.interrupt(f"the tick ran longer than its limit of {limit:g} s"
+                                      f"{', in ' + where if where else ''}")
+
+    def _interrupted(self, exc: TickInterrupted) -> None:
+        """After an interrupted tick: halts and pauses on an overrun, and tells the listeners.
+
+        An interruption asked for by a halt or stop needs nothing more: they halt the tree.
+        """
+        reason = self._guard.leave() or exc.reason
+        if self._paused or self._stopped:
+            log.info("the tick was interrupted: %s", reason)
+            return
+        log.error("%s: interrupted; the tree is halted and ticking paused", reason)
+        with self._state:
+            self._paused = True
+        with self._tick_lock:
+            self.tree.halt()
+        for listener in list(self._interrupt_listeners):
+            try:
+                listener(reason)
+            except Exception:
+                log.exception("interrupt listener %r raised", listener)
 
     def _sleep_until(self, due: float) -> None:
         """Sleeps until the tick due at ``due``, running the services due before it."""
@@ -261,7 +367,11 @@ class TickLoop(Generic[T]):
                 return
             with self._tick_lock:
                 if self.tree.services is services and services is not None:
-                    services.run_due(clock.now())
+                    self._guard.enter()
+                    try:
+                        services.run_due(clock.now())
+                    finally:
+                        self._guard.leave()
                     self._services_changed(services)
         clock.sleep_until(due, wake)
 
@@ -273,8 +383,13 @@ class TickLoop(Generic[T]):
                 log.exception("service listener %r raised", listener)
 
     def _tick(self) -> TickSnapshot:
+        """Ticks once under the tick lock, interruptibly, then tells the listeners."""
         with self._tick_lock:
-            snapshot = self.tree.tick()
+            self._guard.enter()
+            try:
+                snapshot = self.tree.tick()
+            finally:
+                self._guard.leave()
         for listener in list(self._listeners):
             try:
                 listener(snapshot)

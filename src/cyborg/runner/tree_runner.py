@@ -20,6 +20,11 @@ latches ``stopped`` until ``enable(true)``. Disabling stops the ticks at once; t
 the tick in progress to end, so when a node in it waits on a slow robot, ``enable`` answers
 after :data:`HALT_WAIT` seconds anyway (saying so) and the halt follows when that tick ends;
 ``enable(true)`` meanwhile is refused (the tree must not run before its halt), never held up.
+A tick still going :data:`~cyborg.bt.tick_loop.INTERRUPT_AFTER` seconds into a halt or stop is
+interrupted (:mod:`cyborg.bt.tick_guard`: at once for a node busy in Python, when its wait
+returns for one waiting on the robot), and one that overruns the tick limit (10 s) is
+interrupted, logged with its node, and the tree disabled, so nothing a node does takes away
+the stop.
 
 **Reload.** The file (or another one) is loaded and checked on a thread of its own, one at a
 time, answered within ``reload_timeout`` wall seconds (:mod:`cyborg.runner.background_reload`);
@@ -56,7 +61,7 @@ from cyborg.bt import (
 )
 from cyborg.bt.problems import Problem, TreeLoadError
 from cyborg.bt.snapshot import TickSnapshot
-from cyborg.bt.tick_loop import DEFAULT_RATE
+from cyborg.bt.tick_loop import DEFAULT_RATE, TICK_LIMIT
 from cyborg.bus import Node, SimClock
 from cyborg.bus.msgs.cyborg_msgs.msg import (
     BehaviorTree,
@@ -105,13 +110,15 @@ class TreeRunnerNode:
                  robot: Robot | None = None,
                  registry: NodeRegistry | None = None, enabled: bool = True,
                  reload_timeout: float = RELOAD_TIMEOUT,
-                 services: ServiceRegistry | None = None) -> None:
+                 services: ServiceRegistry | None = None,
+                 tick_limit: float | None = TICK_LIMIT) -> None:
         """Load the tree (raises :class:`~cyborg.bt.TreeLoadError`), set up topics and services.
 
         :meth:`start` begins ticking. ``reload_timeout`` is the default of the node parameter
         of that name (a value given to the node at start-up wins). ``services`` are the
         services its composites may carry (default: the registered ones,
-        :func:`~cyborg.bt.default_service_registry`).
+        :func:`~cyborg.bt.default_service_registry`). ``tick_limit`` (wall seconds) bounds a
+        tick: one that overruns it is interrupted and the tree disabled (module docstring).
         """
         self.node, self.path, self.tree_choice = node, Path(path), tree
         self.registry = registry if registry is not None else default_registry()
@@ -120,7 +127,8 @@ class TreeRunnerNode:
         self.resources: dict[str, Any] = {ROBOT: robot} if robot is not None else {}
         self.ticked = self._load(self.path, Blackboard(resources=self.resources))
         """What the loop ticks: the tree, or the mode machine of a mode file."""
-        self.runner: TickLoop[Tree | ModeMachine] = TickLoop(self.ticked, rate_hz=rate_hz)
+        self.runner: TickLoop[Tree | ModeMachine] = TickLoop(self.ticked, rate_hz=rate_hz,
+                                                                tick_limit=tick_limit)
         self._enabled = enabled
         self._stopped = False
         self._active: tuple[str, ...] | None = None
@@ -145,6 +153,7 @@ class TreeRunnerNode:
         self.control = TreeControl(node, lambda: self.tree,
                                    callbacks=node.callback_thread("control"))
         self.runner.add_listener(self._on_tick)
+        self.runner.add_interrupt_listener(self._on_overrun)
         self.runner.add_service_listener(lambda _ran: self._service_states.look(self.tree))
         self.modes: ModeEndpoints | None = None
         self._structure_after_tick = False
@@ -390,6 +399,13 @@ class TreeRunnerNode:
     def tree_of(self, snapshot: TickSnapshot) -> Tree:
         """The tree that made ``snapshot`` (a tick listener's); see :func:`ticked.tree_of`."""
         return tree_of(self.ticked, snapshot)
+
+    def _on_overrun(self, _reason: str) -> None:
+        """A tick overran its limit: the loop halted the tree and paused; it is disabled now."""
+        with self._lock:
+            self._enabled, self._active = False, None
+        self._publish_enabled()
+        self._publish_active(())
 
     def _on_enable(self, request: SetBool_Request) -> SetBool_Response:
         on = bool(request.data)
