@@ -5,22 +5,29 @@ holds up the others (or the tree). The queue is bounded twice: in messages
 (:data:`QUEUE_LIMIT`) and in characters (:data:`QUEUE_BYTES`, since one structure of a large tree
 weighs as much as thousands of deltas). When either overflows the queue is emptied and the
 client is marked for a *resync*: the writer then sends a fresh structure and snapshot, which
-replace everything the dropped messages would have told it.
+replace everything the dropped messages would have told it. One message may exceed the
+character bound only when the queue is empty (the structure of a tree near the loader's node
+cap), and never :data:`MESSAGE_CHARACTERS`: a larger one is not sent, and said so in the log.
 """
 
 from __future__ import annotations
 
 import asyncio
 import json
+import logging
 from typing import Any
 
 from starlette.websockets import WebSocket
 
 from cyborg.monitor.limits import Bucket, Limits
 
+log = logging.getLogger("cyborg.monitor")
+
 QUEUE_LIMIT = 256
 QUEUE_BYTES = 8 << 20
 """Characters a client's queue may hold (8 Mi: a few structures of the largest trees)."""
+MESSAGE_CHARACTERS = 24 << 20
+"""Characters one message may have (the structure of a 100,000-node tree has some 16.5 Mi)."""
 RESYNC = "\x00resync"
 
 
@@ -64,6 +71,12 @@ class Client:
         """Queue a message (a dict, or JSON text shared between clients)."""
         text = message if isinstance(message, str) else json.dumps(message,
                                                                    separators=(",", ":"))
+        if len(text) > MESSAGE_CHARACTERS:
+            self.dropped += 1
+            log.warning("page %d: a message of %s characters (%s) was not sent: past the "
+                        "%s a message may have", self.number, f"{len(text):,}", text[:40],
+                        f"{MESSAGE_CHARACTERS:,}")
+            return
         if self.queued_bytes + len(text) > QUEUE_BYTES and not self.queue.empty():
             self._overflow()
             return

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -45,6 +46,21 @@ CONTROL_ACTIONS = {action.label: int(action) for action in HookAction}
 STATUSES = {Status(int(status)).label: int(status) for status in HookStatus}
 """The statuses a hook may give, by name."""
 SERVICE_TIMEOUT = 5.0
+BLACKBOARD_CHARACTERS = 2 << 20
+"""Characters of a ``get_blackboard`` answer the monitor reads (the runner sends under 1 Mi)."""
+
+
+def _refuse_constant(name: str) -> None:
+    """``NaN`` and ``Infinity`` are not JSON: a browser's parser refuses the whole message."""
+    raise ValueError(f"{name} is not a JSON value")
+
+
+def _finite(text: str) -> float:
+    """A JSON number as a float; one past a float's range (``1e999``) is refused, as above."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"{text[:20]} is past a float's range")
+    return value
 
 
 class ControlError(RuntimeError):
@@ -239,12 +255,22 @@ class TreeSource:
         return str(response.message)
 
     def blackboard(self) -> dict[str, Any]:
-        """The runner's blackboard as JSON (``{"global", "tree", "node"}`` scopes)."""
+        """The runner's blackboard as JSON (``{"global", "tree", "node"}`` scopes).
+
+        An answer past :data:`BLACKBOARD_CHARACTERS` is not read: one row says so instead
+        (the runner's own view stays under 1 Mi characters; another may send anything).
+        """
         response = self._call(tree_runner.GET_BLACKBOARD)
+        text = response.json
+        if len(text) > BLACKBOARD_CHARACTERS:
+            return {"global": {"(not shown)": (
+                f"(not shown: the blackboard is {len(text):,} characters, past the monitor's "
+                f"{BLACKBOARD_CHARACTERS:,})")}}
         try:
-            data = json.loads(response.json)
-        except ValueError as exc:
-            raise ControlError(f"{self.namespace}/get_blackboard: not JSON ({exc})") from None
+            data = json.loads(text, parse_constant=_refuse_constant, parse_float=_finite)
+        except (ValueError, RecursionError) as exc:
+            raise ControlError(f"{self.namespace}/get_blackboard: not JSON "
+                               f"({type(exc).__name__}: {str(exc)[:200]})") from None
         return data if isinstance(data, dict) else {"value": data}
 
     def describe(self) -> dict[str, Any]:
