@@ -291,9 +291,22 @@ def test_falling_behind_is_said_once_after_it_lasted_naming_the_load_and_what_to
     step, text = warnings[0]
     assert step == 31  # below half from step 11 on (wall 5.5 s), 10 s later
     assert "runs at " in text and "below half the 30x asked (--speed)" in text
-    assert "load average 5.2 on 2 CPUs" in text
+    assert "the CPU is busy (load average 5.2 on 2 CPUs)" in text
     assert "--speed 7" in text and "--speed 0" in text
     assert FallingBehind(0.0, lambda: 0.0).check(0.5) is None, "as fast as possible: never"
+
+
+def test_falling_behind_on_an_idle_machine_blames_the_simulation_not_the_cpu() -> None:
+    wall = [0.0]
+    behind = FallingBehind(30.0, lambda: wall[0], patience=1.0, load=lambda: (0.6, 2))
+    said = []
+    for step in range(10):
+        wall[0] = step * 0.5
+        said.append(behind.check(12.0))
+    (text,) = [text for text in said if text]
+    assert "CPU is busy" not in text, text
+    assert "the simulation itself is the limit, not the CPU (load average 0.6 on 2 CPUs" in text
+    assert "--speed 12" in text
 
 
 def test_the_live_line_shows_the_pace_reached_and_warns_once_when_it_falls_behind(

@@ -179,12 +179,15 @@ class FallingBehind:
         self.warned = True
         load, cpus = self._load()
         on = f" on {cpus} CPU{'s' if cpus != 1 else ''}" if cpus else ""
+        busy = cpus is None or not load < cpus  # unknown, or every CPU has work waiting
+        why = (f"the CPU is busy (load average {load:.1f}{on})" if busy else
+               f"the simulation itself is the limit, not the CPU (load average {load:.1f}{on}: "
+               "one process steps it, on one CPU)")
         slower = max(1, int(pace))
         return (f"the simulation runs at {pace:.1f}x real time, below half the {self.asked:g}x "
-                f"asked (--speed), for {self._patience:g} s: the CPU is busy (load average "
-                f"{load:.1f}{on}), so the tree's timing and the battery's stretch in wall time; "
-                f"ask for what it reaches, --speed {slower}, or --speed 0 (as fast as the CPU "
-                "allows, timing kept on simulated time)")
+                f"asked (--speed), for {self._patience:g} s: {why}, so the tree's timing and "
+                f"the battery's stretch in wall time; ask for what it reaches, --speed {slower}, "
+                "or --speed 0 (as fast as the CPU allows, timing kept on simulated time)")
 
 
 def _load_and_cpus() -> tuple[float, int | None]:
