@@ -106,7 +106,7 @@ class _Builder:
         self.limits = limits
         self.count = 0
         """Node instances built so far, for ``max_nodes``."""
-        self.sizes: dict[str, Size] = measure(project, limits.max_nodes)
+        self.sizes: dict[str, Size] = {}  # measured by build, once the tree is chosen
         self.built: set[str] = set()
         """Ids of the trees instantiated so far."""
         self.shallow = False
@@ -360,12 +360,12 @@ def build(project: ProjectSpec, registry: NodeRegistry, *, tree: str | None = No
     ``services`` declarations.
     """
     builder = _Builder(project, registry, Blackboard() if blackboard is None else blackboard,
-                       TickRecord() if record is None else record,
-                       stub_missing,
+                       TickRecord() if record is None else record, stub_missing,
                        limits if limits is not None else Limits.resolve(source=project.source),
                        services)
     builder.problems.extend(project.problems)
     chosen, reason = choose_tree(project, tree)
+    builder.sizes = measure(project, builder.limits.max_nodes, None if check_all else chosen)
     root = None
     if chosen is None:
         if project.kind != "nodes" or tree is not None or not check_all:

@@ -33,16 +33,18 @@ class Size:
     """Levels of the instance, the tree's own node being level 1."""
 
 
-def measure(project: ProjectSpec, cap: int) -> dict[str, Size]:
-    """The :class:`Size` of every tree of ``project``, by tree id.
+def measure(project: ProjectSpec, cap: int, root: TreeSpec | None = None) -> dict[str, Size]:
+    """The :class:`Size` of every tree of ``project``, by tree id; with ``root``, of it only.
 
-    Node counts stop at ``cap + 1``: such a count only says that the tree is too big.
+    With ``root``, the trees it references are measured too, and no others: building one tree
+    of a project of many (as each mode of a mode file does) costs its own size, not the
+    project's. Node counts stop at ``cap + 1``: such a count only says that the tree is too big.
     """
     trees = project.tree_by_id()
     sizes: dict[str, Size] = {}
     active: set[str] = set()  # trees being measured: a reference to one of them is a cycle
     layouts: dict[str, list[tuple[int, str | None]]] = {}
-    for start in trees:
+    for start in trees if root is None or root.id not in trees else [root.id]:
         stack = [start]
         while stack:
             tree_id = stack[-1]

@@ -91,6 +91,9 @@ class Limits:
     origin: dict[str, str] | None = None
     """Where each cap came from, for messages: ``"parameter"``, the variable's name, or
     ``"default"``."""
+    entry: str = "load_tree"
+    """The function whose keyword sets a cap, for messages (``"load_machine"`` for a mode
+    file's load)."""
 
     @classmethod
     def resolve(cls, max_bytes: int | None = None, max_depth: int | None = None,
@@ -136,7 +139,7 @@ class Limits:
         """``"raise it with load_tree(..., max_nodes=N) or CYBORG_TREE_MAX_NODES"``."""
         variable = _ENVIRONMENT[name]
         where = f" (now set by {variable})" if (self.origin or {}).get(name) == variable else ""
-        return (f"raise it with load_tree(..., {name}=N) or the environment variable "
+        return (f"raise it with {self.entry}(..., {name}=N) or the environment variable "
                 f"{variable}{where}")
 
     @property
