@@ -1,9 +1,16 @@
 """Mode files fuzzed: every mutation of a good file loads, or fails with located problems.
 
 A valid mode file is mutated as text (lines dropped, doubled, swapped or cut; characters
-inserted; values replaced by values of other types, names by unknown or odd names), then read.
-It must either give a machine that ticks, or raise ModeFileError whose problems each name the
-mode file (or a tree file it names) and a line; never any other exception.
+inserted, among them blocks of modes and transitions past the caps; values replaced by values
+of other types, names by unknown or odd names), then read. It must either give a machine that
+ticks, or raise ModeFileError whose problems each name the mode file (or a tree file it names)
+and a line; never any other exception.
+
+Machines are also drawn whole, under small caps (:mod:`cyborg.modes.caps`): modes naming trees
+of several sizes (one made of subtree references), chains and other transitions. Each loads
+within its caps — every tree built once, however many modes name it, the trees within the node
+budget, every mode reachable that a path reaches — or is refused, located, for the cap it
+passes.
 """
 
 from __future__ import annotations
@@ -11,13 +18,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from cyborg.bt import Blackboard, ManualClock
-from cyborg.modes import ModeFileError, build_machine, parse_mode_file
-from tests.builders import registry
-from tests.modes.machines import write_project
+from cyborg.bt import Blackboard, ManualClock, load_tree
+from cyborg.modes import ModeFileError, build_machine, caps, load_machine, parse_mode_file
+from cyborg.modes.spec import MachineSpec
+from tests.builders import N, project_json, registry, tree_json
+from tests.modes.machines import write_modes, write_project
 from tests.modes.test_mode_file import GOOD, TREES
 
 _VALUES = ["1", "-1", "0", "nan", "inf", "1e400", '"x"', '""', "true", "[]", '["normal"]',
@@ -29,7 +37,11 @@ _VALUES = ["1", "-1", "0", "nan", "inf", "1e400", '"x"', '""', "true", "[]", '["
            "[" * 1000 + "]" * 1000, "{a=" * 1000 + "1" + "}" * 1000, "1" + "0" * 5000,
            "1" + "0" * 400, "1." + "0" * 400, '"' + "[" * 1000 + '"']
 _FRAGMENTS = ["[", "]", "[[", "=", '"', "'", "#", ".", "\n", "[modes.x]", "[[transitions]]",
-              "[modes]", "modes = 3", "transitions = 1", "from", "to = ", "\ud800", "\x00"]
+              "[modes]", "modes = 3", "transitions = 1", "from", "to = ", "\ud800", "\x00",
+              # past the caps: more modes, more transitions, more problems than a file may have
+              "\n" + "".join(f'[modes.z{i}]\ntree = "patrol"\n' for i in range(300)),
+              "\n" + '[[transitions]]\nfrom = "normal"\nto = "demo"\nevent = "e"\n' * 1100,
+              "\n" + "".join(f"k{i} = 1\n" for i in range(150))]
 _MUTATIONS = st.one_of(
     st.tuples(st.just("drop"), st.integers(0, 200)),
     st.tuples(st.just("double"), st.integers(0, 200)),
@@ -96,4 +108,115 @@ def test_mutated_mode_files_load_or_fail_with_located_problems(
         return
     machine.tick()
     assert machine.mode in spec.modes
+    machine.halt()
+
+
+_SIZES = {"tiny": 3, "middle": 30, "large": 60}
+"""The wide trees of the shapes' project, by id: a Sequence over Succeeders, so many nodes."""
+_SHAPE_CAPS = {"MAX_MODES": 6, "MAX_TRANSITIONS": 8}
+_LINK = st.tuples(st.integers(0, 7), st.integers(0, 7),
+                  st.sampled_from(["event", "on_request", "when", "any"]))
+_SHAPES = st.fixed_dictionaries({
+    "trees": st.lists(st.sampled_from([*_SIZES, "doubled"]), min_size=1, max_size=8),
+    "chain": st.sampled_from(["none", "transitions", "then"]),
+    "links": st.lists(_LINK, max_size=10),
+    "budget": st.integers(1, 260),
+})
+
+
+@pytest.fixture(scope="module")
+def shapes(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, int]]:
+    """A project of wide trees and one of two references to 'middle'; instances by tree."""
+    path = tmp_path_factory.mktemp("shapes")
+    trees = [tree_json(N("Sequence", *[N("Succeeder") for _ in range(size - 1)]),
+                       tree_id=tree, title=tree) for tree, size in _SIZES.items()]
+    trees.append(tree_json(N("Sequence", N("middle"), N("middle")), tree_id="doubled",
+                           title="doubled"))
+    (path / "shapes.b3.json").write_text(project_json(trees))
+    instances = {tree["id"]: len(load_tree(path / "shapes.b3.json", tree=tree["id"],
+                                           registry=registry())) for tree in trees}
+    return path, instances
+
+
+def shape_text(shape: dict[str, object]) -> str:
+    """The mode file of a drawn shape: mode i runs the i-th tree drawn."""
+    trees = list(shape["trees"])  # type: ignore[call-overload]
+    lines = ['project = "shapes.b3.json"', 'initial = "m0"']
+    links: list[tuple[int, int, str]] = list(shape["links"])  # type: ignore[call-overload]
+    for index, tree in enumerate(trees):
+        lines += [f"[modes.m{index}]", f'tree = "{tree}"']
+        if shape["chain"] == "then" and index + 1 < len(trees):
+            lines += ["max_time = 1.0", f'then = "m{index + 1}"']
+        elif shape["chain"] == "transitions" and index + 1 < len(trees):
+            links.append((index, index + 1, "event"))
+    count = len(trees)
+    for number, (source, step, trigger) in enumerate(links):
+        source %= count
+        target = (source + 1 + step % max(count - 1, 1)) % count  # another mode, if any
+        origin = '"*"' if trigger == "any" else f'"m{source}"'
+        how = {"event": f'event = "e{number}"', "on_request": "on_request = true",
+               "when": f"when = \"x == {number}\"", "any": f'event = "e{number}"'}[trigger]
+        lines += ["[[transitions]]", f"from = {origin}", f'to = "m{target}"', how]
+    return "\n".join(lines) + "\n"
+
+
+def naive_reachable(spec: MachineSpec) -> set[str]:
+    """The modes a path reaches, each mode tried against every transition (the definition)."""
+    seen, frontier = {spec.initial}, [spec.initial]
+    while frontier:
+        mode = frontier.pop()
+        targets = [t.target for t in spec.transitions if t.leaves(mode)]
+        then = spec.modes[mode].then
+        if then is not None:
+            targets.append(then)
+        for target in targets:
+            if target not in seen:
+                seen.add(target)
+                frontier.append(target)
+    return seen
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(shape=_SHAPES)
+def test_drawn_machines_load_within_their_caps_or_are_refused_for_the_cap_they_pass(
+        shapes: tuple[Path, dict[str, int]], shape: dict[str, object]) -> None:
+    folder, instances = shapes
+    text = shape_text(shape)
+    trees: list[str] = list(shape["trees"])  # type: ignore[call-overload]
+    budget = int(str(shape["budget"]))
+    needed = sum(instances[tree] for tree in set(trees))
+    transitions = text.count("[[transitions]]")
+    path = write_modes(folder, text, "shape.modes.toml")
+    with pytest.MonkeyPatch.context() as patch:
+        for name, value in _SHAPE_CAPS.items():
+            patch.setattr(caps, name, value)
+        try:
+            machine = load_machine(path, registry=registry(), clock=ManualClock(),
+                                   max_nodes=budget)
+        except ModeFileError as exc:
+            ours = [p for p in exc.problems if p.source == str(path)]
+            assert ours and all(p.line is not None for p in ours)
+            said = " ".join(p.message for p in ours)
+            if len(trees) > _SHAPE_CAPS["MAX_MODES"]:
+                event("refused: modes")
+                assert "modes, more than the 6" in said
+            elif transitions > _SHAPE_CAPS["MAX_TRANSITIONS"]:
+                event("refused: transitions")
+                assert "transitions, more than the 8" in said
+            elif "node instances" in said:  # alone, and only when the trees need more
+                event("refused: nodes")
+                assert len(ours) == 1 and needed > budget
+                assert f"more than the {budget:,} one mode file may load" in said
+            else:  # the file's own mistakes (unreachable modes, repeated transitions)
+                event("refused: the file's mistakes")
+                assert "cannot be reached" in said or "repeats" in said or "leads back" in said
+            return
+    assert len(trees) <= _SHAPE_CAPS["MAX_MODES"] and transitions <= _SHAPE_CAPS[
+        "MAX_TRANSITIONS"] and needed <= budget
+    event("loaded")
+    built = {id(tree): tree for tree in machine.trees.values()}
+    assert len(built) == len(set(trees))
+    assert sum(len(tree) for tree in built.values()) == needed
+    assert machine.spec.reachable() == naive_reachable(machine.spec) == set(machine.spec.modes)
+    machine.tick()
     machine.halt()

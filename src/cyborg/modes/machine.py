@@ -26,7 +26,9 @@ first event, request or force).
 node's ``on_halt`` runs exactly once, deepest first, so a running MoveTo cancels its goal)
 before anything else happens, and **entering** one starts its tree fresh: its tree and node
 memories are emptied, so it begins as on its first tick. Only the blackboard's global scope
-(and the resources) is shared between the modes' trees.
+(and the resources) is shared between the modes' trees. Two modes may hold the same
+:class:`~cyborg.bt.tree.Tree` (:func:`cyborg.modes.build_machine` builds a tree several modes
+name once): the switch between them halts it and empties its memories all the same.
 
 Each transition is kept in :attr:`~ModeMachine.history` and handed to the listeners added with
 :meth:`~ModeMachine.add_listener`, in the thread that caused it (the ticking thread, or the one

@@ -128,12 +128,25 @@ def reachable(initial: str, modes: dict[str, ModeSpec],
     """Modes reached from ``initial`` by any transition (condition, event, request) or ``then``.
 
     A force reaches any mode, so it is no path: a mode only an operator can enter is a mistake
-    in the file, most often a transition forgotten.
+    in the file, most often a transition forgotten. Time linear in the modes and transitions:
+    each transition is looked at once per mode it names in ``from``, and a ``"*"`` one once.
     """
+    leading: dict[str, list[str]] = {}
+    from_any: list[str] = []
+    for transition in transitions:
+        if transition.sources == (ANY,):
+            from_any.append(transition.target)
+        else:
+            for source in transition.sources:
+                leading.setdefault(source, []).append(transition.target)
     seen, frontier = {initial}, [initial]
+    # "*" leaves every mode but its target, and the initial mode is one: its targets other
+    # than the initial mode are reached from it, and the initial mode is reached already.
+    following_any = from_any
     while frontier:
         mode = frontier.pop()
-        following = [t.target for t in transitions if t.leaves(mode)]
+        following = leading.get(mode, []) + following_any
+        following_any = []
         then = modes[mode].then if mode in modes else None
         if then is not None:
             following.append(then)
