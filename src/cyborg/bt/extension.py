@@ -27,7 +27,7 @@ from collections.abc import Callable
 from time import perf_counter
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
-from cyborg.bt.status import RUNNING, Status, TickInterrupted
+from cyborg.bt.status import RUNNING, Status
 
 _rehooking = threading.Lock()  # slots change from any thread (a monitor's, the ticking one)
 
@@ -205,9 +205,6 @@ class ExtensionPoints:
                 status = self._coerce(status)
         except Exception as exc:
             status = self._raised(exc)
-        except TickInterrupted:
-            self.status = RUNNING  # cut off mid-tick: the halt that follows must reach it
-            raise
         self.status = status
         record = self._record
         record.visits.append((self, status))

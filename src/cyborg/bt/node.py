@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 from cyborg.bt.extension import ExtensionPoints, TickRecord
 from cyborg.bt.limits import check_value_size
-from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status, TickInterrupted
+from cyborg.bt.status import ERROR, FAILURE, RUNNING, SUCCESS, NodeError, Status
 
 if TYPE_CHECKING:
     from cyborg.bt.blackboard import Blackboard
@@ -197,9 +197,6 @@ class Node(ExtensionPoints):
                 status = self._coerce(status)
         except Exception as exc:
             status = self._raised(exc)
-        except TickInterrupted:
-            self.status = RUNNING  # cut off mid-tick: the halt that follows must reach it
-            raise
         self.status = status
         record.visits.append((self, status))
         if status is RUNNING:
@@ -219,9 +216,6 @@ class Node(ExtensionPoints):
                 status = self._coerce(status)
         except Exception as exc:
             status = self._raised(exc)
-        except TickInterrupted:
-            self.status = RUNNING  # cut off mid-tick: the halt that follows must reach it
-            raise
         self.status = status
         record.visits.append((self, status))
         if status is RUNNING:

@@ -30,9 +30,9 @@ from time import perf_counter
 from types import FrameType
 
 from cyborg.bt.node import Node
-from cyborg.bt.status import TickInterrupted
+from cyborg.bt.status import RUNNING, TickInterrupted
 
-__all__ = ["COMPUTING_SHARE", "TickGuard", "TickInterrupted"]
+__all__ = ["COMPUTING_SHARE", "TickGuard", "TickInterrupted", "mark_cut_off"]
 
 COMPUTING_SHARE = 0.1
 """The share of a wait's wall time a tick must use the CPU to count as computing (a tick
@@ -131,6 +131,23 @@ class TickGuard:
                 return f"node {node.uid} ({node.label}, {node.name})"
             frame = frame.f_back
         return ""
+
+
+def mark_cut_off(exc: TickInterrupted) -> list[Node]:
+    """Leaves RUNNING every node ``exc`` passed on its way out of the tick; returns them.
+
+    A node cut off mid-tick may have started something (a goal sent) before it could say
+    RUNNING: so marked, the halt that follows reaches it and its ``on_halt`` cancels it.
+    """
+    cut_off: list[Node] = []
+    trace = exc.__traceback__
+    while trace is not None:
+        node = trace.tb_frame.f_locals.get("self")
+        if isinstance(node, Node) and node not in cut_off:
+            node.status = RUNNING
+            cut_off.append(node)
+        trace = trace.tb_next
+    return cut_off
 
 
 def _reason_type(reason: str) -> type[TickInterrupted]:

@@ -45,7 +45,7 @@ from cyborg.bt.hooks import TreeHooks
 from cyborg.bt.service_runner import ServiceRunner
 from cyborg.bt.snapshot import TickSnapshot
 from cyborg.bt.status import RUNNING, TickInterrupted
-from cyborg.bt.tick_guard import TickGuard
+from cyborg.bt.tick_guard import TickGuard, mark_cut_off
 
 log = logging.getLogger("cyborg.bt")
 
@@ -388,6 +388,9 @@ class TickLoop(Generic[T]):
             self._guard.enter()
             try:
                 snapshot = self.tree.tick()
+            except TickInterrupted as exc:  # before a halting thread may take the lock:
+                mark_cut_off(exc)  # its halt must reach the nodes cut off
+                raise
             finally:
                 self._guard.leave()
         for listener in list(self._listeners):

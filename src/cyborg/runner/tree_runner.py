@@ -1,36 +1,23 @@
 """The tree runner on the bus: load a behavior3editor tree, tick it, publish what it does.
 
-Under the runner's namespace (``/cyborg/bt`` by default, as in 2018) it serves the topics and
-services that :mod:`cyborg.interfaces.tree_runner` names and describes (structure, active path,
-``enabled``, ``stopped``, ``status`` every tick with each node's wall time while someone
-listens, ``services`` at most 4 a second through :mod:`cyborg.runner.service_states`;
-``enable``, ``stop``, ``reload``), plus the per-node controls of
-:mod:`cyborg.runner.tree_control` (hooks, breakpoints, blackboard), and the node parameter
-``reload_timeout`` (seconds, wall time; default 30).
+Under its namespace (``/cyborg/bt`` by default, as in 2018) it serves what
+:mod:`cyborg.interfaces.tree_runner` describes (structure, active path, ``enabled``,
+``stopped``, per-tick ``status`` while someone listens, ``services`` via
+:mod:`cyborg.runner.service_states`; ``enable``, ``stop``, ``reload``), the per-node controls of
+:mod:`cyborg.runner.tree_control`, and the parameter ``reload_timeout`` (wall seconds; 30).
 
-**Services never wait on each other.** ``enable`` and ``stop`` are answered on a thread
-of its own, the other control services (``control``, ``step``, ``resume``,
-``get_blackboard``) on another, and neither waits for ``reload`` or for anything else the
-node's own thread does (``/clock``, parameters). A reload loads in the background.
+**Services never wait on each other.** ``enable`` and ``stop`` are answered on a thread of
+their own, the other control services on another; neither waits for ``reload`` (loaded in the
+background, :mod:`cyborg.runner.background_reload`) or the node's own thread.
 
-**Enable and disable.** Unlike 2018, disabling *halts* the tree: every RUNNING node is halted,
-so a MoveTo cancels its goal and the robot stops. Enabling starts the tree afresh from its root
-(memories of halted nodes are reset, as after any halt). ``stop`` disables likewise and
-latches ``stopped`` until ``enable(true)``. Disabling stops the ticks at once; the halt needs
-the tick in progress to end, so when a node in it waits on a slow robot, ``enable`` answers
-after :data:`HALT_WAIT` seconds anyway (saying so) and the halt follows when that tick ends;
-``enable(true)`` meanwhile is refused (the tree must not run before its halt), never held up.
-A tick still going :data:`~cyborg.bt.tick_loop.INTERRUPT_AFTER` seconds into a halt or stop is
-interrupted (:mod:`cyborg.bt.tick_guard`: at once for a node busy in Python, when its wait
-returns for one waiting on the robot), and one that overruns the tick limit (10 s) is
-interrupted, logged with its node, and the tree disabled, so nothing a node does takes away
-the stop.
-
-**Reload.** The file (or another one) is loaded and checked on a thread of its own, one at a
-time, answered within ``reload_timeout`` wall seconds (:mod:`cyborg.runner.background_reload`);
-a file with errors is rejected with every problem and the running tree keeps running; a good
-one replaces the tree between two ticks, keeping the global blackboard and the hooks on nodes
-that still exist (docs/controller.md).
+**Enable, disable, stop** (docs/controller.md). Disabling *halts* the tree (a MoveTo cancels its
+goal); enabling starts it afresh; ``stop`` disables and latches ``stopped`` until
+``enable(true)``. Ticks stop at once; the halt waits for the tick in progress, which a tick that
+computes does not hold up (:mod:`cyborg.bt.tick_guard` interrupts it) and one waiting on a slow
+robot may: ``enable`` then answers after :data:`HALT_WAIT` seconds (saying so) and
+``enable(true)`` is refused until the halt is done. A tick past its limit (10 s) is
+interrupted, logged with its node, and the tree disabled. A good reload replaces the tree
+between two ticks, keeping the global blackboard and the hooks of nodes that still exist.
 
 **Time.** The tree ticks on the wall clock, or on ``/clock`` with ``use_sim_time``. **Modes.**
 Given a mode file (``*.toml``, docs/modes.md) instead of a tree file, the runner ticks a
@@ -97,9 +84,9 @@ STILL_HALTING = ("; ticking has stopped and the tree halts when its current tick
 HALT_WAIT = 0.5
 """Seconds ``enable(false)`` waits for the halt before it answers (see ``set_enabled``)."""
 MODE_FILE_SUFFIX = ".toml"
+"""A file with this suffix is a mode file (docs/modes.md), any other a tree file."""
 AFTER_A_TICK = (Trigger.CONDITION, Trigger.TIMEOUT)
 """Transitions the machine makes right after a tick, before the tick's listeners run."""
-"""A file with this suffix is a mode file (docs/modes.md), any other a tree file."""
 
 
 class TreeRunnerNode:
@@ -162,7 +149,7 @@ class TreeRunnerNode:
             self._follow(self.ticked)
         self._publish_structure()
         self._publish_enabled()
-        self._publish_stopped()
+        self._stopped_pub.publish(Bool(data=self._stopped))
         self._thread: threading.Thread | None = None
 
     @property
@@ -340,7 +327,7 @@ class TreeRunnerNode:
         with self._lock:
             changed, self._stopped = stopped != self._stopped, stopped
         if changed:
-            self._publish_stopped()
+            self._stopped_pub.publish(Bool(data=self._stopped))
 
     def stop(self) -> None:
         """Stop ticking and halt the tree (the robot stops); withdraws nothing from the bus."""
@@ -363,9 +350,6 @@ class TreeRunnerNode:
 
     def _publish_enabled(self) -> None:
         self._enabled_pub.publish(Bool(data=self._enabled))
-
-    def _publish_stopped(self) -> None:
-        self._stopped_pub.publish(Bool(data=self._stopped))
 
     def _publish_active(self, active: tuple[str, ...]) -> None:
         self._updates.publish(BehaviorTreeNodes(ids=list(active)))
