@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.status_line import StatusLine
 from cyborg.app.terminal import errors_on_one_line
@@ -37,7 +38,7 @@ def add_parser(commands: Any) -> Any:
     :mod:`cyborg.app.cli` adds the tree runner's subcommands to the group
     (:mod:`cyborg.app.runner_commands`).
     """
-    bt = commands.add_parser("bt", help="behaviour trees: validate, run, export",
+    bt = commands.add_parser("bt", help=COMMANDS["bt"].help,
                              description="Work with behavior3editor exports.")
     sub = bt.add_subparsers(dest="bt_command", metavar="SUBCOMMAND", required=True)
 

@@ -26,6 +26,7 @@ import yaml
 
 from cyborg.app.bus_lookup import echo_qos, service_type, topic_type
 from cyborg.app.bus_options import add_join_command, open_context
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.app.rate_window import RateWindow, hz_line
 from cyborg.bus import (
@@ -48,7 +49,7 @@ ARRAY_PREVIEW = 16
 
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg router``, ``node``, ``topic`` and ``service`` to the commands."""
-    router = commands.add_parser("router", help="run a Zenoh router for the bus")
+    router = commands.add_parser("router", help=COMMANDS["router"].help)
     router.add_argument("--listen", action="append", default=[], metavar="ENDPOINT",
                         help=f"where to listen (default {DEFAULT_ROUTER}; tcp/[::]:7447 for "
                              "other machines)")
@@ -56,12 +57,12 @@ def add_parser(commands: Any) -> None:
                         help="another router to link to (repeatable)")
     router.set_defaults(handler=router_command)
 
-    node = _group(commands, "node", "nodes on the bus")
+    node = _group(commands, "node")
     add_join_command(node, "list", "list live nodes", node_list)
     add_join_command(node, "info", "a node's publishers, subscriptions and services",
                      node_info).add_argument("name")
 
-    topic = _group(commands, "topic", "topics on the bus")
+    topic = _group(commands, "topic")
     add_join_command(topic, "list", "list topics", topic_list).add_argument(
         "-t", "--show-types", action="store_true")
     echo = add_join_command(topic, "echo", "print messages of a topic as YAML", topic_echo)
@@ -88,7 +89,7 @@ def add_parser(commands: Any) -> None:
     hz.add_argument("type", nargs="?", help="message type (default: from the graph)")
     hz.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
 
-    service = _group(commands, "service", "services on the bus")
+    service = _group(commands, "service")
     add_join_command(service, "list", "list services", service_list).add_argument(
         "-t", "--show-types", action="store_true")
     call = add_join_command(service, "call", "call a service with a request given as YAML",
@@ -100,8 +101,8 @@ def add_parser(commands: Any) -> None:
                       help="seconds to wait for a server, then for the reply (default 5)")
 
 
-def _group(commands: Any, name: str, text: str) -> Any:
-    parser = commands.add_parser(name, help=text)
+def _group(commands: Any, name: str) -> Any:
+    parser = commands.add_parser(name, help=COMMANDS[name].help)
     return parser.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND", required=True)
 
 

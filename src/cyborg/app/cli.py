@@ -39,32 +39,48 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from types import FrameType
+from typing import Any
 
 from cyborg import __version__
+from cyborg.app.command_table import COMMANDS, command_in
 from cyborg.app.errors import CommandError
 
-COMMAND_MODULES = ("up", "monitor_commands", "foxglove_commands", "bt_commands",
-                   "runner_commands", "bus_commands", "record_commands", "play_commands",
-                   "report_commands", "param_commands", "sim_commands", "detect_commands")
-"""The modules of :mod:`cyborg.app` that add the commands, imported by :func:`build_parser`
-(not when this module is imported: they take seconds, and Ctrl-C may come meanwhile)."""
+def _add_bt(commands: Any) -> None:
+    """``cyborg bt``: the files' commands, then the running tree's (serve, reload, ...)."""
+    from cyborg.app import bt_commands, runner_commands
+    runner_commands.add_parsers(bt_commands.add_parser(commands))
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``cyborg`` command's parser, with every subcommand (imports their modules)."""
-    modules = {name: importlib.import_module(f"cyborg.app.{name}") for name in COMMAND_MODULES}
+
+ADDERS: dict[str, Callable[[Any], None]] = {"bt_commands": _add_bt}
+"""How a module's commands are added to the parser, where it is not ``module.add_parser``."""
+
+
+def build_parser(command: str | None = "") -> argparse.ArgumentParser:
+    """The ``cyborg`` command's parser.
+
+    Every command is there; ``command`` says which one is built in full, importing its module
+    (:mod:`cyborg.app.command_table`): None, none (``cyborg --help`` imports nothing); the
+    default ``""``, all of them.
+    """
     parser = argparse.ArgumentParser(
         prog="cyborg", description="Control stack for the NTNU Cyborg robot.")
     parser.add_argument("--version", action="version", version=f"cyborg {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="more log output (-vv for debug)")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    modules["up"].add_parser(commands)
-    modules["monitor_commands"].add_parser(commands)
-    modules["foxglove_commands"].add_parser(commands)
-    modules["runner_commands"].add_parsers(modules["bt_commands"].add_parser(commands))
-    for name in ("bus_commands", "record_commands", "play_commands", "report_commands",
-                 "param_commands", "sim_commands", "detect_commands"):
-        modules[name].add_parser(commands)
+    full = {name for name, entry in COMMANDS.items()
+            if command == "" or (command is not None and command in COMMANDS
+                                 and entry.module == COMMANDS[command].module)}
+    added: set[str] = set()
+    for name, entry in COMMANDS.items():
+        if name not in full:
+            commands.add_parser(name, help=entry.help)  # its options come when it runs
+        elif entry.module not in added:
+            added.add(entry.module)
+            adder = ADDERS.get(entry.module)
+            if adder is None:
+                adder = importlib.import_module(f"cyborg.app.{entry.module}").add_parser
+            adder(commands)
     return parser
 
 def _exit_interrupted(_signum: int, _frame: FrameType | None) -> None:
@@ -113,8 +129,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         with interrupt_ends_at_once():
             from cyborg.app.memory import limit_malloc_arenas
             limit_malloc_arenas()  # before any thread starts: keeps a long run's memory flat
-            parser = build_parser()
-            args = parser.parse_args(argv)
+            words = list(sys.argv[1:] if argv is None else argv)
+            parser = build_parser(command_in(words))
+            args = parser.parse_args(words)
         level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
         logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
         result: int = args.handler(args)

@@ -23,6 +23,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any, TextIO
 
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.detect_output import FrameWriter
 from cyborg.app.errors import CommandError
 from cyborg.app.progress import ProgressBar
@@ -47,7 +48,7 @@ from cyborg.vision.pipeline import STAGES
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg detect`` (and ``cyborg detect models``) to the commands."""
     detect = commands.add_parser(
-        "detect", help="detect objects (with distance) in images, videos, bags or the bus",
+        "detect", help=COMMANDS["detect"].help,
         description="Run the object detector on a source and report labelled boxes with "
                     "their distance. SOURCE: an image, a folder, a video, LEFT,RIGHT, a ROS "
                     "bag, camera:N, sample:motorcycle or bus:TOPIC. `cyborg detect models "

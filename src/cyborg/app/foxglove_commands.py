@@ -27,6 +27,7 @@ from cyborg.app.access_options import (
     add_token_option,
 )
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.launch import LaunchDescription
 from cyborg.app.system import run_system
 from cyborg.bus.component import NodeSpec
@@ -36,7 +37,7 @@ from cyborg.foxglove import component as foxglove
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg foxglove`` to the commands."""
     parser = commands.add_parser(
-        "foxglove", help="serve the bus to the Foxglove app (WebSocket)",
+        "foxglove", help=COMMANDS["foxglove"].help,
         description="Serve every topic on the bus, the robots' maps and frames and the trees' "
                     "ticks to the Foxglove app over the Foxglove WebSocket protocol.")
     parser.add_argument("--port", type=int, default=foxglove.PORT,

@@ -28,6 +28,7 @@ from cyborg.app.access_options import (
     add_token_option,
 )
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.launch import LaunchDescription
 from cyborg.app.system import run_system
 from cyborg.bus.component import NodeSpec
@@ -37,7 +38,7 @@ from cyborg.monitor import component as monitor
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg monitor`` to the commands."""
     parser = commands.add_parser(
-        "monitor", help="serve the web monitor for running behaviour trees",
+        "monitor", help=COMMANDS["monitor"].help,
         description="Serve a web page that shows the running behaviour trees live and "
                     "controls them (run/pause, disable, force, breakpoints).")
     parser.add_argument("--port", type=int, default=monitor.PORT,

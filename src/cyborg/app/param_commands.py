@@ -9,6 +9,7 @@ from typing import Any
 import yaml
 
 from cyborg.app.bus_options import add_join_command, open_context
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.bus import Node, ServiceError
 from cyborg.bus.parameter_client import ParameterClient, ParameterError
@@ -16,7 +17,7 @@ from cyborg.bus.parameter_client import ParameterClient, ParameterError
 
 def add_parser(commands: Any) -> None:
     """``cyborg param``: its subcommands join the bus (:func:`add_join_command`)."""
-    param = commands.add_parser("param", help="parameters of a node")
+    param = commands.add_parser("param", help=COMMANDS["param"].help)
     group = param.add_subparsers(dest="param_command", metavar="SUBCOMMAND", required=True)
     add_join_command(group, "list", "a node's parameters", param_list).add_argument("node")
     get = add_join_command(group, "get", "a parameter's value", param_get)

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from cyborg.app.bus_options import bus_context, open_context
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
 from cyborg.app.progress import LiveLine, duration
@@ -42,7 +43,7 @@ POLL = 0.1
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg play`` to the commands."""
     play = commands.add_parser(
-        "play", help="play a recording (MCAP, ROS 1 or ROS 2 bag) on the bus",
+        "play", help=COMMANDS["play"].help,
         description="Publish a recording on the bus with its original timing, its messages' "
                     "bytes as recorded, /clock from its time and its latched topics latched.")
     play.add_argument("recording", type=Path, metavar="FILE",

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from cyborg.app.bus_options import open_context
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError, interrupt
 from cyborg.app.keypress import Keys
 from cyborg.app.memory import keep_large_buffers
@@ -46,7 +47,7 @@ POLL = 0.1
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg record`` to the commands."""
     record = commands.add_parser(
-        "record", help="record the bus into an MCAP file (or --recover a cut one)",
+        "record", help=COMMANDS["record"].help,
         description="Record topics of the bus into an MCAP file in the rosbag2 layout, "
                     "readable by ros2 bag, Foxglove and rosbags.")
     record.add_argument("topics", nargs="*", metavar="TOPIC",

@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.record.playback_source import RecordingError
 from cyborg.report.build import write_report
@@ -24,7 +25,7 @@ from cyborg.report.build import write_report
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg report`` to the commands."""
     report = commands.add_parser(
-        "report", help="write an HTML report of a recorded run",
+        "report", help=COMMANDS["report"].help,
         description="Write one self-contained HTML page of an MCAP recording: tree, path on "
                     "the map, battery, goals, detections and warnings of each robot.")
     report.add_argument("recording", type=Path, metavar="FILE",

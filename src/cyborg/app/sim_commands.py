@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from cyborg.app.bus_options import DEFAULT_ROUTER, bus_context
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.interfaces.robot import fleet_namespaces
@@ -32,7 +33,7 @@ from cyborg.sim import component as sim
 
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg sim`` and ``cyborg nav`` to the commands."""
-    parser = commands.add_parser("sim", help="run the simulated robot on an ARNL map",
+    parser = commands.add_parser("sim", help=COMMANDS["sim"].help,
                                  description="Simulate the Pioneer LX on a map and serve it "
                                              "on the bus with an ARNL-like interface.")
     parser.add_argument("--map", type=Path, required=True, metavar="FILE",
@@ -57,7 +58,7 @@ def add_parser(commands: Any) -> None:
                         help="stop after this much simulated time")
     parser.set_defaults(handler=sim_command)
 
-    nav = commands.add_parser("nav", help="goals and paths of an ARNL map")
+    nav = commands.add_parser("nav", help=COMMANDS["nav"].help)
     actions = nav.add_subparsers(dest="nav_command", metavar="COMMAND", required=True)
     goals = actions.add_parser("goals", help="list the goals and docks of a map")
     goals.add_argument("map", type=Path)

@@ -41,6 +41,7 @@ from typing import Any
 
 from cyborg.app.access_options import access_parameters, add_access_options
 from cyborg.app.bus_options import DEFAULT_ROUTER, add_bus_options
+from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.app.foxglove_commands import foxglove_parameters
 from cyborg.app.launch import LaunchDescription, as_child, read_launch, under_robot
@@ -85,7 +86,7 @@ as a recharge takes, so the robots take turns at the map's charger instead of qu
 
 def add_parser(commands: Any) -> None:
     """Adds ``cyborg up`` and ``cyborg launch`` to the commands."""
-    up = commands.add_parser("up", help="run the robot's system on built-in defaults",
+    up = commands.add_parser("up", help=COMMANDS["up"].help,
                              description="Start the simulated robot on the bundled campus map, "
                                          "its navigation services and the tree runner with the "
                                          "bundled mission on modes (patrol, go charge, stop "
@@ -130,7 +131,7 @@ def add_parser(commands: Any) -> None:
     add_bus_options(up)
     up.set_defaults(handler=up_command)
 
-    launch = commands.add_parser("launch", help="start the nodes a launch file lists",
+    launch = commands.add_parser("launch", help=COMMANDS["launch"].help,
                                  description="Start the nodes of a TOML or YAML launch file, "
                                              "in one process or several.")
     launch.add_argument("file", type=Path, help="launch file (.toml, .yaml)")
