@@ -38,6 +38,7 @@ BENCHMARKS: dict[str, str] = {
     "recording_cpu": "the recorder's CPU on cyborg up's default topics",
     "recording_camera": "recording the camera's full stream",
     "replay": "cyborg play's timing against a bare sleep loop",
+    "cli_startup": "the command line's start-up time and memory against import zenoh",
     "soak": "cyborg up at full speed: memory growth and collisions",
 }
 """Every benchmark (module ``benchmarks.NAME``) and what it measures, in the order of
