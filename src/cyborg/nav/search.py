@@ -10,18 +10,26 @@ The first call compiles the kernels (about a second); the result is cached on di
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
 from numba import njit
 
 SQRT2 = math.sqrt(2.0)
+FLOOD_EVERY = 4
+"""Steps of the search per step of :func:`astar`'s flood from the goal."""
 
 
 @njit(cache=True)
 def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no cover - jit
-    """Cells (flat indices) of a cheapest 8-connected path from start to goal; empty if none."""
+    """Cells (flat indices) of a cheapest 8-connected path from start to goal; empty if none.
+
+    The open cells wait in a binary heap ordered by estimate, then cell (so ties go the same
+    way every time). Beside the search, one step in :data:`FLOOD_EVERY`, a flood from the goal
+    goes back over the cells from which the goal can be reached: when it runs out before it
+    reaches the start, there is no path, and the search stops there rather than visit every
+    cell it can reach (a goal in a room whose door is taken costs the room, not the map).
+    """
     rows, columns = cost.shape
     flat = cost.ravel()
     size = rows * columns
@@ -30,11 +38,29 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
     closed = np.zeros(size, np.bool_)
     goal_r, goal_c = goal // columns, goal % columns
     g[start] = 0.0
-    heap = [(0.0, start)]
-    dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
-    dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
-    while len(heap) > 0:
-        _f, current = heapq.heappop(heap)
+    capacity = 1024
+    keys = np.empty(capacity)
+    cells = np.empty(capacity, np.int64)
+    keys[0], cells[0], count = 0.0, start, 1
+    if goal != start and not np.isfinite(flat[goal]):
+        return np.zeros(0, np.int64)  # the search enters finite cells only
+    back = np.zeros(size, np.bool_)  # the flood from the goal
+    queue = np.empty(size, np.int64)
+    queue[0], back[goal], head, tail = goal, True, 0, 1
+    flooding = goal != start
+    turn = 0
+    while count > 0:
+        turn += 1
+        if flooding and turn % FLOOD_EVERY == 0:
+            if head == tail:  # the goal's side is closed, without the start in it
+                return np.zeros(0, np.int64)
+            tail = _flood(flat, rows, columns, back, queue, head, tail)
+            head += 1
+            flooding = not back[start]
+        current = cells[0]
+        count -= 1
+        if count > 0:
+            _sift_down(keys, cells, count)
         if closed[current]:
             continue
         if current == goal:
@@ -42,26 +68,32 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
         closed[current] = True
         r, c = current // columns, current % columns
         here = flat[current]
+        base = g[current]
         for k in range(8):
-            nr, nc = r + dr[k], c + dc[k]
+            dr, dc = _DR[k], _DC[k]
+            nr, nc = r + dr, c + dc
             if nr < 0 or nr >= rows or nc < 0 or nc >= columns:
                 continue
             neighbour = nr * columns + nc
             there = flat[neighbour]
             if closed[neighbour] or not np.isfinite(there):
                 continue
-            diagonal = dr[k] != 0 and dc[k] != 0
+            diagonal = dr != 0 and dc != 0
             if diagonal and (not np.isfinite(flat[r * columns + nc])
                              or not np.isfinite(flat[nr * columns + c])):
                 continue  # never squeeze between two blocked cells
             step = (SQRT2 if diagonal else 1.0) * 0.5 * (here + there)
-            candidate = g[current] + step
+            candidate = base + step
             if candidate < g[neighbour]:
                 g[neighbour] = candidate
                 parent[neighbour] = current
                 ar, ac = abs(nr - goal_r), abs(nc - goal_c)
                 h = (SQRT2 - 1.0) * min(ar, ac) + max(ar, ac)
-                heapq.heappush(heap, (candidate + h, neighbour))
+                if count == capacity:
+                    capacity *= 2
+                    keys, cells = _grown(keys, count, capacity), _grown(cells, count, capacity)
+                _sift_up(keys, cells, count, candidate + h, neighbour)
+                count += 1
     if parent[goal] < 0 and goal != start:
         return np.zeros(0, np.int64)
     length = 1
@@ -75,6 +107,80 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
         path[index] = cell
         cell = parent[cell]
     return path
+
+
+_DR = (-1, -1, -1, 0, 0, 1, 1, 1)
+_DC = (-1, 0, 1, -1, 1, -1, 0, 1)
+
+
+@njit(cache=True)
+def _flood(flat: np.ndarray, rows: int, columns: int, back: np.ndarray, queue: np.ndarray,
+           head: int, tail: int) -> int:  # pragma: no cover - jit
+    """Take ``queue[head]`` and queue the cells from which the search may step onto it.
+
+    Those are its finite neighbours not in ``back`` yet (a diagonal one only between two
+    finite cells, as :func:`astar` steps); they join ``back``. Returns the queue's new tail.
+    """
+    cell = queue[head]
+    r, c = cell // columns, cell % columns
+    for k in range(8):
+        dr, dc = _DR[k], _DC[k]
+        nr, nc = r + dr, c + dc
+        if nr < 0 or nr >= rows or nc < 0 or nc >= columns:
+            continue
+        neighbour = nr * columns + nc
+        if back[neighbour] or not np.isfinite(flat[neighbour]):
+            continue
+        if dr != 0 and dc != 0 and (not np.isfinite(flat[r * columns + nc])
+                                    or not np.isfinite(flat[nr * columns + c])):
+            continue
+        back[neighbour] = True
+        queue[tail] = neighbour
+        tail += 1
+    return tail
+
+
+@njit(cache=True)
+def _sift_down(keys: np.ndarray, cells: np.ndarray, count: int) -> None:  # pragma: no cover
+    """Put the heap's entry ``count`` (just past its end) in place of its root, in order."""
+    key, cell = keys[count], cells[count]
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= count:
+            break
+        if child + 1 < count and (keys[child + 1] < keys[child] or (
+                keys[child + 1] == keys[child] and cells[child + 1] < cells[child])):
+            child += 1
+        if keys[child] < key or (keys[child] == key and cells[child] < cell):
+            keys[i], cells[i] = keys[child], cells[child]
+            i = child
+        else:
+            break
+    keys[i], cells[i] = key, cell
+
+
+@njit(cache=True)
+def _sift_up(keys: np.ndarray, cells: np.ndarray, count: int, key: float,
+             cell: int) -> None:  # pragma: no cover - jit
+    """Add ``(key, cell)`` to the heap of ``count`` entries, in order."""
+    i = count
+    while i > 0:
+        up = (i - 1) >> 1
+        if key < keys[up] or (key == keys[up] and cell < cells[up]):
+            keys[i], cells[i] = keys[up], cells[up]
+            i = up
+        else:
+            break
+    keys[i], cells[i] = key, cell
+
+
+@njit(cache=True)
+def _grown(values: np.ndarray, count: int, capacity: int) -> np.ndarray:  # pragma: no cover
+    """A copy of ``values``' first ``count`` entries with room for ``capacity``."""
+    more = np.empty(capacity, values.dtype)
+    more[:count] = values[:count]
+    return more
 
 
 @njit(cache=True)

@@ -151,10 +151,23 @@ def _corner_distance(corners: np.ndarray, polygon: np.ndarray) -> float:  # prag
 @njit(cache=True)
 def cast_onto(outline: np.ndarray, x: float, y: float, angles: np.ndarray,
               ranges: np.ndarray) -> None:  # pragma: no cover - jit
-    """Shorten ``ranges`` (m, from ``(x, y)`` along absolute ``angles``) that hit ``outline``."""
+    """Shorten ``ranges`` (m, from ``(x, y)`` along absolute ``angles``) that hit ``outline``.
+
+    Beams that pass the circle around the outline, or end before it, are not tried.
+    """
     count = outline.shape[0]
+    cx, cy, radius = 0.0, 0.0, 0.0
+    for k in range(count):
+        cx += outline[k, 0] / count
+        cy += outline[k, 1] / count
+    for k in range(count):
+        radius = max(radius, math.hypot(outline[k, 0] - cx, outline[k, 1] - cy))
+    cx, cy, radius = cx - x, cy - y, radius + 1e-9
     for beam in range(angles.shape[0]):
         dx, dy = math.cos(angles[beam]), math.sin(angles[beam])
+        along = dx * cx + dy * cy
+        if along < -radius or along - radius > ranges[beam] or abs(dx * cy - dy * cx) > radius:
+            continue
         for i in range(count):
             j = (i + 1) % count
             ax, ay = outline[i, 0] - x, outline[i, 1] - y

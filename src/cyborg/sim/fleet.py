@@ -9,6 +9,9 @@ while the others stand still, and its drive refuses any step that would make its
 another's (:mod:`cyborg.sim.bodies`), robots never overlap: one blocked by another stops, and
 its navigator waits and replans around it as ARNL does around any obstacle, or gives up;
 two that meet head-on settle it, one making way for the other (:mod:`cyborg.sim.giving_way`).
+At the physics steps between two sensor steps only the drive needs the others, and only those
+near enough to touch it (:data:`CONTACT_MARGIN`): a robot that stands keeps its outline (the
+same array), and one alone pays nothing for the others.
 
 The robots start at distinct free poses (:func:`choose_starts`): the first where a lone robot
 would (:func:`cyborg.sim.start.choose_start`), the others at the free points nearest to it,
@@ -28,6 +31,7 @@ its share of that loop (a :class:`~cyborg.sim.loop.RobotLoop`), which is what it
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -44,6 +48,9 @@ from cyborg.sim.people import NOBODY, Crowd, Meeting
 from cyborg.sim.simulator import SimSettings, Simulator
 from cyborg.sim.start import START_MARGIN, StartChoice, choose_start
 
+CONTACT_MARGIN = 0.5
+"""Metres beyond two bodies' reach within which one robot's drive checks another's outline
+at every physics step (a step at top speed is 4 cm); further ones only its sensors meet."""
 MAX_ROBOTS = 16
 """The most robots a fleet has (as many as the web monitor follows)."""
 START_SPACING = 1.5
@@ -123,6 +130,8 @@ class Fleet:
         self._steps = 0
         self._samples = [outline_points(grown(sim.base.footprint.polygon(), KEEP_CLEAR))
                          for sim in self.simulators]  # around each body, in its own frame
+        # centres further apart than this cannot touch within a physics step
+        self._contact = 2 * max(sim.base.span for sim in self.simulators) + CONTACT_MARGIN
         self.crowd: Crowd | None = None  # people walking among the robots
         self.way_giving = WayGiving(count)  # robots that meet head-on settle it
         self._met: list[Meeting] = []
@@ -163,31 +172,37 @@ class Fleet:
                          if sim.planner is self.crowd.routes.planner else NOBODY
                          for sim in self.simulators]  # people walk on the fleet's first map
         for index, sim in enumerate(self.simulators):
-            near = self._near(index)
-            points = None
-            if sensing:
-                placed_points = [placed(self._samples[other], braking_poses(
-                    self.simulators[other].pose, self.simulators[other].base.speed,
-                    self.simulators[other].base.limits.acceleration)) for other in near]
-                if self._met:
-                    placed_points.append(self._met[index].points)
-                points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
-            bodies = tuple(outlines[other] for other in near)
             met = self._met[index] if self._met else None
+            if not sensing:  # only the drive needs the others: those it may touch this step
+                bodies = tuple(outlines[other] for other in self._near(index, self._contact))
+                sim.base.others = bodies + met.bodies if met else bodies
+                sim.step()
+                outlines[index] = sim.outline
+                continue
+            near = self._near(index)
+            placed_points = [placed(self._samples[other], braking_poses(
+                self.simulators[other].pose, self.simulators[other].base.speed,
+                self.simulators[other].base.limits.acceleration)) for other in near]
+            if met:
+                placed_points.append(met.points)
+            points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
+            bodies = tuple(outlines[other] for other in near)
             sim.meet(bodies + met.bodies if met else bodies, points,
-                     met.circles if met and sensing else None)
+                     met.circles if met else None)
             sim.step()
             outlines[index] = sim.outline  # where the next robot meets it
         if sensing and len(self.simulators) > 1:
             self.way_giving.step(self.simulators, self.time)
 
-    def _near(self, index: int) -> list[int]:
-        """The indices of the robots on ``index``'s map within its laser's reach."""
+    def _near(self, index: int, reach: float | None = None) -> list[int]:
+        """The indices of the robots on ``index``'s map within ``reach`` m (its laser's)."""
         sim = self.simulators[index]
-        pose, reach = sim.pose, sim.laser.spec.range_max + 1.0
+        pose = sim.pose
+        reach = sim.laser.spec.range_max + 1.0 if reach is None else reach
+        x, y, world = pose.x, pose.y, sim.map
         return [number for number, other in enumerate(self.simulators)
-                if other is not sim and other.map is sim.map
-                and np.hypot(other.pose.x - pose.x, other.pose.y - pose.y) <= reach]
+                if other is not sim and other.map is world
+                and math.hypot(other.pose.x - x, other.pose.y - y) <= reach]
 
 
 class FleetRobotLoop:

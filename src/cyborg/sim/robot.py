@@ -71,6 +71,7 @@ class RobotBase:
     def __post_init__(self) -> None:
         """The body's outline and the bounding circles of ``others`` (redone as they change)."""
         self._polygon = self.footprint.polygon()
+        self._outline: tuple[Pose2D, np.ndarray] | None = None  # see outline
         self._circles = self.footprint.circles()
         # the circle around the outline's corners, about their mean (the body's circle)
         self._reach = float(np.max(np.hypot(*(self._polygon - self._polygon.mean(axis=0)).T)))
@@ -88,23 +89,46 @@ class RobotBase:
         self.speed += _limited(speed - self.speed, limits.acceleration * dt)
         self.turn_rate += _limited(turn_rate - self.turn_rate, limits.turn_acceleration * dt)
         pose = self.pose
+        if self.speed == 0.0 and self.turn_rate == 0.0:  # standing: the body stays put
+            heading = normalize_angle(pose.theta)
+            if heading != pose.theta:
+                self.pose = Pose2D(pose.x, pose.y, heading)
+            if self.bumpers.any and self.body_clearance(self.pose) >= self.resolution:
+                self.bumpers = Bumpers()
+            return
         x, y, theta = arc_step(pose.x, pose.y, pose.theta, self.speed, self.turn_rate, dt)
         moved = Pose2D(x, y, normalize_angle(theta))
-        if self.collides(moved) and self._worse(moved):
-            if self.speed or self.turn_rate:
-                if not self.bumpers.any:
-                    self.bumps += 1
-                self.bumpers = Bumpers(front=self.speed >= 0, rear=self.speed < 0)
+        gap = self.body_clearance(moved)
+        if gap < 0.0 and gap <= self.body_clearance(pose):  # overlaps, and not backing off
+            if not self.bumpers.any:
+                self.bumps += 1
+            self.bumpers = Bumpers(front=self.speed >= 0, rear=self.speed < 0)
             self.speed = self.turn_rate = 0.0
             return
         self.odometer += math.hypot(moved.x - pose.x, moved.y - pose.y)
         self.pose = moved
-        if self.bumpers.any and self.body_clearance(moved) >= self.resolution:
+        if self.bumpers.any and gap >= self.resolution:
             self.bumpers = Bumpers()  # clear of the wall again (by more than the grid's step)
 
     def place(self, pose: Pose2D) -> None:
         """Put the robot at ``pose``, standing still."""
         self.pose, self.speed, self.turn_rate, self.bumpers = pose, 0.0, 0.0, Bumpers()
+
+    @property
+    def outline(self) -> np.ndarray:
+        """The body's outline where it stands: K x 2 map coordinates (kept while it stands).
+
+        The same array until the robot moves: not to be changed by whoever reads it.
+        """
+        pose = self.pose
+        if self._outline is None or self._outline[0] is not pose:
+            self._outline = (pose, outline_at(self._polygon, pose))
+        return self._outline[1]
+
+    @property
+    def span(self) -> float:
+        """Metres from the pose to the body's furthest corner."""
+        return self._span
 
     # ------------------------------------------------------------------ contact
     def body_clearance(self, pose: Pose2D) -> float:
@@ -123,7 +147,9 @@ class RobotBase:
         """
         if not self.others:
             return math.inf
-        if self._bounds[0] is not self.others:
+        known = self._bounds[0]
+        if known is not self.others and (len(known) != len(self.others) or any(
+                mine is not theirs for mine, theirs in zip(known, self.others, strict=True))):
             starts = np.cumsum([0, *(len(outline) for outline in self.others)])
             corners = np.ascontiguousarray(np.concatenate(self.others), dtype=np.float64)
             self._bounds = (self.others, corners, starts, *outline_bounds(corners, starts))
@@ -142,10 +168,6 @@ class RobotBase:
     def collides(self, pose: Pose2D) -> bool:
         """Whether the body at ``pose`` overlaps a wall."""
         return self.body_clearance(pose) < 0.0
-
-    def _worse(self, moved: Pose2D) -> bool:
-        """Moves that increase the gap are allowed even in contact (backing off a wall)."""
-        return self.body_clearance(moved) <= self.body_clearance(self.pose)
 
 
 def _limited(change: float, most: float) -> float:

@@ -33,7 +33,6 @@ from cyborg.nav.geometry import Pose2D, normalize_angle
 from cyborg.nav.grid import MapGrid
 from cyborg.nav.planner import Planner, PlanResult
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import outline_at
 from cyborg.sim.docking import Docking, DockPhase, DockSettings, DockState
 from cyborg.sim.laser import Laser, LaserSpec
 from cyborg.sim.manual import limit_command, placement_problem
@@ -167,8 +166,8 @@ class Simulator:
 
     @property
     def outline(self) -> np.ndarray:
-        """The robot's outline where it stands: its footprint's corners in the map (K x 2, m)."""
-        return outline_at(self.base.footprint.polygon(), self.base.pose)
+        """The robot's outline where it stands (:attr:`RobotBase.outline`; read, never change)."""
+        return self.base.outline
 
     def meet(self, others: tuple[np.ndarray, ...], points: np.ndarray | None = None,
              people: np.ndarray | None = None) -> None:
