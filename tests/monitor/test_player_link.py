@@ -276,3 +276,28 @@ def test_a_drawable_state_keeps_the_file_name_only() -> None:
     view = view_of(_state())
     assert view.wire() == {"file": "shift.mcap", "duration": 4.0, "position": 1.0,
                            "rate": 1.0, "paused": False, "finished": False, "time": 5.0}
+
+
+def test_while_a_recording_plays_commands_that_act_are_refused_but_stops_go_out(
+        monitor: Monitor, playing: Player) -> None:
+    """The page disables acting while a recording plays; the monitor refuses it too (a page
+    of its own, a script), never a stop or a disable."""
+    with local_client(monitor.app) as client, client.websocket_connect("/ws") as socket:
+        _holding_the_seat(socket)
+        _player(socket, lambda p: p is not None)
+        acting: list[dict[str, Any]] = [
+            {"t": "go", "ns": ROBOT, "goal": "Office"},
+            {"t": "go_pose", "ns": ROBOT, "pose": [1.0, 2.0, 0.0]},
+            {"t": "drive", "ns": ROBOT, "vx": 0.2, "wz": 0.0},
+            {"t": "enable", "ns": TREE, "on": True},
+            {"t": "step", "ns": TREE},
+            {"t": "mode_force", "ns": TREE, "mode": "demo"}]
+        for number, command in enumerate(acting, start=10):
+            refused = _answer(socket, {**command, "req": number})
+            assert refused["ok"] is False, refused
+            assert "refused while a recording plays (cyborg play)" in refused["message"], refused
+        stops: list[dict[str, Any]] = [{"t": "stop", "ns": ROBOT},
+                                       {"t": "enable", "ns": TREE, "on": False}]
+        for number, stop in enumerate(stops, start=30):
+            answer = _answer(socket, {**stop, "req": number})
+            assert "recording plays" not in answer.get("message", ""), answer

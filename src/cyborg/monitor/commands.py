@@ -46,7 +46,10 @@ commands (``go`` … ``tour``) but ``stop``, which any page that may control sen
 player's (``player_pause``, ``player_seek``, ``player_step``) and the mode machine's
 (``mode_force``, ``mode_request``, ``mode_hold``). The robot
 commands, their answers (``result``, ``robot_result``, ``tour``, ``manual_pause``) and why a
-manual goal pauses the tree are in :mod:`cyborg.monitor.robot_commands`.
+manual goal pauses the tree are in :mod:`cyborg.monitor.robot_commands`. While a recording
+plays (the monitor follows a ``cyborg play``), every command that would act on a robot, a tree
+or a mode machine is refused (:data:`REPLAY_REFUSAL`), as the page disables them; a ``stop``
+and an ``enable`` with ``on: false`` still go out.
 
 A message the monitor cannot read or will not carry out is answered with a *located* error::
 
@@ -81,6 +84,9 @@ log = logging.getLogger("cyborg.monitor")
 
 CONTROLS = ("enable", "control", "step", "resume")
 SECRET_LIMIT = 64
+REPLAY_REFUSAL = ("refused while a recording plays (cyborg play): it would act on no robot; a "
+                  "stop or a disable still goes out")
+"""Why a command that acts is refused while the monitor follows a player (as the page says)."""
 
 
 class CommandError(ValueError):
@@ -133,6 +139,10 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
     if not isinstance(command, dict) or not isinstance(command.get("t"), str):
         raise CommandError('a command is a JSON object with a string "t"', "t")
     kind, request = command["t"], command.get("req")
+    if hub.player.source is not None and _acts(kind, command):
+        client.send({"t": "result", "n": client.received, "req": request, "command": kind,
+                     "ok": False, "field": None, "message": f"{kind}: {REPLAY_REFUSAL}"})
+        return
     if kind in CONTROLS:
         answer = {"t": "result", "n": client.received, "req": request}
         try:
@@ -197,6 +207,13 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         client.send({"t": "pong", "req": request})
     else:
         raise CommandError(f"unknown command {kind[:40]!r}", "t")
+
+
+def _acts(kind: str, command: dict[str, Any]) -> bool:
+    """Whether ``command`` would act on a robot or a tree (a stop or a disable never counts)."""
+    if kind == "stop" or (kind == "enable" and command.get("on") is False):
+        return False
+    return kind in CONTROLS or kind in ROBOT_COMMANDS or kind in MODE_COMMANDS
 
 
 async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
