@@ -1,19 +1,27 @@
 """Bad input to the reader that ``cyborg play`` and ``cyborg report`` share: what is no recording
 is refused with one line naming the file and what is wrong; a recording with topics it cannot
-play plays the rest and names them; random damage to a valid file never raises anything but
-:class:`~cyborg.record.playback_source.RecordingError`."""
+play plays the rest and names them; random damage to a valid file, and hostile shapes (a bag's
+``metadata.yaml`` nested deep, edited at random or listing too many files and topics; channels
+and schema fields around their bounds), never raise anything but
+:class:`~cyborg.record.playback_source.RecordingError`, in one line."""
 
 from __future__ import annotations
 
+import itertools
 import tempfile
 from pathlib import Path
+from unittest import mock
 
 import pytest
+import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.writer import Writer
 
 from cyborg.bus import MessageTypes
+from cyborg.record import recorded
+from cyborg.record import scan as scan_module
+from cyborg.record.bag_checks import MAX_BAG_FILES, MAX_BAG_TOPICS
 from cyborg.record.playback_source import RecordingError, open_recording
 from cyborg.report.recording import read_recording
 from tests.record.bad_recordings import (
@@ -22,6 +30,8 @@ from tests.record.bad_recordings import (
     cut_in_its_middle,
     refused,
     small_recording,
+    sqlite_bag,
+    wide,
     with_strange_schemas,
 )
 
@@ -139,3 +149,117 @@ def test_a_damaged_recording_raises_nothing_but_a_recording_error(
         recording.close()
     report = read_recording(path, lambda _topic, _type: True)
     assert report.message_count >= len(played)
+
+
+def _fuzzed_bag() -> tuple[bytes, str]:
+    """The ``.db3`` file and ``metadata.yaml`` text of a small valid ROS 2 bag."""
+    with tempfile.TemporaryDirectory() as folder:
+        bag = sqlite_bag(Path(folder) / "bag")
+        return (bag / "bag.db3").read_bytes(), (bag / "metadata.yaml").read_text()
+
+
+BAG_DB3, BAG_METADATA = _fuzzed_bag()
+SHARED_TYPES = MessageTypes()
+"""The bus's types for the examples below (each learns types of names of its own)."""
+EXAMPLES = itertools.count()
+
+nesting = st.tuples(st.integers(1, 120), st.sampled_from(["[", "{a: ", "- ", "{a: ["]))
+edit = st.tuples(st.integers(0, len(BAG_METADATA)), st.integers(0, 40),
+                 st.text(alphabet="[]{}&*:,-'\"\n\t #!%@|>?~0123456789abc", max_size=12))
+listing = st.tuples(st.sampled_from([0, 1, 2, 7, MAX_BAG_FILES, MAX_BAG_FILES + 1]),
+                    st.integers(0, 3), st.sampled_from([0, 1, 2, 7, MAX_BAG_TOPICS + 1]))
+
+
+def _nested(depth: int, opening: str) -> str:
+    """A YAML document nesting ``depth`` collections opened with ``opening``."""
+    if opening == "- ":
+        return "".join("  " * level + "-\n" for level in range(depth)) + "  " * depth + "- 1\n"
+    closing = "".join({"[": "]", "{": "}"}[char] for char in reversed(opening) if char in "[{")
+    return opening * depth + "1" + closing * depth
+
+
+def _edited(edits: list[tuple[int, int, str]]) -> str:
+    """``BAG_METADATA`` with each (where, how many characters removed, what inserted) made."""
+    text = BAG_METADATA
+    for where, removed, inserted in edits:
+        where = min(where, len(text))
+        text = text[:where] + inserted + text[where + removed:]
+    return text
+
+
+def _listed(files: int, present: int, topics: int) -> str:
+    """``BAG_METADATA`` listing ``files`` files (the first ``present`` the bag's own) and
+    ``topics`` topics."""
+    information = yaml.safe_load(BAG_METADATA)
+    bag = information["rosbag2_bagfile_information"]
+    bag["relative_file_paths"] = [("bag.db3" if number < present else f"gone_{number}.db3")
+                                  for number in range(files)]
+    bag["topics_with_message_count"] = bag["topics_with_message_count"][:1] * topics
+    return str(yaml.safe_dump(information))
+
+
+@settings(max_examples=150, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(shape=st.one_of(nesting.map(lambda shape: _nested(*shape)),
+                       st.lists(edit, min_size=1, max_size=5).map(_edited),
+                       listing.map(lambda shape: _listed(*shape))))
+def test_a_hostile_bag_metadata_raises_nothing_but_a_one_line_recording_error(
+        tmp_path: Path, shape: str) -> None:
+    folder = tmp_path / "bag"
+    folder.mkdir(exist_ok=True)
+    (folder / "bag.db3").write_bytes(BAG_DB3)
+    (folder / "metadata.yaml").write_text(shape)
+    try:
+        recording = open_recording(folder, SHARED_TYPES)
+    except RecordingError as exc:
+        assert str(exc).startswith(f"{folder}") and "\n" not in str(exc)
+        assert len(str(exc)) < 500
+        return
+    try:
+        played = list(recording.messages())  # 3 from each time the file is listed
+        assert {item.topic for item in played} <= {"/chatter"}
+        assert len(played) <= 3 * max(shape.count("bag.db3"), 1)
+    finally:
+        recording.close()
+
+
+@settings(max_examples=80, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(fields=st.lists(st.integers(0, 12), min_size=1, max_size=4),
+       uses=st.lists(st.integers(0, 3), min_size=0, max_size=12),
+       chunk_size=st.sampled_from([64, 300, 1 << 20]))
+def test_channels_and_schemas_around_their_bounds_are_refused_or_read_right(
+        tmp_path: Path, fields: list[int], uses: list[int], chunk_size: int) -> None:
+    """Schemas of ``fields`` fields each, a channel of ``uses[i]``'s schema each, under bounds
+    of 8 channels and 8 fields a schema."""
+    path, example = tmp_path / "run.mcap", next(EXAMPLES)
+    with open(path, "wb") as stream:
+        writer = Writer(stream, chunk_size=chunk_size)
+        writer.start(profile="ros2", library="test")
+        schemas = [writer.register_schema(f"their_msgs/msg/T{example}x{number}", "ros2msg",
+                                          wide(count).encode() or b"int32 x\n")
+                   for number, count in enumerate(fields)]
+        for number, use in enumerate(uses):
+            schema = use % len(schemas)
+            channel = writer.register_channel(f"/t{number}", "cdr", schemas[schema])
+            size = 4 * max(fields[schema], 1)
+            writer.add_message(channel, 1_000 + number, b"\x00\x01\x00\x00" + bytes(size), 1)
+        writer.finish()
+    with mock.patch.object(scan_module, "MAX_CHANNELS", 8), \
+            mock.patch.object(recorded, "MAX_SCHEMA_FIELDS", 8):
+        try:
+            recording = open_recording(path, SHARED_TYPES)
+        except RecordingError as exc:
+            assert len(uses) > 8 or not uses, exc
+            assert str(exc).startswith(f"{path}: ") and "\n" not in str(exc)
+            return
+    try:
+        assert len(uses) <= 8
+        wide_ones = {f"/t{number}" for number, use in enumerate(uses)
+                     if fields[use % len(fields)] > 8}
+        assert set(recording.skipped) == wide_ones
+        assert all("the most one may declare" in why for why in recording.skipped.values())
+        played = [played.topic for played in recording.messages()]
+        assert played == [f"/t{n}" for n in range(len(uses)) if f"/t{n}" not in wide_ones]
+    finally:
+        recording.close()

@@ -24,13 +24,14 @@ from rosbags.interfaces import Connection, Nodetype, QosDurability
 from rosbags.typesys import Stores, get_typestore
 
 from cyborg.bus import MessageTypes
+from cyborg.record.bag_checks import check_folder, check_ros1
 from cyborg.record.recorded import (
     Played,
     PlayedTopic,
     Recording,
     RecordingError,
+    TypeLearner,
     is_latched,
-    learn_type,
 )
 
 ROS1_MAGIC = b"#ROSBAG V2.0"
@@ -48,6 +49,9 @@ class BagRecording(Recording):
     _connections: list[Connection]
     _ros1: bool
     _types: MessageTypes
+    _learner: TypeLearner
+    _why_type: dict[str, str | None]
+    """Why each type's topics cannot play (None: they can), worked out once per type."""
 
     @classmethod
     def open(cls, path: Path, types: MessageTypes) -> BagRecording:
@@ -64,16 +68,21 @@ class BagRecording(Recording):
             if start != ROS1_MAGIC:
                 what = "empty" if not start else "not a ROS 1 bag (no #ROSBAG V2.0 header)"
                 raise RecordingError(f"{path}: {what}")
+            check_ros1(path)
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
             raise RecordingError(f"{path}: a folder without metadata.yaml, neither an MCAP file "
                                  "nor a ROS 2 bag")
+        if bag.is_dir():
+            check_folder(bag)
         reader = AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         try:
             reader.open()
-        except (AnyReaderError, OSError, ValueError) as exc:
-            raise RecordingError(f"{path}: cannot be read as a bag ({exc})") from None
+        except (AnyReaderError, OSError, ValueError, RecursionError) as exc:
+            said = " ".join(str(exc).split()) or type(exc).__name__  # rosbags' run over lines
+            raise RecordingError(f"{path}: cannot be read as a bag ({said})") from None
         recording = cls(path, start_ns=reader.start_time, end_ns=reader.end_time)
         recording._reader, recording._ros1, recording._types = reader, not reader.is2, types
+        recording._learner, recording._why_type = TypeLearner(types), {}
         recording._connections = []
         for connection in reader.connections:
             why = recording._why_not(connection)
@@ -92,16 +101,23 @@ class BagRecording(Recording):
         return recording
 
     def _why_not(self, connection: Connection) -> str | None:
+        """Why ``connection`` cannot play (None when it can)."""
         type_name = connection.msgtype
         known = self.topics.get(connection.topic)
         if known is not None and known.type_name != type_name:
             return f"recorded with two types, {known.type_name} and {type_name}"
+        if type_name not in self._why_type:
+            self._why_type[type_name] = self._why_not_type(type_name)
+        return self._why_type[type_name]
+
+    def _why_not_type(self, type_name: str) -> str | None:
+        """Why topics of ``type_name`` cannot play (None when they can)."""
         if type_name not in self._types:
             try:
                 definition, _ = self._reader.typestore.generate_msgdef(type_name, ros_version=2)
             except Exception as exc:  # rosbags' own errors for a type it cannot write out
                 return f"unknown type {type_name} ({exc})"
-            why = learn_type(self._types, type_name, definition)
+            why = self._learner.learn(type_name, definition)
             if why is not None:
                 return why
         if self._ros1:

@@ -8,6 +8,8 @@ chunk by chunk and merged across chunks in log-time order (with those of a file 
 without chunks, read one by one where the scan found them); the latched topics' last messages
 before a time are found through the chunks' message indexes. A channel whose encoding is not
 ``cdr``, or whose type cannot be made known from a ``ros2msg`` schema, is skipped and named.
+Each schema is read once, however many channels use it, and within the bounds of
+:class:`~cyborg.record.recorded.TypeLearner`.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from typing import BinaryIO
 
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, Message, Metadata, MetadataIndex, Schema
+from mcap.records import Chunk, Message, Metadata, MetadataIndex, Schema
 
 from cyborg.bus import MessageTypes
 from cyborg.record import layout
@@ -31,8 +33,8 @@ from cyborg.record.recorded import (
     PlayedTopic,
     Recording,
     RecordingError,
+    TypeLearner,
     is_latched,
-    learn_type,
 )
 from cyborg.record.scan import NotRecoverableError, ScannedChunk, decompress, scan
 
@@ -70,12 +72,21 @@ class McapRecording(Recording):
         recording._chunks = sorted(found.chunks, key=lambda c: c.record.message_start_time)
         recording._loose = sorted(found.loose)
         recording._channels = {}
+        learner = TypeLearner(types)
+        learnt: dict[int, str | None] = {}  # why not, by schema id (None: its channels play)
         for channel_id, channel in sorted(found.channels.items()):
             schema = found.schemas.get(channel.schema_id)
             topic = PlayedTopic(channel.topic, schema.name if schema else "",
                                 is_latched(channel.metadata.get(layout.QOS_KEY, "")),
                                 found.message_counts.get(channel_id, 0))
-            why = recording._why_not(types, channel, found.schemas)
+            why: str | None
+            if channel.message_encoding != layout.MESSAGE_ENCODING:
+                why = f"message encoding {channel.message_encoding!r}, not cdr"
+            else:
+                if channel.schema_id not in learnt:
+                    learnt[channel.schema_id] = recording._why_not(learner, channel.schema_id,
+                                                                   found.schemas)
+                why = learnt[channel.schema_id]
             if why is not None:
                 recording.skip(topic, why)
                 continue
@@ -93,19 +104,18 @@ class McapRecording(Recording):
         return record.name, dict(record.metadata)
 
     @staticmethod
-    def _why_not(types: MessageTypes, channel: Channel, schemas: dict[int, Schema]
+    def _why_not(learner: TypeLearner, schema_id: int, schemas: dict[int, Schema]
                  ) -> str | None:
-        if channel.message_encoding != layout.MESSAGE_ENCODING:
-            return f"message encoding {channel.message_encoding!r}, not cdr"
-        schema = schemas.get(channel.schema_id)
+        """Why the channels of schema ``schema_id`` cannot play (None when they can)."""
+        schema = schemas.get(schema_id)
         if schema is None:
-            return f"no schema (schema id {channel.schema_id}), so its type is not known"
+            return f"no schema (schema id {schema_id}), so its type is not known"
         if not schema.name:
             return "a schema without a type name"
-        if schema.encoding != layout.SCHEMA_ENCODING and schema.name not in types:
+        if schema.encoding != layout.SCHEMA_ENCODING and schema.name not in learner.types:
             return (f"unknown type {schema.name} with a {schema.encoding or 'missing'} schema, "
                     "not ros2msg")
-        return learn_type(types, schema.name, schema.data.decode("utf-8", errors="replace"))
+        return learner.learn(schema.name, schema.data.decode("utf-8", errors="replace"))
 
     def _records(self, chunk: ScannedChunk) -> bytes:
         """The decompressed content of a chunk (its messages' records)."""

@@ -4,8 +4,12 @@
 :mod:`cyborg.record.bag_recording`; :func:`cyborg.record.playback_source.open_recording`
 chooses one): the topics it can play (:class:`PlayedTopic`), those it cannot with the reason,
 its first and last log times, whether it was cut, and its messages as :class:`Played` (topic,
-log time, CDR bytes) in log-time order. :func:`learn_type` makes a recorded type known to the
-bus from the recording's own definition.
+log time, CDR bytes) in log-time order. A :class:`TypeLearner` makes recorded types known to
+the bus from the recording's own definitions, within bounds: the time to read a definition
+grows with its lines (and faster than them past a few thousand fields), so one holding more than
+:data:`MAX_SCHEMA_FIELDS` fields or :data:`MAX_SCHEMA_BYTES` bytes is not read, nor any past
+:data:`MAX_LEARNED_FIELDS` fields read for one recording; their topics are skipped, naming the
+type and the bound.
 """
 
 from __future__ import annotations
@@ -16,6 +20,16 @@ from pathlib import Path
 from typing import NamedTuple
 
 from cyborg.bus import MessageTypes
+
+MAX_SCHEMA_BYTES = 1024 * 1024
+"""Most bytes of one type's definition, comments and the types it uses included (the largest
+known to the bus, ``visualization_msgs/msg/InteractiveMarkerUpdate``, takes 4 KB without its
+comments)."""
+MAX_SCHEMA_FIELDS = 1000
+"""Most fields one type's definition may declare, counting its constants and the types it
+uses with their own (the largest known to the bus has 112)."""
+MAX_LEARNED_FIELDS = 20_000
+"""Most fields read from the definitions of one recording, all its types together."""
 
 
 class RecordingError(ValueError):
@@ -97,22 +111,69 @@ class Recording:
         """Releases the file."""
 
 
-def learn_type(types: MessageTypes, type_name: str, definition: str) -> str | None:
-    """Makes ``type_name`` known to the bus from a recording's definition text, if needed.
+def plain_definition(type_name: str, text: str) -> tuple[str, int]:
+    """``text`` without its comment and blank lines, and how many fields it declares.
 
-    Returns None when the bus knows it (now), else why it cannot be played.
+    Its constants and the ``MSG:`` line of each type it uses count as fields. Raises
+    ValueError naming the type when ``text`` passes :data:`MAX_SCHEMA_BYTES` or
+    :data:`MAX_SCHEMA_FIELDS` (counted line by line, no further than the bound).
     """
-    if type_name in types:
-        return None
-    if not definition.strip():
-        return f"unknown type {type_name}, and the recording holds no definition of it"
-    try:
-        types.add_definition(type_name, definition)
-    except ValueError as exc:
-        reason = str(exc)
-        first = reason.splitlines()[0]  # a parser's report of the text runs over lines
-        return first if first == reason else first.split(" (")[0]
-    return None if type_name in types else f"unknown type {type_name}"
+    if len(text) > MAX_SCHEMA_BYTES:
+        raise ValueError(f"{type_name}: a definition of {len(text):,} characters, more than the "
+                         f"{MAX_SCHEMA_BYTES // 2**20} MiB one may hold")
+    kept: list[str] = []
+    fields = 0
+    for line in text.splitlines():
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        kept.append(line)
+        if not stripped.startswith("="):  # the line of = between two types' definitions
+            fields += 1
+            if fields > MAX_SCHEMA_FIELDS:
+                raise ValueError(f"{type_name}: a definition of more than "
+                                 f"{MAX_SCHEMA_FIELDS:,} fields, the most one may declare "
+                                 "(its constants and the types it uses counted)")
+    return "\n".join(kept) + "\n", fields
+
+
+class TypeLearner:
+    """Makes recorded types known to ``types``: one per recording, see the module.
+
+    It reads no more than :data:`MAX_LEARNED_FIELDS` fields of definitions in all. Callers
+    ask once per definition (a schema, a type): a definition that cannot be read is read again
+    each time it is asked for, and counted again.
+    """
+
+    def __init__(self, types: MessageTypes) -> None:
+        self.types = types
+        self.fields_left = MAX_LEARNED_FIELDS
+
+    def learn(self, type_name: str, definition: str) -> str | None:
+        """Makes ``type_name`` known from ``definition`` if the bus does not know it.
+
+        Returns None when the bus knows it (now), else why it cannot be played, in one line
+        naming the type.
+        """
+        if type_name in self.types:
+            return None
+        try:
+            plain, fields = plain_definition(type_name, definition)
+        except ValueError as exc:
+            return str(exc)
+        if not definition.strip():
+            return f"unknown type {type_name}, and the recording holds no definition of it"
+        if fields > self.fields_left:
+            return (f"{type_name}: its definition's {fields:,} fields would pass the "
+                    f"{MAX_LEARNED_FIELDS:,} read for one recording")
+        self.fields_left -= fields
+        try:
+            self.types.add_definition(type_name, plain)
+        except ValueError as exc:
+            reason = str(exc)
+            first = reason.splitlines()[0]  # a parser's report of the text runs over lines
+            return first if first == reason else first.split(" (")[0]
+        return None if type_name in self.types else f"unknown type {type_name}"
 
 
 def is_latched(qos_yaml: str) -> bool:

@@ -13,6 +13,13 @@ What it finds (:class:`Scan`) is what :mod:`cyborg.record.completion` needs to w
 indexes and summary the file lacks: the schemas and channels, each complete chunk with its
 place and a message index rebuilt from its content, the metadata and attachment records, the
 counts and times of the statistics, and where the whole part ends.
+
+**Bounds.** Every reader of a recording does some work for each channel and schema, so a file
+defining more than :data:`MAX_CHANNELS` channels or :data:`MAX_SCHEMAS` schemas, more channels
+than one per :data:`BYTES_PER_CHANNEL` bytes of the file, or more than
+:data:`MAX_DEFINITION_BYTES` of schema and channel records, is refused
+(:class:`NotRecoverableError` naming the file and the byte where the record lies), not kept up
+to that point. The scan's own work is linear in the records read.
 """
 
 from __future__ import annotations
@@ -47,6 +54,17 @@ _RECORD = struct.Struct("<BQ")
 _DATA_SECTION = {int(op) for op in (Opcode.HEADER, Opcode.SCHEMA, Opcode.CHANNEL,
                                     Opcode.MESSAGE, Opcode.CHUNK, Opcode.MESSAGE_INDEX,
                                     Opcode.ATTACHMENT, Opcode.METADATA, Opcode.DATA_END)}
+
+
+MAX_CHANNELS = 10_000
+"""Most channels a file may define (ROS systems have hundreds of topics)."""
+MAX_SCHEMAS = 10_000
+"""Most schemas a file may define."""
+BYTES_PER_CHANNEL = 16
+"""A file may define one channel per so many of its bytes: a channel record alone takes 25 or
+more, and the summary of a finished file repeats it uncompressed."""
+MAX_DEFINITION_BYTES = 64 * 2**20
+"""Most bytes of schema and channel records a file may define (they are all kept in memory)."""
 
 
 class NotRecoverableError(ValueError):
@@ -96,6 +114,13 @@ class Scan:
     end_time: int = 0
     end: int = 0
     """Where the last whole record of the data section ends."""
+    defined_bytes: int = 0
+    """Bytes of the schema and channel records kept (see :data:`MAX_DEFINITION_BYTES`)."""
+    defined_ids: dict[str, int] = field(default_factory=lambda: {"schema": 0, "channel": 0})
+    """Schema and channel ids defined so far (a chunk's staged scan counts on from the
+    file's)."""
+    counted_any: bool = False
+    """Whether a message was counted yet (:attr:`start_time` is then the first one's)."""
     finished: bool = False
     """Whether the data section ended properly (a Data End record was reached)."""
     stopped: str = ""
@@ -108,7 +133,8 @@ class Scan:
 
     def count(self, channel_id: int, log_time: int, messages: int = 1) -> None:
         """Counts ``messages`` on ``channel_id`` into the statistics, the first at ``log_time``."""
-        first = self.message_count == 0
+        first = not self.counted_any
+        self.counted_any = True
         self.message_counts[channel_id] = self.message_counts.get(channel_id, 0) + messages
         self.start_time = log_time if first else min(self.start_time, log_time)
         self.end_time = max(self.end_time, log_time)
@@ -140,7 +166,8 @@ def scan(path: Path) -> Scan:
     """Reads ``path`` up to its last whole record; see the module.
 
     Raises :class:`NotRecoverableError` naming the file for one that is empty, foreign (a
-    ROS 1 bag, a text file) or cut before its header ended; OSError if it cannot be read.
+    ROS 1 bag, a text file), cut before its header ended or past a bound of the module's;
+    OSError if it cannot be read.
     """
     with open(path, "rb") as stream:
         size = stream.seek(0, io.SEEK_END)
@@ -175,6 +202,8 @@ def _read_records(stream: BinaryIO, result: Scan) -> None:
         content = stream.read(length)
         try:
             kept = _keep(result, opcode, content, offset, _RECORD.size + length)
+        except NotRecoverableError:
+            raise
         except Exception as exc:  # bad content is where the good part ends
             result.stopped = (f"a damaged {Opcode(opcode).name.lower()} record {where}: "
                               f"{type(exc).__name__}: {exc}")
@@ -202,7 +231,7 @@ def _keep(result: Scan, opcode: int, content: bytes, offset: int, length: int) -
             last.index_offsets[index.channel_id] = offset
             last.index_end = offset + length
     else:
-        loose = _inner(result, opcode, content, len(content))
+        loose = _inner(result, opcode, content, len(content), f"at byte {offset}")
         if loose is not None:
             result.loose.append((loose.log_time, offset, loose.channel_id))
         if opcode == Opcode.METADATA:
@@ -256,38 +285,94 @@ def _chunk(result: Scan, chunk: Chunk, offset: int, length: int) -> ScannedChunk
     data = decompress(chunk)
     index: dict[int, list[tuple[int, int]]] = {}
     position = 0
-    staged = Scan(result.path, result.size, channels=dict(result.channels))  # kept once whole
+    # what the chunk defines is kept once it is whole; only its own records are copied
+    staged = Scan(result.path, result.size, defined_bytes=result.defined_bytes,
+                  defined_ids=dict(result.defined_ids))
+    where = f"in the chunk at byte {offset}"
     while position < len(data):
         opcode, inner_length = _RECORD.unpack_from(data, position)
         body = data[position + _RECORD.size:position + _RECORD.size + inner_length]
         if len(body) != inner_length:
             raise ValueError("a record inside it runs past its end")
-        message = _inner(staged, opcode, body, inner_length)
+        message = _inner(staged, opcode, body, inner_length, where, result)
         if message is not None:
             index.setdefault(message.channel_id, []).append((message.log_time, position))
         position += _RECORD.size + inner_length
     result.schemas.update(staged.schemas)
     result.channels.update(staged.channels)
+    result.defined_bytes, result.defined_ids = staged.defined_bytes, staged.defined_ids
     for channel_id, entries in index.items():
-        result.count(channel_id, min(time for time, _ in entries), len(entries))
-        result.end_time = max(result.end_time, max(time for time, _ in entries))
+        times = [time for time, _ in entries]
+        result.count(channel_id, min(times), len(entries))
+        result.end_time = max(result.end_time, max(times))
     chunk.data = b""
     return ScannedChunk(offset, length, chunk, index, index_end=offset + length)
 
 
-def _inner(result: Scan, opcode: int, body: bytes, length: int) -> Message | None:
-    """A schema, channel or message record (in a chunk or not); the message, if one."""
+def _inner(result: Scan, opcode: int, body: bytes, length: int, where: str,
+           known: Scan | None = None) -> Message | None:
+    """A schema, channel or message record (in a chunk or not); the message, if one.
+
+    Schemas and channels go into ``result``; ``known`` holds those defined before, when
+    ``result`` stages a chunk's own. ``where`` says where the record lies, for a refusal.
+    """
     data = ReadDataStream(io.BytesIO(body))
     if opcode == Opcode.SCHEMA:
         schema = Schema.read(data)
+        _admit(result, known, schema, where)
         result.schemas[schema.id] = schema
     elif opcode == Opcode.CHANNEL:
         channel = Channel.read(data)
+        _admit(result, known, channel, where)
         result.channels[channel.id] = channel
     elif opcode == Opcode.MESSAGE:
         message: Message = Message.read(data, length)
-        if message.channel_id not in result.channels:
+        if message.channel_id not in result.channels and (
+                known is None or message.channel_id not in known.channels):
             raise ValueError(f"a message on channel {message.channel_id}, never defined")
         result.count(message.channel_id, message.log_time)
         return message
     return None
+
+
+def _size(record: Schema | Channel) -> int:
+    """The bytes a schema or channel keeps in memory, near enough: its strings and data."""
+    if isinstance(record, Schema):
+        return len(record.data) + len(record.name) + len(record.encoding)
+    return (len(record.topic) + len(record.message_encoding)
+            + sum(len(key) + len(value) for key, value in record.metadata.items()))
+
+
+def _admit(result: Scan, known: Scan | None, record: Schema | Channel, where: str) -> None:
+    """Counts a schema or channel record about to be kept against the module's bounds.
+
+    A record that defines an id again replaces the one before. Raises
+    :class:`NotRecoverableError` naming the file and ``where`` the record lies when a new id
+    passes :data:`MAX_SCHEMAS` or the channel bounds, or the records kept pass
+    :data:`MAX_DEFINITION_BYTES`.
+    """
+    schema = isinstance(record, Schema)
+    kind = "schema" if schema else "channel"
+    replaced: Schema | Channel | None
+    if schema:
+        replaced = result.schemas.get(record.id) or (known.schemas.get(record.id)
+                                                     if known is not None else None)
+    else:
+        replaced = result.channels.get(record.id) or (known.channels.get(record.id)
+                                                      if known is not None else None)
+    result.defined_bytes += _size(record) - (_size(replaced) if replaced is not None else 0)
+    if result.defined_bytes > MAX_DEFINITION_BYTES:
+        raise NotRecoverableError(
+            f"{result.path}: more than {MAX_DEFINITION_BYTES:,} bytes of schema and channel "
+            f"records (the {kind} record {where} passes it)")
+    if replaced is not None:
+        return
+    count = result.defined_ids[kind] = result.defined_ids[kind] + 1
+    most = MAX_SCHEMAS if schema else MAX_CHANNELS
+    if count > most:
+        raise NotRecoverableError(f"{result.path}: more than the {most:,} {kind}s a recording "
+                                  f"may define ({kind} {record.id} {where} passes it)")
+    if not schema and count > result.size // BYTES_PER_CHANNEL:
+        raise NotRecoverableError(
+            f"{result.path}: {count:,} channels in {result.size:,} bytes, more than one per "
+            f"{BYTES_PER_CHANNEL} bytes of the file (channel {record.id} {where})")
