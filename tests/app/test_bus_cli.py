@@ -12,7 +12,7 @@ from typing import IO, Any
 import pytest
 
 from cyborg.bus import MessageTypes
-from tests.bus.test_multiprocess import free_port
+from tests.ports import free_port
 
 pytestmark = pytest.mark.heavy
 PEER = Path(__file__).resolve().parents[1] / "bus" / "bus_peer.py"

@@ -6,7 +6,6 @@ import json
 import os
 import shlex
 import signal
-import socket
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -20,6 +19,7 @@ from cyborg.bt import default_registry
 from tests.builders import N, project_json, tree_json
 from tests.conftest import shared_dir
 from tests.doc_commands import ROOT, doc_commands
+from tests.ports import free_port
 from tests.running_system import interruptible
 
 PATROL = shared_dir() / "trees" / "patrol_recharge.b3.json"
@@ -209,9 +209,7 @@ def _cyborg(*args: str) -> subprocess.Popen[str]:
 
 
 def test_ctrl_c_stops_cleanly_and_halts() -> None:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
+    port = free_port()
     process = _cyborg("up", "--listen", f"tcp/127.0.0.1:{port}", "--monitor-port", "0")
     assert process.stdout is not None
     first = process.stdout.readline()
@@ -276,9 +274,7 @@ def test_up_refuses_a_tree_whose_goals_are_not_on_the_map() -> None:
     """The shared patrol drives to AMROffice.map's rooms; on the default campus map its MoveTos
     could never arrive: cyborg up names each (tree, node, id, goal), the map and its goals, and
     stops everything, rather than warn once per MoveTo while it runs. With its map it runs."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
+    port = free_port()
     common = ["up", "--tree", str(PATROL), "--listen", f"tcp/127.0.0.1:{port}",
               "--no-monitor", "--no-detector"]
     refused = subprocess.run([sys.executable, "-m", "cyborg", *common], capture_output=True,

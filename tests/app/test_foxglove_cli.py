@@ -7,7 +7,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -22,6 +21,7 @@ from cyborg.bus.component import LaunchError, NodeSpec
 from cyborg.foxglove import component as foxglove
 from cyborg.foxglove.server import FoxgloveServer
 from tests.foxglove.protocol_client import ProtocolClient
+from tests.ports import free_port
 from tests.running_system import interruptible
 
 
@@ -70,9 +70,7 @@ def test_the_component_declares_its_defaults_and_refuses_a_missing_token_file(
 
 @pytest.mark.heavy
 def test_cyborg_up_with_foxglove_serves_the_robot_map_and_tree() -> None:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        bus_port = sock.getsockname()[1]
+    bus_port = free_port()
     process = subprocess.Popen(
         [sys.executable, "-m", "cyborg", "up", "--listen", f"tcp/127.0.0.1:{bus_port}",
          "--no-monitor", "--no-detector", "--foxglove", "0"], stdout=subprocess.PIPE,

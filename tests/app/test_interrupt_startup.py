@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -18,6 +17,7 @@ from importlib.resources import files
 
 import pytest
 
+from tests.ports import free_port
 from tests.running_system import interruptible
 
 CAMPUS = str(files("cyborg.app").joinpath("data", "campus.map"))
@@ -34,16 +34,10 @@ START_LIMIT = 120.0
 """Seconds the start-up may take to reach a moment (minutes on a loaded machine)."""
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @pytest.mark.parametrize("moment", MOMENTS)
 def test_ctrl_c_during_start_up_exits_130_without_a_traceback(moment: str) -> None:
     command = [sys.executable, "-X", "importtime", "-m", "cyborg", "sim", "--map", CAMPUS,
-               "--listen", f"tcp/127.0.0.1:{_free_port()}"]
+               "--listen", f"tcp/127.0.0.1:{free_port()}"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                text=True, env=dict(os.environ, PYTHONUNBUFFERED="1"),
                                preexec_fn=interruptible)

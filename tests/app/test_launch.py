@@ -21,13 +21,8 @@ from cyborg.bus import BusConfig, Context, SimClock
 from cyborg.bus.component import LaunchError
 from cyborg.runner.component import RunningTree
 from cyborg.sim.component import RunningSimulator
+from tests.ports import free_port
 from tests.running_system import interruptible
-
-
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
 
 
 def _launch_file(folder: Path, shared: Path, *, port: int = 7447, process: str = "main",
@@ -182,7 +177,7 @@ def test_launch_in_one_process(tmp_path: Path, shared: Path) -> None:
 @pytest.mark.heavy
 def test_launch_across_processes_and_control_from_the_shell(
         tmp_path: Path, shared: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    port = _free_port()
+    port = free_port()
     path = _launch_file(tmp_path, shared, port=port, process="robot")
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     parent = subprocess.Popen([sys.executable, "-m", "cyborg", "launch", str(path)],
@@ -219,7 +214,7 @@ def test_launch_across_processes_and_control_from_the_shell(
 
 @pytest.mark.heavy
 def test_cyborg_up_runs_the_bundled_system() -> None:
-    port = _free_port()
+    port = free_port()
     process = subprocess.Popen(
         [sys.executable, "-m", "cyborg", "up", "--speed", "20", "--duration", "8",
          "--listen", f"tcp/127.0.0.1:{port}", "--monitor-port", "0"],
@@ -255,7 +250,7 @@ def test_cyborg_up_runs_the_bundled_system() -> None:
 
 
 def test_cyborg_monitor_serves_and_a_taken_port_is_a_clear_error() -> None:
-    bus = _free_port()
+    bus = free_port()
     with socket.socket() as taken:
         taken.bind(("0.0.0.0", 0))
         taken.listen()

@@ -16,7 +16,8 @@ import pytest
 from cyborg.app.launch import Launch, LaunchDescription
 from cyborg.bus import BusConfig, Context, GoalStatus, Node, Qos
 from cyborg.runner.component import RunningTree
-from tests.app.test_launch import _free_port, _launch_file
+from tests.app.test_launch import _launch_file
+from tests.ports import free_port
 from tests.running_system import interruptible, wait_until
 
 
@@ -119,7 +120,7 @@ def test_ctrl_c_halts_the_tree_before_the_simulator_process_goes(
         tmp_path: Path, shared: Path, ctrl_c: str) -> None:
     """The README's launch example: the simulator in process "robot", the tree runner in main.
     Ctrl-C in a terminal reaches every process of the job; the launch alone decides the order."""
-    port = _free_port()
+    port = free_port()
     path = _launch_file(tmp_path, shared, port=port, process="robot")
     parent = subprocess.Popen([sys.executable, "-m", "cyborg", "-v", "launch", str(path)],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,

@@ -13,9 +13,9 @@ from cyborg.bus import BusConfig, Context, Node
 from cyborg.modes import ModeMachine
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.builders import registry
-from tests.bus.test_multiprocess import free_port
 from tests.modes.machines import write_modes, write_project
 from tests.modes.test_machine import MISSION, TREES
+from tests.ports import free_port
 
 
 @pytest.fixture

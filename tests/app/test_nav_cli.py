@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from cyborg.app.cli import main
+from tests.ports import free_port
 
 
 def test_nav_goals_lists_names_kinds_and_headings(shared: Path,
@@ -40,10 +41,7 @@ def test_bad_map_file_is_reported_with_its_line(tmp_path: Path,
 
 @pytest.mark.heavy
 def test_cyborg_sim_runs_for_a_simulated_duration(shared: Path, tmp_path: Path) -> None:
-    import socket
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
+    port = free_port()
     done = subprocess.run(
         [sys.executable, "-m", "cyborg", "sim", "--map", str(shared / "maps" / "AMROffice.map"),
          "--speed", "0", "--duration", "30", "--start", "Dock",
@@ -55,10 +53,7 @@ def test_cyborg_sim_runs_for_a_simulated_duration(shared: Path, tmp_path: Path) 
 
 @pytest.mark.heavy
 def test_cyborg_sim_runs_several_robots(shared: Path) -> None:
-    import socket
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
+    port = free_port()
     done = subprocess.run(
         [sys.executable, "-m", "cyborg", "sim", "--map", str(shared / "maps" / "AMROffice.map"),
          "--speed", "0", "--duration", "10", "--robots", "3", "--namespace", "/",

@@ -21,7 +21,7 @@ from cyborg.bus.config import CONNECT_ENV
 from cyborg.bus.wire import EntityKind
 from cyborg.record.playback_source import open_recording
 from tests.bus.bus_peer import wait_for
-from tests.bus.test_multiprocess import free_port
+from tests.ports import free_port
 from tests.record.bad_recordings import (
     REFUSED,
     STRANGE_TOPICS,

@@ -18,7 +18,7 @@ from cyborg.bus import BusConfig, Context, Node, Qos
 from cyborg.bus.msgs.std_msgs.msg import String
 from cyborg.record.scan import scan
 from tests.app.test_bus_cli import first_line
-from tests.bus.test_multiprocess import free_port
+from tests.ports import free_port
 from tests.record.readers import read_mcap
 
 pytestmark = pytest.mark.heavy

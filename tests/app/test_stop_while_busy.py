@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from cyborg.bus import BusConfig, Context, Node, new_message
-from tests.app.test_launch import _free_port
+from tests.ports import free_port
 from tests.running_system import wait_until, write_tree
 
 BUSY_NODES = '''
@@ -46,7 +46,7 @@ def test_enable_false_and_sigterm_answer_while_a_node_spins(tmp_path: Path) -> N
     (tmp_path / "busy_spin_nodes.py").write_text(BUSY_NODES)
     tree = write_tree(tmp_path, {"name": "Spin"})
     spin_log = tmp_path / "spins.log"
-    port = _free_port()
+    port = free_port()
     env = dict(os.environ, PYTHONPATH=f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
                SPIN_LOG=str(spin_log))
     server = subprocess.Popen(

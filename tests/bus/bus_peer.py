@@ -30,13 +30,6 @@ from cyborg.bus.wire import Attachment, EntityKind, data_key, fully_qualified
 
 
 # ---------------------------------------------------------------------- in-process attacker
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
-
-
 def wait_for(predicate: Callable[[], object], timeout: float = 5.0) -> bool:
     """Poll ``predicate`` until it is true or ``timeout`` wall seconds pass."""
     deadline = time.monotonic() + timeout
@@ -48,7 +41,8 @@ def wait_for(predicate: Callable[[], object], timeout: float = 5.0) -> bool:
 @contextlib.contextmanager
 def linked_contexts() -> Iterator[tuple[Context, Context]]:
     """(victim, attacker): two sessions linked peer to peer over loopback, no router."""
-    address = f"tcp/127.0.0.1:{free_port()}"
+    from tests.ports import local_endpoint  # here: this file also runs as a script
+    address = local_endpoint()
     victim = Context(BusConfig(connect=(), listen=(address,)))
     attacker = Context(BusConfig(connect=(address,), listen=()))
     try:

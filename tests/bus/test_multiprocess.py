@@ -5,7 +5,6 @@ Every wait is bounded; a peer lives at most 60 s even if a test dies.
 
 from __future__ import annotations
 
-import socket
 import subprocess
 import sys
 import threading
@@ -28,16 +27,10 @@ from cyborg.bus import (
 )
 from cyborg.bus.doorbell import supported as doorbell_supported
 from cyborg.bus.parameter_client import ParameterClient, ParameterError
+from tests.ports import free_port
 
 pytestmark = pytest.mark.heavy
 PEER = Path(__file__).with_name("bus_peer.py")
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pytest
 from playwright.sync_api import Browser
 
 from cyborg.report.build import build_report
-from tests.bus.test_multiprocess import free_port
+from tests.ports import free_port
 from tests.report.page_reader import polyline_points, read_page
 from tests.report.recordings import mission
 

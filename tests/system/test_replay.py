@@ -15,9 +15,9 @@ from playwright.sync_api import Browser
 from cyborg.bus import BusConfig, Context, Node
 from cyborg.monitor import Monitor
 from cyborg.nav.arnl_map import read_map
-from tests.bus.test_multiprocess import free_port
 from tests.monitor.browser import CAMPUS_MAP, open_page, screenshot
 from tests.monitor.map_page import on_map
+from tests.ports import free_port
 
 pytestmark = pytest.mark.heavy
 

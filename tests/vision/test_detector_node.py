@@ -8,7 +8,6 @@ import http.server
 import json
 import math
 import os
-import socket
 import subprocess
 import sys
 import threading
@@ -35,6 +34,7 @@ from cyborg.vision import (
 from cyborg.vision.models import CATALOGUE, fetch, find_model
 from cyborg.vision.samples import SampleSource, photo
 from tests.conftest import shared_dir
+from tests.ports import free_port
 
 MODEL = shared_dir() / "models" / "yolox_nano.onnx"
 
@@ -312,15 +312,9 @@ def test_cyborg_detect_on_the_stereo_sample_and_its_errors(tmp_path: Path,
 
 
 # ------------------------------------------------------------------ cyborg up
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
 @pytest.mark.heavy
 def test_cyborg_up_detects_the_motorcycle_in_the_sample_stereo_frames() -> None:
-    port = _free_port()
+    port = free_port()
     process = subprocess.Popen(
         [sys.executable, "-m", "cyborg", "up", "--no-monitor", "--camera", "real",
          "--duration", "15", "--listen", f"tcp/127.0.0.1:{port}"],

@@ -28,7 +28,8 @@ from cyborg.vision import CameraTopics, DetectionPipeline, Detector, DetectorNod
 from cyborg.vision.image_messages import bgr_to_image, depth_to_image
 from cyborg.vision.samples import photo
 from tests.conftest import shared_dir
-from tests.vision.test_detector_node import _free_port, wait_for
+from tests.ports import free_port
+from tests.vision.test_detector_node import wait_for
 
 MODEL = shared_dir() / "models" / "yolox_nano.onnx"
 WARNING = "cyborg.vision"
@@ -209,7 +210,7 @@ def test_a_silent_depth_publisher_is_waited_for_5_s_then_named_and_detection_goe
 @pytest.mark.heavy
 def test_cyborg_up_with_a_video_camera_detects_without_distance(tmp_path: Path) -> None:
     video = write_video(tmp_path / "walk.avi")
-    port = _free_port()
+    port = free_port()
     process = subprocess.Popen(
         [sys.executable, "-m", "cyborg", "up", "--no-monitor", "--duration", "20",
          "--listen", f"tcp/127.0.0.1:{port}", "--camera", str(video)],
