@@ -18,7 +18,7 @@ from cyborg.app.cli import main
 from cyborg.bus import MessageTypes
 from cyborg.record import bag_checks
 from cyborg.record.playback_source import RecordingError, open_recording
-from cyborg.record.recorded import MAX_SCHEMA_FIELDS
+from cyborg.record.recorded import MAX_SCHEMA_FIELDS, skipped_line
 from tests.record.bad_recordings import BAD_BAGS, wide
 
 
@@ -101,3 +101,12 @@ def test_a_bags_definitions_are_bounded_together_as_rosbags_reads_one_per_topic(
         assert [played.data[4:] for played in recording.messages()] == [bytes(8000)] * 3
     finally:
         recording.close()
+
+
+def test_the_line_of_topics_left_out_names_ten_and_counts_the_rest() -> None:
+    """A recording may leave out 10,000 topics: play's and report's one line stays short."""
+    many = {f"/topic{number:05d}": "unknown type pkg/msg/T" for number in range(10_000)}
+    line = skipped_line(many)
+    assert line.startswith("10,000 topics: /topic00000 (unknown type pkg/msg/T); /topic00001")
+    assert line.endswith("; and 9,990 more") and len(line) < 600
+    assert skipped_line({"/a": "x" * 5000}) == f"1 topic: /a ({'x' * 200})"

@@ -45,6 +45,7 @@ from cyborg import __version__
 from cyborg.app.command_table import COMMANDS, command_in
 from cyborg.app.errors import CommandError
 
+
 def _add_bt(commands: Any) -> None:
     """``cyborg bt``: the files' commands, then the running tree's (serve, reload, ...)."""
     from cyborg.app import bt_commands, runner_commands

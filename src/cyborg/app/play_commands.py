@@ -35,6 +35,7 @@ from cyborg.bus.config import CONNECT_ENV, DEFAULT_ROUTER, BusConfig
 from cyborg.interfaces import player as contract
 from cyborg.record.playback_source import Recording, RecordingError, open_recording
 from cyborg.record.player import Player, topic_filter
+from cyborg.record.recorded import skipped_line
 
 POLL = 0.1
 """Seconds between two looks at the player: the live line's redraw, the end."""
@@ -160,8 +161,8 @@ def _play(args: argparse.Namespace, context: Context, recording: Recording,
 def notes(path: Path, recording: Recording) -> list[str]:
     """What a user is told before play starts, one line each: the file was cut, topics skipped.
 
-    The first suggests ``--recover`` for an indexed copy; the second names every topic that is
-    not played with its reason.
+    The first suggests ``--recover`` for an indexed copy; the second names the topics that are
+    not played with their reasons (the first ten; the rest counted).
     """
     said: list[str] = []
     if recording.cut is not None:
@@ -169,9 +170,7 @@ def notes(path: Path, recording: Recording) -> list[str]:
                     f"{duration(recording.duration)} before it (cyborg record --recover "
                     f"{path} -o FIXED.mcap writes an indexed copy)")
     if recording.skipped:
-        listed = "; ".join(f"{topic} ({why})" for topic, why in sorted(recording.skipped.items()))
-        said.append(f"cyborg play: not played, {len(recording.skipped)} "
-                    f"topic{'s' if len(recording.skipped) > 1 else ''}: {listed}")
+        said.append(f"cyborg play: not played, {skipped_line(recording.skipped)}")
     return said
 
 

@@ -19,6 +19,7 @@ from typing import Any
 from cyborg.app.command_table import COMMANDS
 from cyborg.app.errors import CommandError
 from cyborg.record.playback_source import RecordingError
+from cyborg.record.recorded import skipped_line
 from cyborg.report.build import write_report
 
 
@@ -52,7 +53,5 @@ def report_command(args: argparse.Namespace) -> int:
     print(f"report of {source} ({recording.message_count:,} messages on "
           f"{len(recording.topics)} topics) written to {output}{cut}")
     if recording.skipped:
-        listed = "; ".join(f"{topic} ({why})" for topic, why in recording.skipped.items())
-        print(f"cyborg report: not read, {len(recording.skipped)} "
-              f"topic{'s' if len(recording.skipped) > 1 else ''}: {listed}")
+        print(f"cyborg report: not read, {skipped_line(recording.skipped)}")
     return 0

@@ -14,7 +14,7 @@ type and the bound.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -56,6 +56,23 @@ class PlayedTopic:
     """Recorded from a transient-local publisher: played latched again."""
     count: int
     """Messages of it in the recording (what could be read of a cut file)."""
+
+
+SKIPPED_SHOWN = 10
+"""Skipped topics a command's one line names; the rest are counted."""
+
+
+def skipped_line(skipped: Mapping[str, str], shown: int = SKIPPED_SHOWN) -> str:
+    """Topics left out, in one line: ``N topics: /a (why); /b (why); and 3 more``.
+
+    At most ``shown`` are named (a recording may leave out thousands), in name order, each
+    reason cut to 200 characters.
+    """
+    count = len(skipped)
+    named = sorted(skipped.items())[:shown]
+    listed = "; ".join(f"{topic} ({why[:200]})" for topic, why in named)
+    more = f"; and {count - len(named):,} more" if count > len(named) else ""
+    return f"{count:,} topic{'s' if count != 1 else ''}: {listed}{more}"
 
 
 @dataclass
