@@ -7,7 +7,6 @@ warning; no exception is logged and the page's connection stays open."""
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import random
@@ -27,14 +26,11 @@ from tests.monitor.monitor_protocol import RECEIVE_TIMEOUT, local_client
 from tests.monitor.robot_messages import map_geometry, pose
 from tests.monitor.test_robot_protocol import _followed, _map_on, _subscribed, robot_bus
 from tests.running_system import wait_until
+from tests.strict_json import strict_loads
 
 WORLD_M = 10_000.0
 """Farthest a pose, goal or path point may be from the origin (m)."""
 KEY = re.compile(r"^[0-9a-f]{32}$")
-
-
-def _refuse_constant(name: str) -> Any:
-    raise AssertionError(f"the monitor sent {name}, which JSON does not have")
 
 
 def _next(socket: Any, timeout: float = RECEIVE_TIMEOUT) -> dict[str, Any]:
@@ -45,7 +41,7 @@ def _next(socket: Any, timeout: float = RECEIVE_TIMEOUT) -> dict[str, Any]:
 
     message = socket.portal.call(receive)
     assert message["type"] == "websocket.send", f"the connection ended: {message}"
-    decoded: dict[str, Any] = json.loads(message["text"], parse_constant=_refuse_constant)
+    decoded: dict[str, Any] = strict_loads(message["text"])
     return decoded
 
 

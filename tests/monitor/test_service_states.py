@@ -38,10 +38,7 @@ from tests.monitor.hostile_messages import hostile_service_states
 from tests.monitor.monitor_protocol import SMALL_TREE, local_client, next_json, watch
 from tests.running_system import wait_until, write_tree
 from tests.service_trees import registry, sequence_of, sequence_with
-
-
-def _refuse_constant(name: str) -> Any:
-    raise AssertionError(f"the monitor sent {name}, which JSON does not have")
+from tests.strict_json import strict_loads
 
 
 def states(*entries: ServiceState, stamp: float = 12.5) -> ServiceStates:
@@ -100,7 +97,7 @@ def test_hostile_messages_become_pages_within_the_limits(rng: random.Random) -> 
     incoming = hostile_service_states(rng, list(tree.ids))
     message = page_services("/cyborg/bt", incoming, tree)
     text = json.dumps(message, allow_nan=False)
-    assert json.loads(text, parse_constant=_refuse_constant) == message
+    assert strict_loads(text) == message
     assert len(message["s"]) + message["dropped"] == len(incoming.services)
     assert len(message["s"]) <= MAX_SERVICES and len(message["tree"]) <= NAME_LIMIT
     for service in message["s"]:

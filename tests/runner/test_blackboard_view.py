@@ -4,8 +4,7 @@ blackboard went stale."""
 
 from __future__ import annotations
 
-import json
-from typing import Any, NoReturn
+from typing import Any
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -17,16 +16,13 @@ from cyborg.runner.blackboard_view import (
     MAX_TEXT,
     blackboard_json,
 )
-
-
-def _refuse(constant: str) -> NoReturn:
-    raise AssertionError(f"{constant} is not strict JSON")
+from tests.strict_json import strict_loads
 
 
 def shown(scopes: dict[str, Any]) -> Any:
     text = blackboard_json(scopes)
     assert len(text) <= MAX_CHARACTERS + 2 * MAX_TEXT + 1000
-    return json.loads(text, parse_constant=_refuse)
+    return strict_loads(text)
 
 
 def test_a_list_that_holds_itself_is_shown_up_to_where_it_loops() -> None:
