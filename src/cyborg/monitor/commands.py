@@ -67,7 +67,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Awaitable
+from collections.abc import Awaitable, Callable
 from typing import Any
 
 from cyborg.monitor.client import Client
@@ -138,75 +138,99 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
     """Carry out one command from ``client`` and queue what it answers."""
     if not isinstance(command, dict) or not isinstance(command.get("t"), str):
         raise CommandError('a command is a JSON object with a string "t"', "t")
-    kind, request = command["t"], command.get("req")
+    kind = command["t"]
     if hub.player.source is not None and _acts(kind, command):
-        client.send({"t": "result", "n": client.received, "req": request, "command": kind,
-                     "ok": False, "field": None, "message": f"{kind}: {REPLAY_REFUSAL}"})
-        return
-    if kind in CONTROLS:
-        answer = {"t": "result", "n": client.received, "req": request}
-        try:
-            message = await _control(hub, client, kind, command)
-        except (CommandError, ControlError) as exc:
-            client.send({**answer, "ok": False, "message": str(exc)})
-        else:
-            client.send({**answer, "ok": True, "message": message})
-        return
-    if kind in ROBOT_COMMANDS:
+        client.send({"t": "result", "n": client.received, "req": command.get("req"),
+                     "command": kind, "ok": False, "field": None,
+                     "message": f"{kind}: {REPLAY_REFUSAL}"})
+    elif kind in CONTROLS:
+        await _tree_control(hub, client, kind, command)
+    elif kind in ROBOT_COMMANDS:
         await _robot_command(hub, client, kind, command)
-        return
-    if kind in PLAYER_COMMANDS:
+    elif kind in PLAYER_COMMANDS:
         await _link_command(client, kind, command, hub.player.handle(client, kind, command),
                             PlayerCommandError, PlayerError)
-        return
-    if kind in MODE_COMMANDS:
+    elif kind in MODE_COMMANDS:
         await _link_command(client, kind, command, hub.modes.handle(client, kind, command),
                             ModeCommandError, ModeError)
-        return
-    if kind == "hello":
-        secret = command.get("seat")
-        if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
-                and hub.seat.resume(client.number, secret)):
-            hub.announce_seat()  # the page's old connection, if still open, hears it lost
-        else:
-            client.send(hub.seat_message(client))
-        client.send(hub.robots())
-        hub.robot_commands.resend(client)
-        hub.player.resend(client)
-    elif kind == "watch":
-        try:
-            hub.watch(client, command.get("ns") or hub.default_namespace)
-        except ValueError as exc:
-            raise CommandError(str(exc), "ns") from None
-    elif kind == "refresh":
-        hub.resync(client)
-    elif kind == "history":
-        source = hub.sources.get(client.watching or "")
-        state = source.state if source else None
-        client.send({"t": "history", "ns": client.watching,
-                     "v": state.version if state else None,
-                     "ticks": state.history_json() if state else []})
-    elif kind == "claim":
-        if not client.may_control:
-            raise CommandError(VIEW_ONLY)
-        held = hub.seat.holds(client.number)
-        granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
-        client.send({"t": "result", "n": client.received, "req": request, "ok": granted,
-                     "message": "you have control" if granted else
-                     "another page has control; take it over to control from here"})
-        if granted and not held:  # every page hears of a change, and only of one
-            hub.announce_seat()
-    elif kind == "release":
-        if hub.seat.release(client.number):
-            hub.announce_seat()
-    elif kind == "map":
-        if not isinstance(command.get("on"), bool):
-            raise CommandError("map: on must be true or false", "on")
-        hub.robot_hub.view(client, command["on"])
-    elif kind == "ping":
-        client.send({"t": "pong", "req": request})
+    elif kind in PAGE_COMMANDS:
+        PAGE_COMMANDS[kind](hub, client, command)
     else:
         raise CommandError(f"unknown command {kind[:40]!r}", "t")
+
+
+async def _tree_control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
+    """``enable``, ``control``, ``step``, ``resume``: answered with ``result``."""
+    answer = {"t": "result", "n": client.received, "req": command.get("req")}
+    try:
+        message = await _control(hub, client, kind, command)
+    except (CommandError, ControlError) as exc:
+        client.send({**answer, "ok": False, "message": str(exc)})
+    else:
+        client.send({**answer, "ok": True, "message": message})
+
+
+def _hello(hub: Hub, client: Client, command: dict[str, Any]) -> None:
+    """The page's first message: its seat back (by secret) or the seat's state, the robots."""
+    secret = command.get("seat")
+    if (client.may_control and isinstance(secret, str) and len(secret) <= SECRET_LIMIT
+            and hub.seat.resume(client.number, secret)):
+        hub.announce_seat()  # the page's old connection, if still open, hears it lost
+    else:
+        client.send(hub.seat_message(client))
+    client.send(hub.robots())
+    hub.robot_commands.resend(client)
+    hub.player.resend(client)
+
+
+def _watch(hub: Hub, client: Client, command: dict[str, Any]) -> None:
+    """Follow the tree under ``ns`` (default: the monitor's) on this page."""
+    try:
+        hub.watch(client, command.get("ns") or hub.default_namespace)
+    except ValueError as exc:
+        raise CommandError(str(exc), "ns") from None
+
+
+def _history(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
+    """The watched tree's kept ticks."""
+    source = hub.sources.get(client.watching or "")
+    state = source.state if source else None
+    client.send({"t": "history", "ns": client.watching, "v": state.version if state else None,
+                 "ticks": state.history_json() if state else []})
+
+
+def _claim(hub: Hub, client: Client, command: dict[str, Any]) -> None:
+    """Take the control seat (``force``: from the page that holds it)."""
+    if not client.may_control:
+        raise CommandError(VIEW_ONLY)
+    held = hub.seat.holds(client.number)
+    granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
+    client.send({"t": "result", "n": client.received, "req": command.get("req"), "ok": granted,
+                 "message": "you have control" if granted else
+                 "another page has control; take it over to control from here"})
+    if granted and not held:  # every page hears of a change, and only of one
+        hub.announce_seat()
+
+
+def _release(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
+    """Give the control seat up."""
+    if hub.seat.release(client.number):
+        hub.announce_seat()
+
+
+def _map(hub: Hub, client: Client, command: dict[str, Any]) -> None:
+    """The page shows the map (``on``): it gets the robots' state, or no longer."""
+    if not isinstance(command.get("on"), bool):
+        raise CommandError("map: on must be true or false", "on")
+    hub.robot_hub.view(client, command["on"])
+
+
+PAGE_COMMANDS: dict[str, Callable[[Hub, Client, dict[str, Any]], None]] = {
+    "hello": _hello, "watch": _watch, "refresh": lambda hub, client, _command: hub.resync(client),
+    "history": _history, "claim": _claim, "release": _release, "map": _map,
+    "ping": lambda _hub, client, command: client.send({"t": "pong", "req": command.get("req")}),
+}
+"""The page's own commands (its session, the seat, what it shows), each answered at once."""
 
 
 def _acts(kind: str, command: dict[str, Any]) -> bool:

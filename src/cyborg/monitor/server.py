@@ -26,7 +26,7 @@ import asyncio
 import contextlib
 import json
 import logging
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Awaitable, Callable
 
 from starlette.applications import Starlette
 from starlette.requests import ClientDisconnect, Request
@@ -75,7 +75,6 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
             hub.modes.detach()
 
     files = files or page_files()
-    exports = asyncio.Semaphore(EXPORTS_AT_ONCE)
 
     async def page(request: Request) -> Response:
         return await files.get_response("index.html", request.scope)
@@ -91,6 +90,26 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
                              "trees": sorted(hub.sources),
                              "dropped": sum(client.dropped for client in hub.clients),
                              "map_fetches": hub.robot_hub.store.fetches})
+
+    routes = [
+        Route("/", page),
+        Route("/api/robots", robots),
+        Route("/api/map/{key}", map_endpoint(hub.robot_hub.store)),
+        Route("/api/export", export_endpoint(hub), methods=["POST"]),
+        Route("/stats", stats),
+        WebSocketRoute("/ws", websocket_endpoint(hub)),
+        Route("/static/{path:path}", static),
+    ]
+    return HostGuard(Starlette(routes=routes, lifespan=lifespan), hosts or HostPolicy())
+
+
+def export_endpoint(hub: Hub) -> Callable[[Request], Awaitable[Response]]:
+    """``POST /api/export``: a watched tree drawn by Graphviz (SVG, PNG, PDF, DOT), two at a time.
+
+    Refused to a page of another origin (403), past :data:`BODY_LIMIT` (413), for a body that
+    is not the expected JSON (400), an unknown tree (404) or while Graphviz is busy (503).
+    """
+    exports = asyncio.Semaphore(EXPORTS_AT_ONCE)
 
     async def export(request: Request) -> Response:
         origin = request.headers.get("origin")
@@ -124,6 +143,17 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
                 return JSONResponse({"error": str(exc)}, 400)
         return Response(result.content, media_type=result.media_type, headers={
             "Content-Disposition": f'attachment; filename="{result.filename}"'})
+
+    return export
+
+
+def websocket_endpoint(hub: Hub) -> Callable[[WebSocket], Awaitable[None]]:
+    """``/ws``: one page's connection to ``hub``, from the origin and seat checks to its end.
+
+    A page of another origin needs the token; past the connection limits the page is told why
+    and closed (1008). Each message is carried out by :func:`~cyborg.monitor.commands.receive`,
+    and what the hub sends goes out through a writer task of the connection's own.
+    """
 
     async def websocket(socket: WebSocket) -> None:
         origin = socket.headers.get("origin")
@@ -163,16 +193,7 @@ def create_app(hub: Hub, *, hosts: HostPolicy | None = None,
                 await writer
             hub.disconnect(client)
 
-    routes = [
-        Route("/", page),
-        Route("/api/robots", robots),
-        Route("/api/map/{key}", map_endpoint(hub.robot_hub.store)),
-        Route("/api/export", export, methods=["POST"]),
-        Route("/stats", stats),
-        WebSocketRoute("/ws", websocket),
-        Route("/static/{path:path}", static),
-    ]
-    return HostGuard(Starlette(routes=routes, lifespan=lifespan), hosts or HostPolicy())
+    return websocket
 
 
 class HostGuard:
