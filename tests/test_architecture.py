@@ -200,3 +200,11 @@ def test_no_import_cycles() -> None:
                      for i in range(len(cycle) - 1)]
             cycles.append("".join(steps) + module)
     assert not cycles, "import cycles in src/cyborg:\n" + "\n".join(cycles)
+
+
+def test_the_monitor_hands_blocking_calls_to_workers_only_through_off_loop() -> None:
+    """``off_loop.in_thread`` turns a refusal at shutdown into ``ShutdownError``, which the
+    monitor answers; a bare ``asyncio.to_thread`` would surface as a bug."""
+    for path in sorted((SOURCE / "monitor").rglob("*.py")):
+        if path.name != "off_loop.py":
+            assert "asyncio.to_thread(" not in path.read_text(), f"{path}: use in_thread"

@@ -65,7 +65,6 @@ reaches the log as a traceback.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Awaitable, Callable
 from typing import Any
@@ -74,6 +73,7 @@ from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import MessageError, check_namespace, decode
 from cyborg.monitor.mode_link import MODE_COMMANDS, ModeCommandError, ModeError
+from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerCommandError, PlayerError
 from cyborg.monitor.robot_commands import ROBOT_COMMANDS
 from cyborg.monitor.robot_fields import RobotCommandError
@@ -113,6 +113,8 @@ async def receive(hub: Hub, client: Client, text: str | None) -> None:
         command = decode(text)
         await handle(hub, client, command)
     except (ValueError, ControlError) as exc:  # CommandError, MessageError, LimitError too
+        client.send(located_error(client, command, exc))
+    except ShutdownError as exc:  # the monitor is stopping: no worker takes the call
         client.send(located_error(client, command, exc))
     except Exception as exc:  # a bug: logged with its traceback, the connection goes on
         log.exception("monitor: message %d of connection %d failed", client.received,
@@ -291,9 +293,9 @@ async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any])
         on = command.get("on")
         if not isinstance(on, bool):
             raise CommandError("enable: on must be true or false", "on")
-        return await asyncio.to_thread(source.set_enabled, on)
+        return await in_thread(source.set_enabled, on)
     if kind in ("step", "resume"):
-        return await asyncio.to_thread(source.trigger, kind)
+        return await in_thread(source.trigger, kind)
     node_id, action = command.get("id"), command.get("action")
     if not isinstance(node_id, str) or not isinstance(action, str):
         raise CommandError("control: id and action must be strings",
@@ -304,7 +306,7 @@ async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any])
                            f"{source.namespace}", "id")
     status = command.get("status") or "failure"
     once, keep = bool(command.get("once")), bool(command.get("keep"))
-    message = await asyncio.to_thread(source.control, node_id, action, str(status),
+    message = await in_thread(source.control, node_id, action, str(status),
                                       once=once, keep=keep)
     hub.seat.note_hook(source.namespace, node_id, set_=action != "clear" and not keep)
     return message

@@ -9,7 +9,6 @@ request with a matching ``If-None-Match`` gets ``304``. The blob goes gzipped
 
 from __future__ import annotations
 
-import asyncio
 import gzip
 import re
 from collections.abc import Awaitable, Callable
@@ -18,6 +17,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 
 from cyborg.monitor.map_store import MapStore
+from cyborg.monitor.off_loop import in_thread
 
 CACHE_CONTROL = "public, max-age=31536000, immutable"
 MEDIA_TYPE = "application/octet-stream"
@@ -68,7 +68,7 @@ def map_endpoint(store: MapStore) -> Callable[[Request], Awaitable[Response]]:
         if accepts_gzip(request.headers.get("accept-encoding")):
             return Response(stored.gzipped, media_type=MEDIA_TYPE,
                             headers={**headers, "Content-Encoding": "gzip"})
-        blob = await asyncio.to_thread(gzip.decompress, stored.gzipped)
+        blob = await in_thread(gzip.decompress, stored.gzipped)
         return Response(blob, media_type=MEDIA_TYPE, headers=headers)
 
     return serve_map

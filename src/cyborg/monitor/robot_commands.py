@@ -74,6 +74,7 @@ from cyborg.interfaces.robot import TELEOP_TIMEOUT
 from cyborg.interfaces.tree_runner import robot_of_runner
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import check_namespace
+from cyborg.monitor.off_loop import in_thread
 from cyborg.monitor.robot_clients import (
     GoalEnd,
     MoveGoal,
@@ -176,7 +177,7 @@ class RobotCommands:
             return {"message": f"{ns}: a tour of {len(points)} points{note}", "paused": paused}
         assert send is not None
         try:
-            moving = await asyncio.to_thread(send)
+            moving = await in_thread(send)
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         self._follow(client, command.get("req"), ns, kind, what, moving)
@@ -215,7 +216,7 @@ class RobotCommands:
 
     async def _call(self, ns: str, bus: RobotClients, service: str) -> str:
         try:
-            ok, message = await asyncio.to_thread(bus.trigger, service)
+            ok, message = await in_thread(bus.trigger, service)
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         if not ok:
@@ -237,7 +238,7 @@ class RobotCommands:
                  and self._trees[tree].alive]
         robot, *halted = await asyncio.gather(
             self._call(ns, bus, "stop"),
-            *(asyncio.to_thread(self._trees[tree].stop) for tree in trees),
+            *(in_thread(self._trees[tree].stop) for tree in trees),
             return_exceptions=True)
         stopped = [tree for tree, done in zip(trees, halted, strict=True)
                    if not isinstance(done, BaseException)]
@@ -265,7 +266,7 @@ class RobotCommands:
             pose = self._robots.robots[ns].source.pose
             theta = float(pose[2]) if pose is not None else 0.0
         try:
-            ok, message = await asyncio.to_thread(bus.set_pose, x, y, theta)
+            ok, message = await in_thread(bus.set_pose, x, y, theta)
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         if not ok:
@@ -295,7 +296,7 @@ class RobotCommands:
             raise RobotCommandError(f"goal: the name of one of the map's goals (1 to "
                                     f"{NAME_LIMIT} characters), not {short(name)}", "goal")
         try:
-            names = await asyncio.to_thread(bus.goal_names)
+            names = await in_thread(bus.goal_names)
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         if name not in names:
@@ -314,7 +315,7 @@ class RobotCommands:
             what = f"home {homes[0]['name'] or ''} {point_text((x, y, theta))}".replace("  ", " ")
             return what, partial(bus.send_goal, pose=(x, y, theta), use_heading=True)
         try:
-            names = await asyncio.to_thread(bus.goal_names)
+            names = await in_thread(bus.goal_names)
         except RobotCallError as exc:
             raise RobotCommandError(str(exc)) from None
         named = next((name for name in names if name.lower() == "home"), None)
@@ -331,7 +332,7 @@ class RobotCommands:
             if robot_of_runner(tree) != ns or not source.alive or source.enabled is not True:
                 continue
             try:
-                await asyncio.to_thread(source.set_enabled, False)
+                await in_thread(source.set_enabled, False)
             except ControlError as exc:
                 raise RobotCommandError(f"the tree {tree} could not be paused, so nothing was "
                                         f"sent: {exc}") from None
@@ -367,7 +368,7 @@ class RobotCommands:
     def _start_tour(self, ns: str, bus: RobotClients, points: list[Waypoint]) -> None:
         async def leg(point: Waypoint) -> GoalEnd:
             x, y, theta = point
-            moving = await asyncio.to_thread(bus.send_goal, pose=(x, y, theta or 0.0),
+            moving = await in_thread(bus.send_goal, pose=(x, y, theta or 0.0),
                                              use_heading=theta is not None)
             try:
                 return await wait_for_end(moving)

@@ -42,6 +42,7 @@ from cyborg.monitor.export import ExportError, render, view_dot
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import BODY_LIMIT, MessageError, check_namespace, decode
 from cyborg.monitor.map_route import map_endpoint
+from cyborg.monitor.off_loop import in_thread
 from cyborg.monitor.page_files import PageSource, page_files
 from cyborg.monitor.seat import is_loopback
 
@@ -137,7 +138,7 @@ def export_endpoint(hub: Hub) -> Callable[[Request], Awaitable[Response]]:
                         active=state.active_ids(), collapsed=collapsed)
         async with exports:
             try:
-                result = await asyncio.to_thread(render, text, file_format,
+                result = await in_thread(render, text, file_format,
                                                  state.structure.get("title") or "behaviour_tree")
             except (ExportError, ValueError) as exc:
                 return JSONResponse({"error": str(exc)}, 400)
