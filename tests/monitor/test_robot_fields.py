@@ -9,9 +9,9 @@ from typing import Any
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_fields import (
     ANGLE_LIMIT,
-    RobotCommandError,
     number_field,
     pose_field,
     tour_points,
@@ -25,7 +25,7 @@ JSON = st.recursive(st.one_of(st.none(), st.booleans(), NUMBERS, st.text(max_siz
 POSES = st.one_of(st.lists(NUMBERS, min_size=2, max_size=3), JSON)
 
 
-def _refused_naming(error: RobotCommandError, field: str) -> bool:
+def _refused_naming(error: RefusalError, field: str) -> bool:
     return error.field is not None and error.field.startswith(field)
 
 
@@ -36,19 +36,19 @@ def test_any_field_is_taken_finite_or_refused_naming_it(vx: Any, pose: Any,
     try:
         speed = number_field({"vx": vx}, "vx")
         assert math.isfinite(speed)
-    except RobotCommandError as error:
+    except RefusalError as error:
         assert _refused_naming(error, "vx")
     try:
         x, y, theta = pose_field({"pose": pose}, "pose")
         assert max(abs(x), abs(y)) <= WORLD_LIMIT
         assert theta is None or abs(theta) <= math.tau
-    except RobotCommandError as error:
+    except RefusalError as error:
         assert _refused_naming(error, "pose")
     try:
         for x, y, theta in tour_points({"points": points}):
             assert max(abs(x), abs(y)) <= WORLD_LIMIT
             assert theta is None or abs(theta) <= math.tau
-    except RobotCommandError as error:
+    except RefusalError as error:
         assert _refused_naming(error, "points")
 
 

@@ -72,11 +72,11 @@ from typing import Any
 from cyborg.monitor.client import Client
 from cyborg.monitor.hub import Hub
 from cyborg.monitor.limits import MessageError, check_namespace, decode
-from cyborg.monitor.mode_link import MODE_COMMANDS, ModeCommandError, ModeError
+from cyborg.monitor.mode_link import MODE_COMMANDS, ModeError
 from cyborg.monitor.off_loop import ShutdownError, in_thread
-from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerCommandError, PlayerError
+from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerError
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_commands import ROBOT_COMMANDS
-from cyborg.monitor.robot_fields import RobotCommandError
 from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY
 from cyborg.monitor.source import ControlError
 
@@ -87,14 +87,6 @@ SECRET_LIMIT = 64
 REPLAY_REFUSAL = ("refused while a recording plays (cyborg play): it would act on no robot; a "
                   "stop or a disable still goes out")
 """Why a command that acts is refused while the monitor follows a player (as the page says)."""
-
-
-class CommandError(ValueError):
-    """A command that is malformed or not allowed; the message says why, ``field`` where."""
-
-    def __init__(self, message: str, field: str | None = None) -> None:
-        super().__init__(message)
-        self.field = field
 
 
 async def receive(hub: Hub, client: Client, text: str | None) -> None:
@@ -112,7 +104,7 @@ async def receive(hub: Hub, client: Client, text: str | None) -> None:
             raise MessageError("too many messages: slow down (this one was not read)")
         command = decode(text)
         await handle(hub, client, command)
-    except (ValueError, ControlError) as exc:  # CommandError, MessageError, LimitError too
+    except (RefusalError, ControlError) as exc:  # MessageError and LimitError are refusals
         client.send(located_error(client, command, exc))
     except ShutdownError as exc:  # the monitor is stopping: no worker takes the call
         client.send(located_error(client, command, exc))
@@ -139,7 +131,7 @@ def located_error(client: Client, command: Any, exc: Exception) -> dict[str, Any
 async def handle(hub: Hub, client: Client, command: Any) -> None:
     """Carry out one command from ``client`` and queue what it answers."""
     if not isinstance(command, dict) or not isinstance(command.get("t"), str):
-        raise CommandError('a command is a JSON object with a string "t"', "t")
+        raise RefusalError('a command is a JSON object with a string "t"', "t")
     kind = command["t"]
     if hub.player.source is not None and _acts(kind, command):
         client.send({"t": "result", "n": client.received, "req": command.get("req"),
@@ -151,14 +143,14 @@ async def handle(hub: Hub, client: Client, command: Any) -> None:
         await _robot_command(hub, client, kind, command)
     elif kind in PLAYER_COMMANDS:
         await _link_command(client, kind, command, hub.player.handle(client, kind, command),
-                            PlayerCommandError, PlayerError)
+                            PlayerError)
     elif kind in MODE_COMMANDS:
         await _link_command(client, kind, command, hub.modes.handle(client, kind, command),
-                            ModeCommandError, ModeError)
+                            ModeError)
     elif kind in PAGE_COMMANDS:
         PAGE_COMMANDS[kind](hub, client, command)
     else:
-        raise CommandError(f"unknown command {kind[:40]!r}", "t")
+        raise RefusalError(f"unknown command {kind[:40]!r}", "t")
 
 
 async def _tree_control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> None:
@@ -166,7 +158,7 @@ async def _tree_control(hub: Hub, client: Client, kind: str, command: dict[str, 
     answer = {"t": "result", "n": client.received, "req": command.get("req")}
     try:
         message = await _control(hub, client, kind, command)
-    except (CommandError, ControlError) as exc:
+    except (RefusalError, ControlError) as exc:
         client.send({**answer, "ok": False, "message": str(exc)})
     else:
         client.send({**answer, "ok": True, "message": message})
@@ -189,8 +181,8 @@ def _watch(hub: Hub, client: Client, command: dict[str, Any]) -> None:
     """Follow the tree under ``ns`` (default: the monitor's) on this page."""
     try:
         hub.watch(client, command.get("ns") or hub.default_namespace)
-    except ValueError as exc:
-        raise CommandError(str(exc), "ns") from None
+    except (ValueError, RefusalError) as exc:  # a bad name, or one namespace too many
+        raise RefusalError(str(exc), "ns") from None
 
 
 def _history(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
@@ -204,7 +196,7 @@ def _history(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
 def _claim(hub: Hub, client: Client, command: dict[str, Any]) -> None:
     """Take the control seat (``force``: from the page that holds it)."""
     if not client.may_control:
-        raise CommandError(VIEW_ONLY)
+        raise RefusalError(VIEW_ONLY)
     held = hub.seat.holds(client.number)
     granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
     client.send({"t": "result", "n": client.received, "req": command.get("req"), "ok": granted,
@@ -223,7 +215,7 @@ def _release(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
 def _map(hub: Hub, client: Client, command: dict[str, Any]) -> None:
     """The page shows the map (``on``): it gets the robots' state, or no longer."""
     if not isinstance(command.get("on"), bool):
-        raise CommandError("map: on must be true or false", "on")
+        raise RefusalError("map: on must be true or false", "on")
     hub.robot_hub.view(client, command["on"])
 
 
@@ -247,7 +239,7 @@ async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str,
     answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
     try:
         done = await hub.robot_commands.handle(client, kind, command)
-    except RobotCommandError as exc:
+    except RefusalError as exc:
         client.send({**answer, "ok": False, "field": exc.field,
                      "message": located_error(client, command, exc)["message"]})
         return
@@ -256,18 +248,16 @@ async def _robot_command(hub: Hub, client: Client, kind: str, command: dict[str,
 
 
 async def _link_command(client: Client, kind: str, command: dict[str, Any],
-                        handled: Awaitable[str],
-                        refused: type[PlayerCommandError | ModeCommandError],
-                        failed: type[Exception]) -> None:
+                        handled: Awaitable[str], failed: type[Exception]) -> None:
     """A command to a link (the player's, a mode machine's), answered with ``result``.
 
-    ``handled`` is the link's handling of it; ``refused`` is the link's error for a bad field
-    (named in the answer), ``failed`` its error when the bus side refused or did not answer.
+    ``handled`` is the link's handling of it; a refusal names the field at fault, ``failed`` is
+    the link's error when the bus side refused or did not answer.
     """
     answer = {"t": "result", "n": client.received, "req": command.get("req"), "command": kind}
     try:
         message = await handled
-    except refused as exc:
+    except RefusalError as exc:
         client.send({**answer, "ok": False, "field": exc.field,
                      "message": located_error(client, command, exc)["message"]})
     except failed as exc:
@@ -278,31 +268,31 @@ async def _link_command(client: Client, kind: str, command: dict[str, Any],
 
 async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> str:
     if not client.may_control:
-        raise CommandError(VIEW_ONLY)
+        raise RefusalError(VIEW_ONLY)
     if not hub.seat.holds(client.number):
-        raise CommandError(NOT_HOLDER)
+        raise RefusalError(NOT_HOLDER)
     namespace = command.get("ns") or client.watching
     try:
         namespace = check_namespace(namespace)
     except ValueError as exc:
-        raise CommandError(f"ns: {exc}", "ns") from None
+        raise RefusalError(f"ns: {exc}", "ns") from None
     source = hub.sources.get(namespace)
     if source is None:
-        raise CommandError(f"no tree is watched under {namespace!r}", "ns")
+        raise RefusalError(f"no tree is watched under {namespace!r}", "ns")
     if kind == "enable":
         on = command.get("on")
         if not isinstance(on, bool):
-            raise CommandError("enable: on must be true or false", "on")
+            raise RefusalError("enable: on must be true or false", "on")
         return await in_thread(source.set_enabled, on)
     if kind in ("step", "resume"):
         return await in_thread(source.trigger, kind)
     node_id, action = command.get("id"), command.get("action")
     if not isinstance(node_id, str) or not isinstance(action, str):
-        raise CommandError("control: id and action must be strings",
+        raise RefusalError("control: id and action must be strings",
                            "id" if not isinstance(node_id, str) else "action")
     state = source.state
     if state is None or node_id not in state.index_of:
-        raise CommandError(f"control: no node {node_id[:80]!r} in the tree under "
+        raise RefusalError(f"control: no node {node_id[:80]!r} in the tree under "
                            f"{source.namespace}", "id")
     status = command.get("status") or "failure"
     once, keep = bool(command.get("once")), bool(command.get("keep"))

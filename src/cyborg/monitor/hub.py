@@ -45,6 +45,7 @@ from cyborg.monitor.limits import Limits, check_namespace
 from cyborg.monitor.mode_link import ModeLink
 from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_link import PlayerLink
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_commands import RobotCommands
 from cyborg.monitor.robot_hub import RobotHub
 from cyborg.monitor.seat import ControlSeat
@@ -60,7 +61,7 @@ FOLLOW_LIMIT = 128
 """Most trees the monitor follows at once (runners beyond are not listed, with a warning)."""
 
 
-class LimitError(ValueError):
+class LimitError(RefusalError):
     """A page asked for more than :class:`Limits` allow; the message says which limit."""
 
 

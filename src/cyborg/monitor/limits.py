@@ -16,7 +16,8 @@ Anyone who can reach the page may watch, so watching must be cheap and bounded:
   (checked before parsing: Python's parser recurses), no NaN or infinities, and at most
   :attr:`Limits.rate` messages a second after a burst of :attr:`Limits.burst` (a token bucket).
 
-A refusal is a :class:`MessageError` (or a ``ValueError`` from :func:`check_namespace`); the
+A refusal is a :class:`MessageError` (a ``ValueError`` from :func:`check_namespace`, which
+the commands turn into a :class:`~cyborg.monitor.refusal.RefusalError` naming ``ns``); the
 server answers it as an ``error`` message that says which message and, where known, which
 field and which character (see :mod:`cyborg.monitor.commands`).
 """
@@ -30,6 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cyborg.bt.json_text import too_deep
+from cyborg.monitor.refusal import RefusalError
 
 MESSAGE_LIMIT = 64 * 1024
 """Longest message a page may send, in characters (the page's own are under 1 KiB)."""
@@ -69,12 +71,11 @@ class Limits:
         return None
 
 
-class MessageError(ValueError):
+class MessageError(RefusalError):
     """A message the monitor will not read; ``pos`` is the character where it went wrong."""
 
     def __init__(self, message: str, pos: int | None = None) -> None:
-        super().__init__(message)
-        self.pos = pos
+        super().__init__(message, pos=pos)
 
 
 def check_namespace(value: Any) -> str:

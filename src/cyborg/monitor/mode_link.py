@@ -21,7 +21,7 @@ except :meth:`ModeLink.notify`, which the bus calls from its threads.
   watched tree), become the runner's ``mode/set`` service (FORCE, REQUEST, HOLD or RELEASE),
   called in a worker thread. They need the control seat; ``mode`` must be one of the
   machine's modes, ``reason`` text of at most :data:`REASON_LIMIT` characters, ``held`` true or
-  false. A refusal names the field (:class:`ModeCommandError`).
+  false. A refusal names the field (:class:`RefusalError`).
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from cyborg.monitor.latest_state import LatestState
 from cyborg.monitor.limits import check_namespace
 from cyborg.monitor.mode_source import Listener, ModeError, ModeSource
 from cyborg.monitor.off_loop import ShutdownError, in_thread
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_fields import short
 from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
 from cyborg.monitor.source import TreeSource
@@ -53,14 +54,6 @@ REASON_LIMIT = 200
 
 MakeSource = Callable[[str, Listener], ModeSource]
 """``make(namespace, listener)``: follows the mode machine of the runner under ``namespace``."""
-
-
-class ModeCommandError(ValueError):
-    """A command to a mode machine refused; the message says why, ``field`` which field."""
-
-    def __init__(self, message: str, field: str | None = None) -> None:
-        super().__init__(message)
-        self.field = field
 
 
 class ModeLink:
@@ -159,42 +152,42 @@ class ModeLink:
     async def handle(self, client: Client, kind: str, command: dict[str, Any]) -> str:
         """Carries out a page's command to a mode machine; the runner's answer.
 
-        Raises :class:`ModeCommandError` (naming the field) for a command refused before the
+        Raises :class:`RefusalError` (naming the field) for a command refused before the
         bus, and :class:`~cyborg.monitor.mode_source.ModeError` when the runner refuses it or
         does not answer.
         """
         if not client.may_control:
-            raise ModeCommandError(VIEW_ONLY)
+            raise RefusalError(VIEW_ONLY)
         if not self._seat.holds(client.number):
-            raise ModeCommandError(NOT_HOLDER)
+            raise RefusalError(NOT_HOLDER)
         try:
             namespace = check_namespace(command.get("ns") or client.watching)
         except ValueError as exc:
-            raise ModeCommandError(f"ns: {exc}", "ns") from None
+            raise RefusalError(f"ns: {exc}", "ns") from None
         source = self.sources.get(namespace)
         view = source.view if source is not None and source.alive else None
         if source is None or view is None:
-            raise ModeCommandError(f"ns: the tree runner under {namespace} runs no mode file",
+            raise RefusalError(f"ns: the tree runner under {namespace} runs no mode file",
                                    "ns")
         if kind == "mode_hold":
             held = command.get("held")
             if not isinstance(held, bool):
-                raise ModeCommandError(f"held is {short(held)}, not true or false", "held")
+                raise RefusalError(f"held is {short(held)}, not true or false", "held")
             action = ModeAction.HOLD if held else ModeAction.RELEASE
             return await in_thread(source.set_mode, action)
         if kind not in ("mode_force", "mode_request"):
-            raise ModeCommandError(f"unknown command {kind[:40]!r}", "t")
+            raise RefusalError(f"unknown command {kind[:40]!r}", "t")
         mode, reason = command.get("mode"), command.get("reason", "")
         names = view.mode_names()
         if not isinstance(mode, str) or mode not in names:
             listed = ", ".join(names[:12]) + (", …" if len(names) > 12 else "")
-            raise ModeCommandError(f"mode is {short(mode)}, not one of the machine's modes "
+            raise RefusalError(f"mode is {short(mode)}, not one of the machine's modes "
                                    f"({listed or 'none could be read'})", "mode")
         if not isinstance(reason, str) or len(reason) > REASON_LIMIT:
-            raise ModeCommandError(f"reason is {short(reason)}, not text of at most "
+            raise RefusalError(f"reason is {short(reason)}, not text of at most "
                                    f"{REASON_LIMIT} characters", "reason")
         action = ModeAction.FORCE if kind == "mode_force" else ModeAction.REQUEST
         return await in_thread(source.set_mode, action, mode, reason)
 
 
-__all__ = ["MODE_COMMANDS", "ModeCommandError", "ModeError", "ModeLink"]
+__all__ = ["MODE_COMMANDS", "ModeError", "ModeLink", "RefusalError"]

@@ -27,7 +27,7 @@ except :meth:`PlayerLink.notify`, which the bus calls from its threads.
   a finite number from 0 to the duration} and ``player_step`` {} become the player's
   services, called in a worker thread. They need the control seat, as every command that
   changes what the robot's side does; a refusal names the field at fault
-  (:class:`PlayerCommandError`).
+  (:class:`RefusalError`).
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ from cyborg.monitor.client import Client
 from cyborg.monitor.latest_state import LatestState
 from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_source import Listener, PlayerError, PlayerSource
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_fields import short
 from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
 from cyborg.monitor.source import TreeSource
@@ -60,14 +61,6 @@ PLAYER = "player"
 
 MakeSource = Callable[[str, Listener], PlayerSource]
 """``make(namespace, listener)``: follows the player under ``namespace``."""
-
-
-class PlayerCommandError(ValueError):
-    """A command to the player refused; the message says why, ``field`` which field."""
-
-    def __init__(self, message: str, field: str | None = None) -> None:
-        super().__init__(message)
-        self.field = field
 
 
 class PlayerLink:
@@ -181,23 +174,23 @@ class PlayerLink:
     async def handle(self, client: Client, kind: str, command: dict[str, Any]) -> str:
         """Carries out a page's command to the player; the player's answer.
 
-        Raises :class:`PlayerCommandError` (naming the field) for a command that is refused
+        Raises :class:`RefusalError` (naming the field) for a command that is refused
         before the bus, and :class:`~cyborg.monitor.player_source.PlayerError` when the player
         refuses it or does not answer.
         """
         if not client.may_control:
-            raise PlayerCommandError(VIEW_ONLY)
+            raise RefusalError(VIEW_ONLY)
         if not self._seat.holds(client.number):
-            raise PlayerCommandError(NOT_HOLDER)
+            raise RefusalError(NOT_HOLDER)
         source = self.source
         view = source.view if source is not None and source.alive else None
         if source is None or view is None:
-            raise PlayerCommandError("no recording is played: no player is on the bus "
+            raise RefusalError("no recording is played: no player is on the bus "
                                      "(start one with cyborg play)")
         if kind == "player_pause":
             paused = command.get("paused")
             if not isinstance(paused, bool):
-                raise PlayerCommandError(f"paused is {short(paused)}, not true or false",
+                raise RefusalError(f"paused is {short(paused)}, not true or false",
                                          "paused")
             return await in_thread(source.set_paused, paused)
         if kind == "player_seek":
@@ -208,23 +201,28 @@ class PlayerLink:
             return answer
         if kind == "player_step":
             return await in_thread(source.step)
-        raise PlayerCommandError(f"unknown command {kind[:40]!r}", "t")
+        raise RefusalError(f"unknown command {kind[:40]!r}", "t")
 
 
 def seek_position(value: Any, duration: float) -> float:
     """``value`` as a position to seek to, within 0 to ``duration`` s.
 
-    :class:`PlayerCommandError` naming ``position`` otherwise.
+    :class:`RefusalError` naming ``position`` otherwise.
     """
     if isinstance(value, bool) or not isinstance(value, int | float) \
             or not math.isfinite(value):
-        raise PlayerCommandError(f"position is {short(value)}, not a finite number of "
+        raise RefusalError(f"position is {short(value)}, not a finite number of "
                                  "seconds", "position")
     if not 0 <= value <= duration:
-        raise PlayerCommandError(f"position {value} s is outside the recording (0 to "
+        raise RefusalError(f"position {value} s is outside the recording (0 to "
                                  f"{duration:.3f} s)", "position")
     return float(value)
 
 
-__all__ = ["PLAYER_COMMANDS", "PlayerCommandError", "PlayerError", "PlayerLink",
-           "seek_position"]
+__all__ = [
+    "PLAYER_COMMANDS",
+    "PlayerError",
+    "PlayerLink",
+    "RefusalError",
+    "seek_position",
+]

@@ -75,6 +75,7 @@ from cyborg.interfaces.tree_runner import robot_of_runner
 from cyborg.monitor.client import Client
 from cyborg.monitor.limits import check_namespace
 from cyborg.monitor.off_loop import in_thread
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_clients import (
     GoalEnd,
     MoveGoal,
@@ -84,7 +85,6 @@ from cyborg.monitor.robot_clients import (
     wait_for_end,
 )
 from cyborg.monitor.robot_fields import (
-    RobotCommandError,
     number_field,
     pose_field,
     short,
@@ -137,12 +137,12 @@ class RobotCommands:
         """Carries out one command; what its ``result`` adds (``message``, ``paused``).
 
         None when nothing is to be answered (a ``drive`` without ``req``). Raises
-        :class:`RobotCommandError` for a refusal.
+        :class:`RefusalError` for a refusal.
         """
         if not client.may_control:
-            raise RobotCommandError(VIEW_ONLY)
+            raise RefusalError(VIEW_ONLY)
         if kind != "stop" and not self._seat.holds(client.number):
-            raise RobotCommandError(NOT_HOLDER)
+            raise RefusalError(NOT_HOLDER)
         ns = self._namespace(command.get("ns"))
         bus = self._clients_for(ns)
         if kind == "stop":
@@ -179,23 +179,23 @@ class RobotCommands:
         try:
             moving = await in_thread(send)
         except RobotCallError as exc:
-            raise RobotCommandError(str(exc)) from None
+            raise RefusalError(str(exc)) from None
         self._follow(client, command.get("req"), ns, kind, what, moving)
         return {"message": f"{ns}: going to {what}{note}", "paused": paused, "goal": what}
 
     def _namespace(self, value: Any) -> str:
         if value is None:
-            raise RobotCommandError("name the robot in ns (such as /cyborg)", "ns")
+            raise RefusalError("name the robot in ns (such as /cyborg)", "ns")
         try:
             ns = check_namespace(value)
         except ValueError as exc:
-            raise RobotCommandError(str(exc), "ns") from None
+            raise RefusalError(str(exc), "ns") from None
         known = self._robots.robots.get(ns)
         if known is None:
             robots = ", ".join(sorted(self._robots.robots)) or "none"
-            raise RobotCommandError(f"no robot {ns} on the bus (robots: {robots})", "ns")
+            raise RefusalError(f"no robot {ns} on the bus (robots: {robots})", "ns")
         if not known.source.alive:
-            raise RobotCommandError(f"the robot {ns} has left the bus", "ns")
+            raise RefusalError(f"the robot {ns} has left the bus", "ns")
         return ns
 
     def _clients_for(self, ns: str) -> RobotClients:
@@ -210,7 +210,7 @@ class RobotCommands:
         found = self._bus.get(ns)
         if found is None:
             if self._make is None:
-                raise RobotCommandError("this monitor does not act on robots")
+                raise RefusalError("this monitor does not act on robots")
             found = self._bus[ns] = self._make(ns)
         return found
 
@@ -218,9 +218,9 @@ class RobotCommands:
         try:
             ok, message = await in_thread(bus.trigger, service)
         except RobotCallError as exc:
-            raise RobotCommandError(str(exc)) from None
+            raise RefusalError(str(exc)) from None
         if not ok:
-            raise RobotCommandError(f"{ns}/{service} refused: {message}")
+            raise RefusalError(f"{ns}/{service} refused: {message}")
         return f"{ns}: {message}"
 
     async def _stop(self, client: Client, ns: str, bus: RobotClients) -> tuple[str, list[str]]:
@@ -250,11 +250,11 @@ class RobotCommands:
         said = [f"the tree {', '.join(stopped)} is stopped until someone resumes it"] \
             if stopped else []
         if isinstance(robot, BaseException):
-            if not isinstance(robot, RobotCommandError):
+            if not isinstance(robot, RefusalError):
                 raise robot
-            raise RobotCommandError("; ".join([str(robot), *said, *failed])) from None
+            raise RefusalError("; ".join([str(robot), *said, *failed])) from None
         if failed:
-            raise RobotCommandError("; ".join([robot, *said, *failed]))
+            raise RefusalError("; ".join([robot, *said, *failed]))
         return "; ".join([robot, *said]), stopped
 
     async def _adjust(self, ns: str, bus: RobotClients, kind: str,
@@ -268,9 +268,9 @@ class RobotCommands:
         try:
             ok, message = await in_thread(bus.set_pose, x, y, theta)
         except RobotCallError as exc:
-            raise RobotCommandError(str(exc)) from None
+            raise RefusalError(str(exc)) from None
         if not ok:
-            raise RobotCommandError(f"{ns}/set_pose refused: {message}", "pose")
+            raise RefusalError(f"{ns}/set_pose refused: {message}", "pose")
         return f"{ns}: {message}"
 
     async def _drive(self, client: Client, ns: str, bus: RobotClients,
@@ -278,7 +278,7 @@ class RobotCommands:
         vx, wz = number_field(command, "vx"), number_field(command, "wz")
         if (client.number, ns) in self._drives_stopped:
             if vx or wz:
-                raise RobotCommandError(f"{ns} was stopped while you drove it: let go, then "
+                raise RefusalError(f"{ns} was stopped while you drove it: let go, then "
                                         "drive again")
             self._drives_stopped.discard((client.number, ns))
         paused = None
@@ -293,16 +293,16 @@ class RobotCommands:
 
     async def _goal_name(self, ns: str, bus: RobotClients, name: Any) -> str:
         if not isinstance(name, str) or not name.strip() or len(name) > NAME_LIMIT:
-            raise RobotCommandError(f"goal: the name of one of the map's goals (1 to "
+            raise RefusalError(f"goal: the name of one of the map's goals (1 to "
                                     f"{NAME_LIMIT} characters), not {short(name)}", "goal")
         try:
             names = await in_thread(bus.goal_names)
         except RobotCallError as exc:
-            raise RobotCommandError(str(exc)) from None
+            raise RefusalError(str(exc)) from None
         if name not in names:
             listed = ", ".join(repr(known) for known in names[:20]) or "none"
             more = f" and {len(names) - 20} more" if len(names) > 20 else ""
-            raise RobotCommandError(f"no goal {name[:80]!r} on the map of {ns} (goals: "
+            raise RefusalError(f"no goal {name[:80]!r} on the map of {ns} (goals: "
                                     f"{listed}{more})", "goal")
         return name
 
@@ -317,10 +317,10 @@ class RobotCommands:
         try:
             names = await in_thread(bus.goal_names)
         except RobotCallError as exc:
-            raise RobotCommandError(str(exc)) from None
+            raise RefusalError(str(exc)) from None
         named = next((name for name in names if name.lower() == "home"), None)
         if named is None:
-            raise RobotCommandError(f"the map of {ns} has no home (no RobotHome, no goal "
+            raise RefusalError(f"the map of {ns} has no home (no RobotHome, no goal "
                                     "named home)")
         return repr(named), partial(bus.send_goal, name=named)
 
@@ -334,7 +334,7 @@ class RobotCommands:
             try:
                 await in_thread(source.set_enabled, False)
             except ControlError as exc:
-                raise RobotCommandError(f"the tree {tree} could not be paused, so nothing was "
+                raise RefusalError(f"the tree {tree} could not be paused, so nothing was "
                                         f"sent: {exc}") from None
             self._manual[tree] = ns
             self._broadcast({"t": "manual_pause", "tree": tree, "ns": ns})

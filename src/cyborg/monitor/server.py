@@ -40,10 +40,11 @@ from cyborg.monitor.client import RESYNC, Client
 from cyborg.monitor.commands import located_error, receive
 from cyborg.monitor.export import ExportError, render, view_dot
 from cyborg.monitor.hub import Hub
-from cyborg.monitor.limits import BODY_LIMIT, MessageError, check_namespace, decode
+from cyborg.monitor.limits import BODY_LIMIT, check_namespace, decode
 from cyborg.monitor.map_route import map_endpoint
 from cyborg.monitor.off_loop import in_thread
 from cyborg.monitor.page_files import PageSource, page_files
+from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.seat import is_loopback
 
 log = logging.getLogger("cyborg.monitor")
@@ -125,7 +126,7 @@ def export_endpoint(hub: Hub) -> Callable[[Request], Awaitable[Response]]:
         except _TooLargeError:
             return JSONResponse({"error": f"export: a request has at most {BODY_LIMIT} "
                                           "bytes"}, 413)
-        except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        except (RefusalError, ValueError, KeyError, TypeError, AttributeError) as exc:
             return JSONResponse({"error": f"export: expected JSON with ns, format and "
                                           f"collapsed ({_reason(exc)})"}, 400)
         source = hub.sources.get(namespace)
@@ -178,7 +179,7 @@ def websocket_endpoint(hub: Hub) -> Callable[[WebSocket], Awaitable[None]]:
         if socket.query_params.get("watch"):  # the page's first connection: no round trip
             try:
                 hub.watch(client, hub.default_namespace)
-            except ValueError as exc:
+            except (ValueError, RefusalError) as exc:
                 client.send(located_error(client, None, exc))
         try:
             while True:
@@ -255,7 +256,7 @@ async def _read_body(request: Request) -> bytes:
 def _reason(exc: Exception) -> str:
     if isinstance(exc, KeyError):
         return f"missing {exc}"
-    return str(exc) if isinstance(exc, MessageError | ValueError) else type(exc).__name__
+    return str(exc) if isinstance(exc, RefusalError | ValueError) else type(exc).__name__
 
 
 async def _write(hub: Hub, client: Client) -> None:
