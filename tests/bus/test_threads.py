@@ -7,8 +7,10 @@ inference on the camera's thread). Now that is an opt-in of one subscription (``
 
 from __future__ import annotations
 
+import gc
 import threading
 import time
+import weakref
 from collections.abc import Callable, Iterator
 
 import pytest
@@ -178,3 +180,29 @@ def test_flush_waits_until_what_was_queued_has_run(bus: Context) -> None:
     detector.callbacks.submit(on_own_thread)
     assert detector.callbacks.flush(5)
     assert errors and "would wait forever" in str(errors[0])
+
+
+def test_a_route_once_forgotten_no_longer_keeps_its_owner(bus: Context) -> None:
+    node = Node("relay", context=bus)
+    own = node.callback_thread("own")
+
+    class Owner:
+        def __init__(self) -> None:
+            self.threads: list[str] = []
+
+        def run(self) -> None:
+            self.threads.append(threading.current_thread().name)
+    owner = Owner()
+    node.callbacks.route(owner, own)
+    node.callbacks.submit(owner.run)
+    node.callbacks.unroute(Owner())  # never routed: nothing happens
+    assert own.flush(5)
+    node.callbacks.unroute(owner)
+    node.callbacks.submit(owner.run)
+    assert node.callbacks.flush(5)
+    assert owner.threads == ["cyborg-node/relay[own]", "cyborg-node/relay"]
+    kept = weakref.ref(owner)
+    del owner
+    gc.collect()
+    assert kept() is None  # a destroyed subscription's route held it, its queue, for good
+    node.destroy()

@@ -56,6 +56,12 @@ class CallbackThread:
         """
         self._routes[id(owner)] = (owner, thread)
 
+    def unroute(self, owner: object) -> None:
+        """Forget ``owner``'s route (it was destroyed): the route would keep it alive."""
+        entry = self._routes.get(id(owner))
+        if entry is not None and entry[0] is owner:
+            del self._routes[id(owner)]
+
     def _routed(self, function: Callable[..., object]) -> CallbackThread | None:
         owner = getattr(function, "__self__", None)
         entry = self._routes.get(id(owner)) if owner is not None else None
