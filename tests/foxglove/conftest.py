@@ -30,16 +30,22 @@ class Served:
 
     def subscriptions(self, topic: str) -> int:
         """Subscriptions on ``topic`` made by the server's node (on the bus graph)."""
+        return len(self.subscription_ids(topic))
+
+    def subscription_ids(self, topic: str) -> set[int]:
+        """The entity ids of the subscriptions on ``topic`` made by the server's node."""
         node = self.server.node.fq_name
-        return sum(1 for entity in self.context.graph.entities()
-                   if entity.topic == topic and entity.node_name == node
-                   and entity.kind.name == "SUBSCRIPTION")
+        return {entity.entity_id for entity in self.context.graph.entities()
+                if entity.topic == topic and entity.node_name == node
+                and entity.kind.name == "SUBSCRIPTION"}
 
 
 @pytest.fixture
 def served() -> Iterator[Served]:
     context = Context(BusConfig.isolated())
-    server = FoxgloveServer(Node("foxglove", "/cyborg", context=context), port=0, poll=0.05)
+    # linger 0: a channel leaves the bus as its last client leaves (test_client_floods lingers)
+    server = FoxgloveServer(Node("foxglove", "/cyborg", context=context), port=0, poll=0.05,
+                            linger=0.0)
     server.start()
     try:
         yield Served(context, Node("robot", "/cyborg", context=context), server)

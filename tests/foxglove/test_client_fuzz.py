@@ -1,12 +1,15 @@
 """Whatever a client sends, the Foxglove server stays up: subscriptions and unsubscriptions with
-random ids, protocol messages with fields of the wrong kind, garbage text and binary frames and
-bytes that are no WebSocket frame at all. A well-behaved client is served afterwards, and the bus
-is left once the fuzzing clients are gone."""
+random ids, floods of subscriptions to channels that do not exist, protocol messages with fields
+of the wrong kind, garbage text and binary frames and bytes that are no WebSocket frame at all.
+A well-behaved client is served afterwards, the SDK's lines about the clients stay few (one per
+client and kind, then a count), and nothing of the fuzzing clients is kept once they are gone."""
 
 from __future__ import annotations
 
 import contextlib
+import gc
 import json
+import logging
 from typing import Any
 
 from hypothesis import given, settings
@@ -14,6 +17,8 @@ from hypothesis import strategies as st
 
 from cyborg.bus.msgs.geometry_msgs.msg import Pose2D
 from cyborg.bus.msgs.std_msgs.msg import String
+from cyborg.foxglove.resubscribe import Resubscriber
+from cyborg.foxglove.sdk_log import KINDS, LIMITER, SDK_CLIENT_LOGGER, TRACKED
 from tests.foxglove.conftest import Repeating, Served, wait_for
 
 ids = st.one_of(st.integers(0, 12), st.integers(-2**63, 2**64), st.none(), st.text(max_size=5),
@@ -39,6 +44,8 @@ messages = st.one_of(
 )
 actions = st.one_of(
     st.builds(lambda message: ("text", json.dumps(message)), messages),
+    st.builds(lambda start, count: ("flood", (start, count)),
+              st.integers(10_000, 2**32 - 1000), st.integers(20, 120)),
     st.builds(lambda garbage: ("text", garbage), st.text(max_size=60)),
     st.builds(lambda garbage: ("binary", garbage), st.binary(max_size=60)),
 )
@@ -49,15 +56,35 @@ def act(served: Served, steps: list[tuple[str, Any]], raw: bytes) -> None:
     with served.client() as client, contextlib.suppress(Exception):
         client.connection.close_timeout = 0.2  # garbage may leave no close handshake to wait for
         for kind, payload in steps:
-            client.connection.send(payload if kind == "text" else bytes(payload))
+            if kind == "flood":  # subscriptions to channels that do not exist, one per frame
+                start, count = payload
+                for number in range(count):
+                    client.connection.send(json.dumps({"op": "subscribe", "subscriptions": [
+                        {"id": number, "channelId": start + number}]}))
+            else:
+                client.connection.send(payload if kind == "text" else bytes(payload))
             client.read(0.001)
         if raw:
             client.connection.socket.sendall(raw)
         client.read(0.02)
 
 
+class Lines(logging.Handler):
+    """Counts the lines that reach the handlers of the SDK's client logger."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.count = 0
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.count += 1
+
+
 def test_the_server_survives_anything_a_client_sends_and_serves_the_next(
         served: Served) -> None:
+    lines = Lines()
+    logging.getLogger(SDK_CLIENT_LOGGER).addHandler(lines)
+    clients, suppressed = 0, LIMITER.suppressed
     pose = served.publisher_node.create_publisher("pose", Pose2D)
     served.publisher_node.create_publisher("note", String)
     stream = Repeating(pose, lambda count: Pose2D(x=float(count), y=0.0, theta=0.0))
@@ -70,6 +97,8 @@ def test_the_server_survives_anything_a_client_sends_and_serves_the_next(
         @given(steps=st.lists(actions, max_size=8), raw=st.one_of(st.just(b""),
                                                                  st.binary(max_size=40)))
         def fuzz(steps: list[tuple[str, Any]], raw: bytes) -> None:
+            nonlocal clients
+            clients += 1
             act(served, steps, raw)
 
         fuzz()
@@ -81,5 +110,17 @@ def test_the_server_survives_anything_a_client_sends_and_serves_the_next(
             assert served.server.relays.watched("/cyborg/pose") == 1
         assert wait_for(lambda: served.subscriptions("/cyborg/pose") == 0)
         assert served.server.relays.watched("/cyborg/pose") == 0
+        assert wait_for(lambda: served.server.relays.subscriptions() == 0)
+
+        def resubscribers() -> int:
+            gc.collect()
+            return sum(isinstance(thing, Resubscriber) for thing in gc.get_objects())
+        assert wait_for(lambda: resubscribers() == 0)
+        assert LIMITER.tracked_now() <= TRACKED + len(KINDS)
+        assert LIMITER.suppressed > suppressed  # the floods were counted, not written
+        # per client and kind: its first line and a count, and again for lines the SDK wrote
+        # after the client had gone
+        assert lines.count <= 4 * len(KINDS) * (clients + 2)
     finally:
         stream.stop()
+        logging.getLogger(SDK_CLIENT_LOGGER).removeHandler(lines)

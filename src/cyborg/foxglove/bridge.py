@@ -4,8 +4,9 @@ A :class:`Bridge` follows the bus graph from its node: every :data:`POLL` second
 changed, it asks :func:`~cyborg.foxglove.catalogue.wanted_channels` what the bus calls for,
 advertises a channel for each new offer, unadvertises those whose topic vanished (a publisher
 that left) and makes again those whose source changed (a topic's type). The relays subscribe on
-the bus only while a client watches (:mod:`cyborg.foxglove.relay`); the robots' maps and the
-trees' ticks are made on a callback thread of their own.
+the bus only while a client watches (:mod:`cyborg.foxglove.relay`; the bridge takes off the
+bus, as it polls, those nobody has watched for a while); the robots' maps and the trees' ticks
+are made on a callback thread of their own.
 """
 
 from __future__ import annotations
@@ -95,6 +96,7 @@ class Bridge:
 
     def _follow(self) -> None:
         while not self._stop.wait(self.poll):
+            self.relays.expire()
             if self.node.context.graph.version == self._version:
                 continue
             try:

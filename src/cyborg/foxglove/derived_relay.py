@@ -65,6 +65,7 @@ class DerivedRelay(Relay):
             self._kept = None
         for subscription in subscriptions:
             subscription.destroy()
+            self.node.callbacks.unroute(subscription)
 
     def replay(self) -> None:
         """Write again what was made from the latched source last."""

@@ -6,9 +6,10 @@ connection the gate reads the handshake (at most :data:`~cyborg.foxglove.admissi
 HANDSHAKE_LIMIT` bytes, within :data:`HANDSHAKE_TIMEOUT` seconds), asks the
 :class:`~cyborg.foxglove.admission.Admission` rules, answers ``403`` with the reason to a
 refused one, and otherwise connects to the server and copies the connection's frames both ways
-until either side closes, unchanged but for one thing: a subscription the server refused for a
-channel it had only just advertised is sent again (:mod:`cyborg.foxglove.resubscribe`). It runs
-an asyncio loop on a thread of its own.
+until either side closes, unchanged but for two things: a subscription the server refused for a
+channel it had only just advertised is sent again, and message data a slow client cannot take
+is dropped past a bound (:mod:`cyborg.foxglove.resubscribe`). It runs an asyncio loop on a
+thread of its own.
 
 The SDK's server accepts only the subprotocol ``foxglove.sdk.v1``; clients written before it
 (older Foxglove Studio and Lichtblick releases, roslibjs-foxglove) offer only
@@ -25,14 +26,17 @@ import logging
 import re
 import socket
 import threading
+from collections.abc import Callable
 
 from cyborg.foxglove.admission import HANDSHAKE_LIMIT, Admission, is_loopback, parse_handshake
-from cyborg.foxglove.resubscribe import Resubscriber
+from cyborg.foxglove.resubscribe import BACKLOG, STALL, Resubscriber
 
 log = logging.getLogger("cyborg.foxglove")
 
 HANDSHAKE_TIMEOUT = 10.0
 """Seconds a client has to send its handshake."""
+HOUSEKEEPING = 1.0
+"""Seconds between calls of the gate's ``housekeeping``."""
 CURRENT = b"foxglove.sdk.v1"
 """The subprotocol the SDK's server requires."""
 LEGACY = b"foxglove.websocket.v1"
@@ -45,11 +49,19 @@ class GateError(RuntimeError):
 
 
 class Gate:
-    """Listens on ``host:port`` and lets admitted connections through to ``upstream_port``."""
+    """Listens on ``host:port`` and lets admitted connections through to ``upstream_port``.
 
-    def __init__(self, host: str, port: int, upstream_port: int, admission: Admission) -> None:
+    ``closed`` is told the address the server knew a connection by (``127.0.0.1:PORT``, as
+    the SDK logs it) when the connection ends; ``housekeeping`` runs every
+    :data:`HOUSEKEEPING` seconds on the gate's thread.
+    """
+
+    def __init__(self, host: str, port: int, upstream_port: int, admission: Admission, *,
+                 closed: Callable[[str], None] | None = None,
+                 housekeeping: Callable[[], None] | None = None) -> None:
         self.host, self.requested_port = host, port
         self.upstream_port, self.admission = upstream_port, admission
+        self.closed, self.housekeeping = closed, housekeeping
         self.port = port
         """The port listened on (the one chosen when ``port`` was 0), once started."""
         self.refused = 0
@@ -76,6 +88,17 @@ class Gate:
         self._server = asyncio.run_coroutine_threadsafe(
             asyncio.start_server(self._handle, sock=listener, limit=HANDSHAKE_LIMIT),
             self._loop).result()
+        if self.housekeeping is not None:
+            self._loop.call_soon_threadsafe(self._keep_house)
+
+    def _keep_house(self) -> None:
+        """Runs ``housekeeping`` (its errors logged), then again in :data:`HOUSEKEEPING` s."""
+        try:
+            if self.housekeeping is not None:
+                self.housekeeping()
+        except Exception:
+            log.exception("the Foxglove gate's housekeeping failed")
+        self._loop.call_later(HOUSEKEEPING, self._keep_house)
 
     def stop(self) -> None:
         """Stop listening and drop the connections."""
@@ -131,7 +154,20 @@ class Gate:
                 upstream_writer.close()
                 return
             writer.write(_PROTOCOL_LINE.sub(rb"\1 " + LEGACY, answer))
-        await Resubscriber().run((reader, writer), (upstream_reader, upstream_writer))
+        known_as = upstream_writer.get_extra_info("sockname")
+        copy = Resubscriber()
+        try:
+            await copy.run((reader, writer), (upstream_reader, upstream_writer))
+        finally:
+            if copy.dropped:
+                log.warning("Foxglove client %s was slower than its data: %d messages were "
+                            "not sent to it (more than %d MiB waited)", peer, copy.dropped,
+                            BACKLOG // (1024 * 1024))
+            if copy.stalled:
+                log.warning("Foxglove client %s took nothing for %.0f s with %d MiB waiting "
+                            "for it: disconnected", peer, STALL, 2 * BACKLOG // (1024 * 1024))
+            if self.closed is not None and known_as:
+                self.closed(f"{known_as[0]}:{known_as[1]}")
 
 
 async def _answer(writer: asyncio.StreamWriter, text: str, status: str) -> None:

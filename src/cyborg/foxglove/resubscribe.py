@@ -8,13 +8,23 @@ panel stays empty although the channel exists.
 
 :class:`Resubscriber` copies the two directions of one admitted connection as WebSocket frames
 (RFC 6455) rather than bytes. It notes the channels the server advertised to the client and the
-subscriptions the client asked for; when the server refuses a subscription to a channel it has
+client's subscriptions to those channels (so what it keeps is bounded by the channels, however
+many subscriptions a client sends); when the server refuses a subscription to a channel it has
 advertised as unknown, the frame is not passed on and the subscription is sent again
 (:data:`RETRIES` times at most, :data:`RETRY_DELAY` apart), as the client's own frame between
-two of its frames. Everything else passes unchanged: frames the client or server sends that are
-not whole text frames of the protocol (binary data, fragments, compressed or malformed frames,
-text that is not JSON) are copied as they came, and a refusal of a channel never advertised is
-passed on.
+two of its frames. Everything else passes unchanged but for the bound below: frames the client
+or server sends that are not whole text frames of the protocol (binary data, fragments,
+compressed or malformed frames, text that is not JSON) are copied as they came, and a refusal of
+a channel never advertised is passed on.
+
+A client slower than the data it subscribed to gets only what it can take: the gate keeps
+reading the server, lets at most :data:`BACKLOG` bytes of message data wait for the client, and
+drops (counts in :attr:`Resubscriber.dropped`) a whole binary frame that would pass it, as the
+protocol's data may be dropped. Text frames (the protocol's control messages) are never
+dropped: they may wait up to another :data:`BACKLOG`, and a client that takes nothing for
+:data:`STALL` seconds past that is disconnected. Otherwise the server would queue up to 1,024
+messages for the client (foxglove-sdk's backlog), camera images included: about 10 MB a second
+of a 500 KB topic at 20 Hz, held until the client leaves.
 """
 
 from __future__ import annotations
@@ -39,7 +49,13 @@ TEXT_LIMIT = 16 * 1024 * 1024
 """The largest text frame read whole to be looked at; larger ones are copied as they come."""
 COPY_BLOCK = 1 << 20
 """Bytes copied at a time of a frame that is not looked at."""
+BACKLOG = 8 * 1024 * 1024
+"""Bytes of message data that may wait for a slow client; further messages are dropped."""
+STALL = 30.0
+"""Seconds a client may take nothing while twice :data:`BACKLOG` waits for it; then it is
+disconnected (its control messages cannot wait without bound)."""
 TEXT = 0x1
+BINARY = 0x2
 _UNKNOWN = re.compile(r"Unknown channel ID: (\d+)")
 
 
@@ -119,9 +135,13 @@ class Resubscriber:
     advertised: set[int] = field(default_factory=set)
     """Channel ids the server advertised to the client and has not withdrawn."""
     asked: dict[int, int] = field(default_factory=dict)
-    """The subscription id the client asked for each channel, while it is subscribed."""
+    """The subscription id the client asked for each advertised channel, while subscribed."""
     tries: dict[int, int] = field(default_factory=dict)
-    """Subscriptions sent again, by channel id."""
+    """Subscriptions sent again, by advertised channel id."""
+    dropped: int = 0
+    """Binary frames (message data) dropped for a client slower than its data."""
+    stalled: bool = False
+    """Whether the client was disconnected for taking nothing for :data:`STALL` seconds."""
     _to_server: asyncio.Lock = field(default_factory=asyncio.Lock)
     _retries: set[asyncio.Future[None]] = field(default_factory=set)
 
@@ -146,7 +166,9 @@ class Resubscriber:
         with contextlib.suppress(TypeError, KeyError, AttributeError, ValueError):
             if message.get("op") == "subscribe":
                 for item in message["subscriptions"]:
-                    self.asked[int(item["channelId"])] = int(item["id"])
+                    channel = int(item["channelId"])
+                    if channel in self.advertised:  # only these are sent again
+                        self.asked[channel] = int(item["id"])
             elif message.get("op") == "unsubscribe":
                 gone = {int(number) for number in message["subscriptionIds"]}
                 self.asked = {channel: number for channel, number in self.asked.items()
@@ -166,7 +188,10 @@ class Resubscriber:
             if op == "advertise":
                 self.advertised.update(int(item["id"]) for item in message["channels"])
             elif op == "unadvertise":
-                self.advertised.difference_update(int(n) for n in message["channelIds"])
+                for gone in {int(n) for n in message["channelIds"]}:
+                    self.advertised.discard(gone)
+                    self.asked.pop(gone, None)
+                    self.tries.pop(gone, None)
             elif op == "status":
                 match = _UNKNOWN.fullmatch(str(message.get("message", "")))
                 if match is None:
@@ -195,22 +220,52 @@ class Resubscriber:
 
     async def _from_server(self, reader: asyncio.StreamReader, client: asyncio.StreamWriter,
                            upstream: asyncio.StreamWriter) -> None:
+        # writing waits only once twice the backlog waits: data alone never makes it wait
+        client.transport.set_write_buffer_limits(high=2 * BACKLOG)
         with contextlib.suppress(asyncio.IncompleteReadError, ConnectionError, OSError):
-            while True:
-                head = await read_head(reader)
-                if head.plain_text and head.length <= TEXT_LIMIT:
-                    payload = await reader.readexactly(head.length)
-                    channel = self.server_said(payload)
-                    if channel is not None:
-                        retry = asyncio.ensure_future(self._again(channel, upstream))
-                        self._retries.add(retry)
-                        retry.add_done_callback(self._retries.discard)
-                        continue
-                    client.write(head.raw + payload)
-                else:
-                    client.write(head.raw)
-                    await _copy(reader, client, head.length)
-                await client.drain()
+            try:
+                await self._serve(reader, client, upstream)
+            except TimeoutError:
+                self.stalled = True
+
+    async def _serve(self, reader: asyncio.StreamReader, client: asyncio.StreamWriter,
+                     upstream: asyncio.StreamWriter) -> None:
+        """Copies the server's frames to the client (TimeoutError: the client took nothing)."""
+        while True:
+            head = await read_head(reader)
+            if head.plain_text and head.length <= TEXT_LIMIT:
+                payload = await reader.readexactly(head.length)
+                channel = self.server_said(payload)
+                if channel is not None:
+                    retry = asyncio.ensure_future(self._again(channel, upstream))
+                    self._retries.add(retry)
+                    retry.add_done_callback(self._retries.discard)
+                    continue
+                client.write(head.raw + payload)
+            elif head.fin and head.rsv == 0 and head.opcode == BINARY \
+                    and head.length <= BACKLOG:
+                await self._data(head, reader, client)
+                continue
+            else:
+                client.write(head.raw)
+                await _copy(reader, client, head.length, STALL)
+            await asyncio.wait_for(client.drain(), STALL)
+
+    async def _data(self, head: FrameHead, reader: asyncio.StreamReader,
+                    client: asyncio.StreamWriter) -> None:
+        """Passes one message-data frame on without waiting, or drops it past the backlog."""
+        if client.transport.is_closing():
+            raise ConnectionResetError("the client has gone")
+        if client.transport.get_write_buffer_size() + head.length > BACKLOG:
+            self.dropped += 1
+            left = head.length
+            while left:
+                block = await reader.read(min(COPY_BLOCK, left))
+                if not block:
+                    raise asyncio.IncompleteReadError(b"", left)
+                left -= len(block)
+            return
+        client.write(head.raw + await reader.readexactly(head.length))
 
     async def _again(self, channel: int, upstream: asyncio.StreamWriter) -> None:
         await asyncio.sleep(RETRY_DELAY)
@@ -226,8 +281,12 @@ class Resubscriber:
                 await upstream.drain()
 
 
-async def _copy(reader: asyncio.StreamReader, writer: asyncio.StreamWriter, length: int) -> None:
-    """Copies ``length`` bytes of a frame's payload as they come."""
+async def _copy(reader: asyncio.StreamReader, writer: asyncio.StreamWriter, length: int,
+                stall: float | None = None) -> None:
+    """Copies ``length`` bytes of a frame's payload as they come.
+
+    TimeoutError when ``writer`` takes nothing for ``stall`` seconds (None: waits as long).
+    """
     left = length
     while left:
         block = await reader.read(min(COPY_BLOCK, left))
@@ -235,4 +294,4 @@ async def _copy(reader: asyncio.StreamReader, writer: asyncio.StreamWriter, leng
             raise asyncio.IncompleteReadError(b"", left)
         writer.write(block)
         left -= len(block)
-        await writer.drain()
+        await asyncio.wait_for(writer.drain(), stall)

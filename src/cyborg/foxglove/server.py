@@ -10,8 +10,9 @@
 foxglove-sdk's server (``foxglove.start_server``) speaks the protocol (subprotocol
 ``foxglove.sdk.v1``, or ``foxglove.websocket.v1`` for older clients) on a free loopback port;
 the :class:`~cyborg.foxglove.gate.Gate` listens on ``host:port`` in front of it and lets in
-only what the rules of :mod:`cyborg.foxglove.admission` admit. The
-:class:`~cyborg.foxglove.bridge.Bridge` keeps the channels in step with the bus, and the
+only what the rules of :mod:`cyborg.foxglove.admission` admit. The SDK's lines about what a
+client sent are limited to one per client and kind per period (:mod:`cyborg.foxglove.sdk_log`).
+The :class:`~cyborg.foxglove.bridge.Bridge` keeps the channels in step with the bus, and the
 :class:`~cyborg.foxglove.relay.Relays` subscribe on the bus while clients watch.
 """
 
@@ -27,7 +28,8 @@ from cyborg.bus import Node
 from cyborg.foxglove.admission import Admission, AdmissionError, check_binding, is_loopback
 from cyborg.foxglove.bridge import POLL, Bridge
 from cyborg.foxglove.gate import Gate, GateError
-from cyborg.foxglove.relay import Relays
+from cyborg.foxglove.relay import LINGER, Relays
+from cyborg.foxglove.sdk_log import install as limit_client_lines
 
 log = logging.getLogger("cyborg.foxglove")
 
@@ -49,12 +51,14 @@ class FoxgloveServer:
     ``token`` (default: ``$CYBORG_MONITOR_TOKEN``) lets other machines in, and is required to
     listen beyond loopback; ``allow_hosts`` adds names the server answers to and
     ``allow_origins`` web pages that may connect from this machine without the token (see
-    :mod:`cyborg.foxglove.admission`). ValueError for a port that is not one.
+    :mod:`cyborg.foxglove.admission`); ``linger``: seconds a channel's bus subscription
+    outlives its last client. ValueError for a port that is not one.
     """
 
     def __init__(self, node: Node, *, host: str = DEFAULT_HOST, port: int = DEFAULT_PORT,
                  token: str | None = None, allow_hosts: list[str] | tuple[str, ...] = (),
-                 allow_origins: list[str] | tuple[str, ...] = (), poll: float = POLL) -> None:
+                 allow_origins: list[str] | tuple[str, ...] = (), poll: float = POLL,
+                 linger: float = LINGER) -> None:
         if not 0 <= port <= MAX_PORT:
             raise ValueError(f"port {port}: expected 0 (any free port) to {MAX_PORT}")
         self.node, self.host, self.requested_port = node, host, port
@@ -62,7 +66,8 @@ class FoxgloveServer:
         self.admission = Admission(HostPolicy(allow_hosts, server="Foxglove server"),
                                    self.token, allow_origins)
         self.context = foxglove.Context()
-        self.relays = Relays()
+        self.log_limiter = limit_client_lines()
+        self.relays = Relays(linger)
         self.bridge = Bridge(node, self.context, self.relays, poll=poll)
         self._sdk: WebSocketServer | None = None
         self.gate: Gate | None = None
@@ -92,7 +97,9 @@ class FoxgloveServer:
         self._sdk = foxglove.start_server(name="cyborg", host="127.0.0.1",
                                           port=0, context=self.context,
                                           server_listener=self.relays)
-        self.gate = Gate(self.host, self.requested_port, self._sdk.port, self.admission)
+        self.gate = Gate(self.host, self.requested_port, self._sdk.port, self.admission,
+                         closed=self.log_limiter.client_gone,
+                         housekeeping=self.log_limiter.sweep)
         try:
             self.gate.start()
         except GateError as exc:
@@ -109,6 +116,7 @@ class FoxgloveServer:
         if self._sdk is not None:
             self._sdk.stop()
             self._sdk = None
+        self.log_limiter.flush()
 
     def exposure(self) -> str | None:
         """Where a server listening beyond loopback is reachable, and how; None on loopback."""
