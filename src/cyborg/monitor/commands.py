@@ -77,7 +77,6 @@ from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_link import PLAYER_COMMANDS, PlayerError
 from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_commands import ROBOT_COMMANDS
-from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY
 from cyborg.monitor.source import ControlError
 
 log = logging.getLogger("cyborg.monitor")
@@ -195,8 +194,7 @@ def _history(hub: Hub, client: Client, _command: dict[str, Any]) -> None:
 
 def _claim(hub: Hub, client: Client, command: dict[str, Any]) -> None:
     """Take the control seat (``force``: from the page that holds it)."""
-    if not client.may_control:
-        raise RefusalError(VIEW_ONLY)
+    hub.seat.require(client.number, client.may_control, seat=False)
     held = hub.seat.holds(client.number)
     granted, _taken_from = hub.seat.claim(client.number, force=bool(command.get("force")))
     client.send({"t": "result", "n": client.received, "req": command.get("req"), "ok": granted,
@@ -267,10 +265,7 @@ async def _link_command(client: Client, kind: str, command: dict[str, Any],
 
 
 async def _control(hub: Hub, client: Client, kind: str, command: dict[str, Any]) -> str:
-    if not client.may_control:
-        raise RefusalError(VIEW_ONLY)
-    if not hub.seat.holds(client.number):
-        raise RefusalError(NOT_HOLDER)
+    hub.seat.require(client.number, client.may_control)
     namespace = command.get("ns") or client.watching
     try:
         namespace = check_namespace(namespace)

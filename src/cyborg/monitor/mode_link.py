@@ -40,7 +40,7 @@ from cyborg.monitor.mode_source import Listener, ModeError, ModeSource
 from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_fields import short
-from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
+from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import TreeSource
 
 log = logging.getLogger("cyborg.monitor")
@@ -156,10 +156,7 @@ class ModeLink:
         bus, and :class:`~cyborg.monitor.mode_source.ModeError` when the runner refuses it or
         does not answer.
         """
-        if not client.may_control:
-            raise RefusalError(VIEW_ONLY)
-        if not self._seat.holds(client.number):
-            raise RefusalError(NOT_HOLDER)
+        self._seat.require(client.number, client.may_control)
         try:
             namespace = check_namespace(command.get("ns") or client.watching)
         except ValueError as exc:

@@ -45,7 +45,7 @@ from cyborg.monitor.off_loop import ShutdownError, in_thread
 from cyborg.monitor.player_source import Listener, PlayerError, PlayerSource
 from cyborg.monitor.refusal import RefusalError
 from cyborg.monitor.robot_fields import short
-from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
+from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import TreeSource
 
 log = logging.getLogger("cyborg.monitor")
@@ -178,10 +178,7 @@ class PlayerLink:
         before the bus, and :class:`~cyborg.monitor.player_source.PlayerError` when the player
         refuses it or does not answer.
         """
-        if not client.may_control:
-            raise RefusalError(VIEW_ONLY)
-        if not self._seat.holds(client.number):
-            raise RefusalError(NOT_HOLDER)
+        self._seat.require(client.number, client.may_control)
         source = self.source
         view = source.view if source is not None and source.alive else None
         if source is None or view is None:

@@ -91,7 +91,7 @@ from cyborg.monitor.robot_fields import (
     tour_points,
 )
 from cyborg.monitor.robot_hub import RobotHub
-from cyborg.monitor.seat import NOT_HOLDER, VIEW_ONLY, ControlSeat
+from cyborg.monitor.seat import ControlSeat
 from cyborg.monitor.source import ControlError, TreeSource
 from cyborg.monitor.tour import Tour, Waypoint, point_text
 
@@ -139,10 +139,7 @@ class RobotCommands:
         None when nothing is to be answered (a ``drive`` without ``req``). Raises
         :class:`RefusalError` for a refusal.
         """
-        if not client.may_control:
-            raise RefusalError(VIEW_ONLY)
-        if kind != "stop" and not self._seat.holds(client.number):
-            raise RefusalError(NOT_HOLDER)
+        self._seat.require(client.number, client.may_control, seat=kind != "stop")
         ns = self._namespace(command.get("ns"))
         bus = self._clients_for(ns)
         if kind == "stop":

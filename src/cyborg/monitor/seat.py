@@ -27,6 +27,7 @@ import time
 from dataclasses import dataclass, field
 
 from cyborg.monitor.access import same_secret
+from cyborg.monitor.refusal import RefusalError
 
 VIEW_ONLY = ("view only: control is accepted from the monitor's own page on this machine, or "
              "with the monitor's token")
@@ -120,6 +121,18 @@ class ControlSeat:
     def holds(self, client: int) -> bool:
         """Whether ``client`` holds the seat now (not merely kept for it after it left)."""
         return self.holder is not None and self.holder.client == client and self.holder.connected
+
+    def require(self, client: int, may_control: bool, *, seat: bool = True) -> None:
+        """The one check before a command that acts; :class:`RefusalError` if it fails.
+
+        ``client`` must be allowed to control (``may_control``: its page's origin or token)
+        and, with ``seat``, hold the seat. A stop needs no seat (any page that may control
+        sends one); everything else does.
+        """
+        if not may_control:
+            raise RefusalError(VIEW_ONLY)
+        if seat and not self.holds(client):
+            raise RefusalError(NOT_HOLDER)
 
     def secret_for(self, client: int) -> str | None:
         """The seat's secret, for its holder only."""
