@@ -208,3 +208,19 @@ def test_the_monitor_hands_blocking_calls_to_workers_only_through_off_loop() -> 
     for path in sorted((SOURCE / "monitor").rglob("*.py")):
         if path.name != "off_loop.py":
             assert "asyncio.to_thread(" not in path.read_text(), f"{path}: use in_thread"
+
+
+def test_every_package_has_a_face_that_says_what_it_exports() -> None:
+    """Each package of cyborg has an ``__init__`` with a docstring and ``__all__`` (empty where
+    the package exports nothing itself and its modules are imported)."""
+    for package in sorted(path for path in SOURCE.iterdir()
+                          if path.is_dir() and not path.name.startswith("__")):
+        face = package / "__init__.py"
+        assert face.is_file(), f"{package} has no __init__.py"
+        tree = ast.parse(face.read_text())
+        assert ast.get_docstring(tree), f"{face} has no docstring"
+        names = {target.id for node in tree.body
+                 if isinstance(node, ast.Assign | ast.AnnAssign)
+                 for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                 if isinstance(target, ast.Name)}
+        assert "__all__" in names, f"{face} has no __all__"

@@ -1,1 +1,6 @@
-"""The ``cyborg`` command line: the one place where the packages are wired together."""
+"""The ``cyborg`` command line: the one place where the packages are wired together.
+
+The package exports nothing itself: import the modules.
+"""
+
+__all__: list[str] = []

@@ -11,3 +11,5 @@
 
 The package exports nothing itself: import the modules.
 """
+
+__all__: list[str] = []

@@ -24,4 +24,8 @@
 
 This package builds on :mod:`cyborg.bus` and :mod:`cyborg.interfaces` only; the command line
 (:mod:`cyborg.app`) wires it. docs/recording.md says what a recording holds.
+
+The package exports nothing itself: import the modules.
 """
+
+__all__: list[str] = []

@@ -25,4 +25,8 @@ topic. Every figure says which clock it is on.
 It builds on :mod:`cyborg.bus` (message types), :mod:`cyborg.interfaces` (topic names),
 :mod:`cyborg.record` (the scan of a file, the metadata's names) and the engine's statuses and
 structure outline (:mod:`cyborg.bt.status`, :mod:`cyborg.bt.outline`).
+
+The package exports nothing itself: import the modules.
 """
+
+__all__: list[str] = []
