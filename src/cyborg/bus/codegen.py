@@ -3,7 +3,7 @@
     python3 -m cyborg.bus.codegen           # rewrite src/cyborg/bus/msgs
     python3 -m cyborg.bus.codegen --check   # exit 1 if the checked-in package is out of date
 
-Run it after changing a file under ``src/cyborg/bus/interfaces`` (``tests/bus/test_codegen.py``
+Run it after changing a file under ``src/cyborg/bus/definitions`` (``tests/bus/test_codegen.py``
 fails until then). The package mirrors ROS's Python layout, ``cyborg.bus.msgs.<package>.<kind>``
 with ``kind`` one of ``msg``, ``srv``, ``action``:
 

@@ -58,7 +58,7 @@ from cyborg.bus.typed import (
 
 log = logging.getLogger("cyborg.bus")
 
-BUNDLED_INTERFACES = Path(__file__).with_name("interfaces")
+BUNDLED_INTERFACES = Path(__file__).with_name("definitions")
 """The interface files shipped with cyborg (cyborg_msgs and standard services)."""
 
 _KINDS = {"msg": 1, "srv": 2, "action": 3}  # file kind -> number of `---` separated parts
