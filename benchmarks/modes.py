@@ -39,8 +39,8 @@ from cyborg.app.up import CAMPUS_MODES, DATA
 from cyborg.bt import Blackboard, ManualClock, Tree
 from cyborg.modes import ModeMachine, load_machine
 from cyborg.nav.geometry import Pose2D
-from cyborg.robot.interface import ROBOT, BatteryReading, DockState, Goal, MoveOutcome
 from cyborg.robot.perceiving import SeenObject
+from cyborg.robot.protocol import ROBOT, BatteryReading, DockState, Goal, MoveOutcome
 
 SWITCH_GOAL_MS = 1.0
 """A mode switch (halt + first tick of the next tree) should take at most this long."""

@@ -12,8 +12,8 @@ from cyborg.app.up import CAMPUS_MODES, DATA, up_notes
 from cyborg.bt import Blackboard, ManualClock
 from cyborg.modes import load_machine, read_mode_file
 from cyborg.nav.geometry import Pose2D
-from cyborg.robot.interface import ROBOT, Goal, MoveOutcome
 from cyborg.robot.perceiving import SeenObject
+from cyborg.robot.protocol import ROBOT, Goal, MoveOutcome
 from tests.robot.fake_robot import FakeRobot
 
 MODE_FILE = Path(str(DATA.joinpath(CAMPUS_MODES)))

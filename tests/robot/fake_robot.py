@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 
 from cyborg.bt import Blackboard, ManualClock, Tree, loads_tree
 from cyborg.nav.geometry import Pose2D
-from cyborg.robot.interface import ROBOT, BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from cyborg.robot.perceiving import SeenObject
+from cyborg.robot.protocol import ROBOT, BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from tests.builders import N, registry, tree_json
 
 

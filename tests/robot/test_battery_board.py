@@ -6,7 +6,7 @@ import pytest
 
 from cyborg.bt import SUCCESS, ManualClock, TreeLoadError
 from cyborg.modes.conditions import Condition
-from cyborg.robot.interface import DockState
+from cyborg.robot.protocol import DockState
 from tests.builders import N
 from tests.robot.fake_robot import FakeRobot, robot_tree
 

@@ -22,7 +22,7 @@ from cyborg.bt import (
 )
 from cyborg.nav.geometry import Pose2D
 from cyborg.robot import move_to
-from cyborg.robot.interface import DockState, MoveOutcome
+from cyborg.robot.protocol import DockState, MoveOutcome
 from cyborg.robot.rate_limited_log import RateLimitedLog
 from tests.builders import N, registry, tree_json
 from tests.robot.fake_robot import FakeRobot, robot_tree

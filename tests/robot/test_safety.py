@@ -7,7 +7,7 @@ from typing import Any
 import pytest
 
 from cyborg.bt import RUNNING, SUCCESS, ManualClock, TreeLoadError
-from cyborg.robot.interface import RobotError
+from cyborg.robot.protocol import RobotError
 from tests.builders import N
 from tests.robot.fake_robot import FakeRobot, robot_tree
 

@@ -9,7 +9,7 @@ from concurrent.futures import Future
 import pytest
 
 from cyborg.bt import Blackboard, ManualClock, Tree, default_service_registry, loads_tree
-from cyborg.robot.interface import ROBOT, DockState, RobotError
+from cyborg.robot.protocol import ROBOT, DockState, RobotError
 from tests.builders import N, registry, tree_json
 from tests.robot.fake_robot import FakeRobot
 

@@ -19,7 +19,7 @@ import pytest
 from cyborg.bt import Action, NodeRegistry, Status, default_registry
 from cyborg.bus import BusConfig, Context, Node, Qos, new_message
 from cyborg.bus.executor import CallbackThread
-from cyborg.robot.interface import DockState
+from cyborg.robot.protocol import DockState
 from cyborg.runner.tree_runner import TreeRunnerNode
 from tests.robot.fake_robot import FakeRobot
 from tests.running_system import wait_until, write_tree

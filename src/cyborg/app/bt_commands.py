@@ -29,7 +29,7 @@ from cyborg.bt import (
 from cyborg.bt.problems import Problem, Severity
 from cyborg.bt.registry import NodeModuleError
 from cyborg.bt.tick_loop import DEFAULT_RATE
-from cyborg.robot.interface import ROBOT
+from cyborg.robot.protocol import ROBOT
 
 
 def add_parser(commands: Any) -> Any:

@@ -39,7 +39,7 @@ Two services (:mod:`cyborg.robot.watch_services`) keep the robot's state in the 
 the composite they are attached to runs: ``BatteryWatch{key,low}`` (the battery reading) and
 ``ClosestGoal{key}`` (the closest goal by path length).
 
-They act on the robot through :class:`~cyborg.robot.interface.Robot` (see that module); the tree
+They act on the robot through :class:`~cyborg.robot.protocol.Robot` (see that module); the tree
 runner (:mod:`cyborg.runner.tree_runner`) provides one on the bus. This package is an entry
 point of the groups ``cyborg.nodes`` and ``cyborg.services``, so every registry built with
 :func:`cyborg.bt.default_registry` (:func:`cyborg.bt.default_service_registry`) knows these nodes
@@ -61,7 +61,7 @@ from cyborg.robot import (
     say,
     watch_services,
 )
-from cyborg.robot.interface import ROBOT, Robot, RobotError, robot_of
+from cyborg.robot.protocol import ROBOT, Robot, RobotError, robot_of
 
 __all__ = ["ROBOT", "Robot", "RobotError", "battery", "battery_board", "blackboard_compare",
            "docking", "goals", "move_to", "object_motion", "object_nodes", "once_per_object",

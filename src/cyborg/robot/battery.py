@@ -21,7 +21,7 @@ import logging
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Decorator, Status, register
-from cyborg.robot.interface import ROBOT, DockState, robot_of
+from cyborg.robot.protocol import ROBOT, DockState, robot_of
 from cyborg.robot.rate_limited_log import RateLimitedLog
 
 log = logging.getLogger("cyborg.robot")

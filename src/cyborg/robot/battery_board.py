@@ -23,7 +23,7 @@ from typing import Any
 from typing_extensions import override
 
 from cyborg.bt import SUCCESS, Action, Status, register
-from cyborg.robot.interface import ROBOT, BatteryReading, DockState, robot_of
+from cyborg.robot.protocol import ROBOT, BatteryReading, DockState, robot_of
 
 
 def battery_entry(reading: BatteryReading) -> dict[str, Any]:

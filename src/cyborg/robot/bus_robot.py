@@ -28,8 +28,8 @@ from cyborg.interfaces import robot
 from cyborg.interfaces.help import HELP, HelpCall, help_text
 from cyborg.nav.geometry import Pose2D
 from cyborg.robot.bus_perception import BusPerception
-from cyborg.robot.interface import BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from cyborg.robot.perceiving import SeenObject
+from cyborg.robot.protocol import BatteryReading, DockState, Goal, MoveOutcome, RobotError
 from cyborg.robot.rate_limited_log import RateLimitedLog
 
 log = logging.getLogger("cyborg.robot")
@@ -113,7 +113,7 @@ class BusMove:
 
 
 class BusRobot:
-    """:class:`~cyborg.robot.interface.Robot` on the bus, for the robot under ``namespace``."""
+    """:class:`~cyborg.robot.protocol.Robot` on the bus, for the robot under ``namespace``."""
 
     def __init__(self, node: Node, namespace: str = robot.NAMESPACE, *,
                  timeout: float = 5.0) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
-from cyborg.robot.interface import ROBOT, DockState, robot_of
+from cyborg.robot.protocol import ROBOT, DockState, robot_of
 
 
 class _DockAction(Action):

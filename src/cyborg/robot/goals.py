@@ -21,7 +21,7 @@ from typing import Any
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Condition, Status, register
-from cyborg.robot.interface import ROBOT, robot_of
+from cyborg.robot.protocol import ROBOT, robot_of
 
 
 class _Query:

@@ -49,7 +49,7 @@ from collections.abc import Hashable
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
-from cyborg.robot.interface import (
+from cyborg.robot.protocol import (
     ROBOT,
     DockState,
     Goal,

@@ -32,7 +32,6 @@ from typing_extensions import override
 
 from cyborg.bt import FAILURE, RUNNING, SUCCESS, Action, Status, register
 from cyborg.interfaces.robot import TELEOP_MAX_SPEED, TELEOP_MAX_TURN_RATE
-from cyborg.robot.interface import ROBOT
 from cyborg.robot.perceiving import (
     PerceivingRobot,
     SeenObject,
@@ -40,6 +39,7 @@ from cyborg.robot.perceiving import (
     choose,
     perceiving_robot_of,
 )
+from cyborg.robot.protocol import ROBOT
 
 MIN_CONFIDENCE = 0.3
 """The confidence a moving node asks for unless told otherwise (it follows a known object)."""

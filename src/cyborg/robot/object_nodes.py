@@ -23,8 +23,8 @@ import math
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, SUCCESS, Action, Condition, Status, register
-from cyborg.robot.interface import ROBOT
 from cyborg.robot.perceiving import check_limits, choose, perceiving_robot_of
+from cyborg.robot.protocol import ROBOT
 
 MIN_CONFIDENCE = 0.5
 """An object's tracked confidence the nodes ask for unless told otherwise."""

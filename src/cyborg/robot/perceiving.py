@@ -27,7 +27,7 @@ from typing import Any, Protocol
 
 from cyborg.bt import Node
 from cyborg.nav.geometry import Pose2D
-from cyborg.robot.interface import RobotError, robot_of
+from cyborg.robot.protocol import RobotError, robot_of
 
 
 @dataclass(frozen=True)

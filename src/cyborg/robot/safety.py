@@ -25,7 +25,7 @@ import math
 from typing_extensions import override
 
 from cyborg.bt import RUNNING, SUCCESS, Action, Status, register
-from cyborg.robot.interface import ROBOT, RobotError, robot_of
+from cyborg.robot.protocol import ROBOT, RobotError, robot_of
 from cyborg.robot.rate_limited_log import RateLimitedLog
 
 log = logging.getLogger("cyborg.robot")

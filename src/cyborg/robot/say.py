@@ -24,8 +24,8 @@ from typing import Any
 from typing_extensions import override
 
 from cyborg.bt import FAILURE, SUCCESS, Action, Status, register
-from cyborg.robot.interface import ROBOT
 from cyborg.robot.perceiving import perceiving_robot_of
+from cyborg.robot.protocol import ROBOT
 
 _NAME = re.compile(r"[A-Za-z_][\w-]*(\.[A-Za-z_][\w-]*)*")
 """A placeholder's name: a blackboard key, then fields of mappings, separated by dots."""

@@ -30,7 +30,7 @@ from concurrent.futures import Future
 from typing import Any
 
 from cyborg.bt import Service, ServiceBoard, register_service
-from cyborg.robot.interface import ROBOT, DockState, Robot, RobotError
+from cyborg.robot.protocol import ROBOT, DockState, Robot, RobotError
 from cyborg.robot.rate_limited_log import RateLimitedLog
 
 log = logging.getLogger("cyborg.robot")

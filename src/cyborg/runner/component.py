@@ -21,7 +21,7 @@ parameter                meaning (default)
 =======================  ============================================================
 
 The robot the tree's nodes act on is not the runner's to choose: the runner knows only
-:class:`~cyborg.robot.interface.Robot`. Whoever wires the system passes a :data:`RobotFactory`
+:class:`~cyborg.robot.protocol.Robot`. Whoever wires the system passes a :data:`RobotFactory`
 (``cyborg.app`` gives the robot on the bus, :class:`~cyborg.robot.settling_robot.
 SettlingBusRobot`); without one the tree runs without a robot, for trees that need none.
 """
@@ -37,7 +37,7 @@ from cyborg.bus import Context, Node, SimClock
 from cyborg.bus.clock import JUMP_LIMIT, STALL_TIMEOUT
 from cyborg.bus.component import NodeSpec
 from cyborg.interfaces import robot, tree_runner
-from cyborg.robot.interface import Robot
+from cyborg.robot.protocol import Robot
 from cyborg.runner.ticked import describe
 from cyborg.runner.tree_runner import TreeRunnerNode
 

@@ -66,7 +66,7 @@ from cyborg.bus.msgs.std_srvs.srv import (
 from cyborg.bus.services import Responder
 from cyborg.interfaces import tree_runner
 from cyborg.modes import ModeMachine, Transition, Trigger, load_machine
-from cyborg.robot.interface import ROBOT, Robot
+from cyborg.robot.protocol import ROBOT, Robot
 from cyborg.runner.background_reload import BackgroundReloads
 from cyborg.runner.mode_endpoints import ModeEndpoints
 from cyborg.runner.service_states import ServiceStatesPublisher
