@@ -70,6 +70,18 @@ def test_a_robot_sees_another_on_its_laser() -> None:
     assert alone[ahead] == pytest.approx(10.0 - 1.0 - mount, abs=0.03)
 
 
+def test_a_robot_is_not_put_onto_another_between_two_sensor_steps() -> None:
+    """Between sensor steps a drive meets only the robots it may touch; put by hand onto one
+    further off, the robot is refused all the same, and beside it, it is put there."""
+    fleet = Fleet(parse_map(room_map([])), 2, start=Pose2D(1.0, 3.0, 0.0))
+    mover, other = fleet.simulators
+    assert other.set_pose(Pose2D(8.0, 3.0, 0.0)) is None
+    for _ in range(fleet.steps_per_sensor + 2):  # past a sensor step
+        fleet.step()
+    assert "would overlap another robot" in (mover.set_pose(Pose2D(8.2, 3.0, 0.0)) or "")
+    assert mover.set_pose(Pose2D(7.0, 3.0, 0.0)) is None
+
+
 def test_each_robot_hears_its_own_sensor_steps_and_one_that_stops_leaves_the_others_be() -> None:
     fleet = Fleet(parse_map(room_map([])), 2, start=Pose2D(1.0, 3.0, 0.0))
     loop = PacedLoop(fleet, speed=0)

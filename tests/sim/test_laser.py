@@ -44,13 +44,13 @@ def test_leaping_through_open_space_finds_the_walls_the_cell_walk_finds(
     occupied = random.random((120, 90)) < density
     occupied[random.integers(120), :] = True
     occupied[:, random.integers(90)] = True
-    room = ndimage.distance_transform_edt(~occupied).astype(np.float32)
+    clearance = (ndimage.distance_transform_edt(~occupied) * 0.05).astype(np.float32)
     x, y = random.uniform(-1.0, 5.5), random.uniform(-1.0, 7.0)
     angles = random.uniform(-math.pi, math.pi, 361)
     angles[:4] = (0.0, math.pi / 2, math.pi, -math.pi / 2)  # along the grid's lines
     walked, leapt = np.empty(361), np.empty(361)
     cast_rays(occupied, 0.0, 1.0, 0.05, x, y, angles, reach, walked)
-    cast_rays_far(occupied, room, 0.0, 1.0, 0.05, x, y, angles, reach, leapt)
+    cast_rays_far(occupied, clearance, 0.0, 1.0, 0.05, x, y, angles, reach, leapt)
     assert np.array_equal(np.isfinite(walked), np.isfinite(leapt))
     assert leapt[np.isfinite(leapt)] == pytest.approx(walked[np.isfinite(walked)], abs=1e-9)
 

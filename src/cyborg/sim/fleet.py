@@ -135,6 +135,7 @@ class Fleet:
         self.crowd: Crowd | None = None  # people walking among the robots
         self.way_giving = WayGiving(count)  # robots that meet head-on settle it
         self._met: list[Meeting] = []
+        self._touching: list[tuple[np.ndarray, ...]] = [()] * count  # people each may touch
 
     @property
     def map(self) -> ArnlMap:
@@ -173,22 +174,22 @@ class Fleet:
                          for sim in self.simulators]  # people walk on the fleet's first map
         for index, sim in enumerate(self.simulators):
             met = self._met[index] if self._met else None
-            if not sensing:  # only the drive needs the others: those it may touch this step
-                bodies = tuple(outlines[other] for other in self._near(index, self._contact))
-                sim.base.others = bodies + met.bodies if met else bodies
-                sim.step()
-                outlines[index] = sim.outline
-                continue
-            near = self._near(index)
-            placed_points = [placed(self._samples[other], braking_poses(
-                self.simulators[other].pose, self.simulators[other].base.speed,
-                self.simulators[other].base.limits.acceleration)) for other in near]
-            if met:
-                placed_points.append(met.points)
-            points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
-            bodies = tuple(outlines[other] for other in near)
-            sim.meet(bodies + met.bodies if met else bodies, points,
-                     met.circles if met else None)
+            if sensing:
+                near = self._near(index)
+                placed_points = [placed(self._samples[other], braking_poses(
+                    self.simulators[other].pose, self.simulators[other].base.speed,
+                    self.simulators[other].base.limits.acceleration)) for other in near]
+                if met:
+                    placed_points.append(met.points)
+                    self._touching[index] = within(met.bodies, sim.pose,
+                                                   sim.base.span + CONTACT_MARGIN)
+                points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
+                bodies = tuple(outlines[other] for other in near)
+                sim.meet(bodies + met.bodies if met else bodies, points,
+                         met.circles if met else None)
+            # the drive needs only the bodies it may touch this step (the same while they stand)
+            touching = tuple(outlines[other] for other in self._near(index, self._contact))
+            sim.base.others = touching + self._touching[index] if met else touching
             sim.step()
             outlines[index] = sim.outline  # where the next robot meets it
         if sensing and len(self.simulators) > 1:
@@ -203,6 +204,18 @@ class Fleet:
         return [number for number, other in enumerate(self.simulators)
                 if other is not sim and other.map is world
                 and math.hypot(other.pose.x - x, other.pose.y - y) <= reach]
+
+
+def within(bodies: tuple[np.ndarray, ...], pose: Pose2D,
+           reach: float) -> tuple[np.ndarray, ...]:
+    """Those of ``bodies`` (outlines, K x 2 each) that come within ``reach`` m of ``pose``."""
+    kept = []
+    for body in bodies:
+        middle = body.mean(axis=0)
+        size = float(np.max(np.hypot(body[:, 0] - middle[0], body[:, 1] - middle[1])))
+        if math.hypot(middle[0] - pose.x, middle[1] - pose.y) - size <= reach:
+            kept.append(body)
+    return tuple(kept)
 
 
 class FleetRobotLoop:

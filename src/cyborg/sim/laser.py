@@ -94,14 +94,14 @@ def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution
 
 
 @njit(cache=True)
-def cast_rays_far(occupied: np.ndarray, room: np.ndarray, origin_x: float, origin_y: float,
+def cast_rays_far(occupied: np.ndarray, clearance: np.ndarray, origin_x: float, origin_y: float,
                   resolution: float, x: float, y: float, angles: np.ndarray, range_max: float,
                   out: np.ndarray) -> None:  # pragma: no cover - jit
     """:func:`cast_rays`, leaping through open space: the same ranges, fewer cells visited.
 
-    ``room`` holds, per cell, the distance (in cells) from its centre to the nearest occupied
-    cell's centre (a Euclidean distance transform of the free cells). No point of a cell lies
-    closer than ``room - sqrt(2)`` cells to any point of an occupied cell, so a beam in a cell
+    ``clearance`` holds, per cell, the metres from its centre to the nearest occupied cell's
+    centre (as :meth:`~cyborg.nav.grid.MapGrid.clearance` gives them). No point of a cell lies
+    closer than that less ``sqrt(2)`` cells to any point of an occupied cell, so a beam in a cell
     with more than :data:`LEAP` cells to spare goes on that far from where it leaves the cell
     at once, and walks the grid cell by cell again from there: where it enters its first
     occupied cell is the same (to rounding).
@@ -135,7 +135,7 @@ def cast_rays_far(occupied: np.ndarray, room: np.ndarray, origin_x: float, origi
             if occupied[r, c]:
                 hit = travelled
                 break
-            free = room[r, c] - SQRT2  # cells clear from any point of this cell
+            free = clearance[r, c] / resolution - SQRT2  # cells clear from all of this one
             if free > LEAP:  # on from where the beam leaves the cell, a hair short of that
                 travelled = min(next_c, next_r) + free - 0.01
                 restart = True
@@ -172,18 +172,22 @@ class Laser:
     """Scans an occupancy grid from a robot pose.
 
     ``occupied`` is a boolean (rows, columns) grid whose cell (0, 0) has its lower-left corner at
-    ``origin`` (m), with ``resolution`` metres per cell; ``seed`` seeds the range noise.
+    ``origin`` (m), with ``resolution`` metres per cell; ``seed`` seeds the range noise;
+    ``clearance``, the grid's metres to the nearest occupied cell (computed when not given).
     """
 
     def __init__(self, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
-                 spec: LaserSpec | None = None, seed: int = 0) -> None:
+                 spec: LaserSpec | None = None, seed: int = 0,
+                 clearance: np.ndarray | None = None) -> None:
         self.occupied = np.ascontiguousarray(occupied, dtype=np.bool_)
         self.origin, self.resolution = origin, resolution
         self.spec = spec or LaserSpec()
         self._relative = self.spec.angles()
         self._ranges = np.empty(self.spec.beams)
-        self._room = (ndimage.distance_transform_edt(~self.occupied).astype(np.float32)
-                      if self.occupied.any() else np.full(self.occupied.shape, np.float32(1e9)))
+        if clearance is None:
+            clearance = (ndimage.distance_transform_edt(~self.occupied) * resolution
+                         if self.occupied.any() else np.full(self.occupied.shape, 1e6))
+        self._clearance = np.asarray(clearance, dtype=np.float32)
         self._walls = np.empty(self.spec.beams)  # the walls' ranges from `_walls_from`
         self._walls_from: tuple[float, float, float] | None = None
         self._random = np.random.default_rng(seed)
@@ -201,7 +205,7 @@ class Laser:
         sy = y + spec.mount_x * math.sin(theta)
         angles = self._relative + theta
         if self._walls_from != (sx, sy, theta):  # a scanner that stands sees the same walls
-            cast_rays_far(self.occupied, self._room, self.origin[0], self.origin[1],
+            cast_rays_far(self.occupied, self._clearance, self.origin[0], self.origin[1],
                           self.resolution, sx, sy, angles, spec.range_max, self._walls)
             self._walls_from = (sx, sy, theta)
         self._ranges[:] = self._walls

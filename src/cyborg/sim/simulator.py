@@ -135,10 +135,10 @@ class Simulator:
         world = MapGrid.from_map(arnl_map, settings.world_resolution, sim_obstacles=True)
         planner = planner or Planner(arnl_map)
         choice = choose_start(arnl_map, planner, start)  # an unknown name changes nothing
-        base = RobotBase(world.clearance(world.walls), (world.origin_x, world.origin_y),
-                         world.resolution)
+        clearance = world.clearance(world.walls)
+        base = RobotBase(clearance, (world.origin_x, world.origin_y), world.resolution)
         laser = Laser(world.walls, (world.origin_x, world.origin_y), world.resolution,
-                      settings.laser, seed=settings.seed)
+                      settings.laser, seed=settings.seed, clearance=clearance)
         return PreparedMap(arnl_map, world, planner, base, laser, choice)
 
     def install_map(self, prepared: PreparedMap) -> None:
@@ -295,6 +295,7 @@ class Simulator:
         Otherwise any goal, docking and driving by hand end first, and the robot leaves the
         dock (charging ends).
         """
+        self.base.others = self.others  # every robot it met, not only those it may touch now
         problem = placement_problem(pose, self.bounds, self.base, self.world)
         if problem is not None:
             return problem
