@@ -254,3 +254,43 @@ def test_a_person_in_a_niche_beside_a_waiting_robots_way_goes_on_along_it(
         crowd.advance(0.2, [sim.outline], [pose.theta], [0.0], [way])
     gap = float(np.min(np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)))
     assert gap >= sim.planner.lethal + crowd.settings.radius, (person.x, person.y, gap)
+
+
+def test_a_person_on_a_waiting_robots_way_with_no_room_aside_walks_straight_off_it(
+        shared: Path) -> None:
+    # AMROffice: a robot west of the junction waits to drive east round it and south to room2;
+    # a person at the junction's inner corner, on that way, has a wall where a step aside
+    # would go: stepping aside and on along the way in turns, they stayed on it for seconds
+    # (once for a minute); now they walk to the nearest place off it and stay there
+    arnl_map = read_map(shared / "maps" / "AMROffice.map")
+    sim = Simulator(arnl_map, Pose2D(-8.39, 2.03, -0.467))
+    assert sim.go_to("room2").found
+    way, pose = sim.way_ahead(), sim.pose
+    crowd = Crowd(sim.planner, [PersonPlan("ivy", (-5.37, 1.38), ((-5.157, 8.727),))], seed=1)
+    person = crowd.people[0]
+    room = sim.planner.lethal + crowd.settings.radius + 0.3  # what a person keeps from a way
+    on_the_way = []
+    for _ in range(50):
+        crowd.advance(0.2, [sim.outline], [pose.theta], [0.0], [way])
+        gap = float(np.min(np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)))
+        on_the_way.append(gap < room)
+    assert not any(on_the_way[5:]), f"off the way within a second, for good: {on_the_way}"
+    assert sim.planner.grid.clearance_at(sim.planner.wall_clearance, person.x,
+                                         person.y) >= crowd.settings.radius
+
+
+def test_a_person_turning_a_corner_does_not_walk_into_someone_round_it() -> None:
+    # one walks north to a corner of their route and then east; another stands east of the
+    # corner, out of the way north: the walker stops at the corner rather than turn into them
+    # in mid-step (what is ahead was looked at facing north)
+    _map, planner = room()
+    crowd = Crowd(planner, [PersonPlan("jo", (2.0, 2.0), ((2.0, 2.0),)),
+                            PersonPlan("kim", (2.65, 2.98), ((2.65, 2.98),))], seed=1)
+    walker, standing = crowd.people
+    walker.gait, walker.route = Gait.WALKING, np.array([(2.0, 2.96), (4.0, 3.0)])
+    walker.speed = 1.5
+    standing.gait = Gait.STANDING
+    for _ in range(10):
+        crowd.advance(0.2)
+        gap = math.hypot(walker.x - standing.x, walker.y - standing.y)
+        assert gap >= 2 * crowd.settings.radius - 1e-9, (walker.x, walker.y)

@@ -71,6 +71,8 @@ and half the work of stepping them with the robots' 10 Hz sensors."""
 ARRIVED_NEAR = 1.5
 """Metres from a waypoint within which a person blocked on the way counts as arrived there:
 someone else stands on it (a robot, a person pausing)."""
+NO_ROBOTS = np.zeros((0, 3))
+"""No robots, as circles (x, y, radius)."""
 NO_WAY = np.zeros((0, 2))
 """The way of a robot that means to drive nowhere."""
 NARROW_LOOK = 0.4
@@ -179,7 +181,12 @@ class Crowd(RoomForRobots):
         of the line ahead (:meth:`_keep_off_ways`).
         """
         self.time += dt
-        stepped_off = self._keep_off_ways(dt, ways, speeds) if ways else set()
+        circles = np.empty((len(robots), 3))
+        for index, outline in enumerate(robots):
+            middle = outline.sum(axis=0) / len(outline)
+            circles[index, :2] = middle
+            circles[index, 2] = math.sqrt(float(np.max(np.sum((outline - middle) ** 2, axis=1))))
+        stepped_off = self._keep_off_ways(dt, ways, speeds, circles) if ways else set()
         walking = []
         for person in self.people:
             if person.gait is Gait.STANDING:
@@ -196,16 +203,11 @@ class Crowd(RoomForRobots):
                 person.heading = math.atan2(ahead[1] - person.y, ahead[0] - person.x)
             if id(person) not in stepped_off:
                 walking.append(person)
-        circles = np.empty((len(robots), 3))
-        for index, outline in enumerate(robots):
-            middle = outline.sum(axis=0) / len(outline)
-            circles[index, :2] = middle
-            circles[index, 2] = math.sqrt(float(np.max(np.sum((outline - middle) ** 2, axis=1))))
         if walking:
             blocked = self._blocked(walking, circles) | self._onto_ways(walking, dt, ways,
                                                                          speeds)
             for person, stopped in zip(walking, blocked, strict=True):
-                self._walk(person, dt, bool(stopped))
+                self._walk(person, dt, bool(stopped), circles)
         if len(circles):
             without_way = [not (index < len(ways) and len(ways[index]))
                            for index in range(len(circles))]
@@ -213,7 +215,13 @@ class Crowd(RoomForRobots):
                                           in zip(headings, without_way, strict=False)],
                             speeds)
 
-    def _walk(self, person: Person, dt: float, blocked: bool) -> None:
+    def _walk(self, person: Person, dt: float, blocked: bool,
+              robots: np.ndarray = NO_ROBOTS) -> None:
+        """Walk ``person`` on along their route for ``dt`` s, or wait when ``blocked``.
+
+        Round a corner they go on only when the way ahead after it is free (of people and of
+        ``robots``, (M, 3) circles), as it was checked before the step in the way they faced.
+        """
         if blocked:
             if math.hypot(person.goal[0] - person.x, person.goal[1] - person.y) <= ARRIVED_NEAR:
                 self._arrive(person)  # someone stands at the waypoint: near enough
@@ -233,12 +241,22 @@ class Crowd(RoomForRobots):
                 person.trail.append((person.x, person.y))
                 person.route = person.route[1:]
                 left -= gap
+                if left > 0.0 and len(person.route) and self._turned_into(person, robots):
+                    break  # round the corner, someone is in the way: the next step waits
             else:
                 person.x += (tx - person.x) * left / gap
                 person.y += (ty - person.y) * left / gap
                 left = 0.0
         if len(person.route) == 0:
             self._arrive(person)
+
+    def _turned_into(self, person: Person, robots: np.ndarray) -> bool:
+        """Whether, facing the next corner of their route, someone is in ``person``'s way."""
+        ahead = person.route[0]
+        if (ahead[0], ahead[1]) == (person.x, person.y):
+            return False
+        person.heading = math.atan2(ahead[1] - person.y, ahead[0] - person.x)
+        return bool(self._blocked([person], robots)[0])
 
     def _blocked(self, walking: list[Person], robots: np.ndarray) -> np.ndarray:
         """For each of ``walking``: whether a robot or another person stands in the way ahead.

@@ -73,6 +73,7 @@ class Person:
     until: float = 0.0  # when a pause ends, simulated seconds
     waited: float = 0.0  # seconds blocked so far
     pocket: tuple[float, float] | None = None  # where no step off a robot's way was free
+    refuge: np.ndarray | None = None  # the walk to a place off a waiting robot's way, (K, 2)
 
     @property
     def pose(self) -> Pose2D:

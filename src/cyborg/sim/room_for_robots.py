@@ -14,8 +14,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from cyborg.sim.crowd_geometry import in_robots_way
-from cyborg.sim.people_routes import Point
+from cyborg.sim.crowd_geometry import in_robots_way, way_off
+from cyborg.sim.people_routes import Point, RouteBook
 from cyborg.sim.person import Gait, PeopleSettings, Person
 
 ROOM = 0.3
@@ -31,6 +31,9 @@ of the next (stepping aside again and again, they would otherwise queue a corner
 POCKET = 1.0
 """Metres a person who found no way on beside a robot's way (a pocket, a niche) goes on along
 the way before stepping aside again."""
+REFUGE = 6.0
+"""Metres a person on a waiting robot's way, with no step aside free, walks at most to a place
+off it (:meth:`RoomForRobots._refuge`)."""
 STILL = 0.05
 """Metres per second under which a robot counts as standing still: people walking on their
 way pass in front of it instead of stepping aside (:meth:`Crowd.advance`)."""
@@ -43,6 +46,8 @@ class RoomForRobots:
     settings: PeopleSettings
     time: float
     _way_room: float  # metres from a robot's way within which a person is on it
+    _clearance: np.ndarray  # metres from walls, on the crowd's planner's grid
+    routes: RouteBook
 
     @property
     def positions(self) -> np.ndarray:
@@ -53,47 +58,92 @@ class RoomForRobots:
         """Whether a person walks from ``start`` to ``end`` clear of walls (the crowd's)."""
         raise NotImplementedError
 
-    def _keep_off_ways(self, dt: float, ways: Sequence[np.ndarray],
-                       speeds: Sequence[float]) -> set[int]:
+    def _keep_off_ways(self, dt: float, ways: Sequence[np.ndarray], speeds: Sequence[float],
+                       robots: np.ndarray) -> set[int]:
         """People on the way of a robot that stands step off it; the ``id`` s of those who did.
 
         On the way means closer to one of its points than the robot's circumscribed radius,
         their body and :data:`ROOM`: where the robot's wait for them would not end (a robot
         that drives has people step out of the way as it comes, :meth:`_make_room`). They step
-        aside from it, else on along it (away from the robot, to where there is room aside),
-        squeezing past other people; with neither free, a pause ends.
+        aside from it; where no step aside is free (a corridor, a doorway) they walk to the
+        nearest place off every such way (:meth:`_refuge`, ``robots`` being the robots' bodies
+        as (M, 3) circles) and keep to that until there; with none in reach, on along the way
+        (away from the robot, to where there is room aside), squeezing past other people; with
+        nothing free, a pause ends.
         """
         moved: set[int] = set()
-        for index, way in enumerate(ways):
-            if len(way) < 2 or not self._stands(index, speeds):
-                continue
+        standing = [way for index, way in enumerate(ways)
+                    if len(way) >= 2 and self._stands(index, speeds)]
+        for way in standing:
             for person in self.people:
                 gaps = np.hypot(way[:, 0] - person.x, way[:, 1] - person.y)
                 nearest = int(np.argmin(gaps))
-                if gaps[nearest] >= self._way_room:
+                if gaps[nearest] >= self._way_room or id(person) in moved:
                     continue
                 if person.pocket and math.dist(person.pocket, (person.x, person.y)) > POCKET:
                     person.pocket = None  # well on along the way: aside again
                 moved.add(id(person))
-                if self._step_off(person, way, float(gaps[nearest]), nearest,
-                                  person.speed * dt):
+                step = person.speed * dt
+                if person.refuge is None:
+                    if self._aside(person, way, float(gaps[nearest]), nearest, step):
+                        continue
+                    person.refuge = self._refuge(person, standing, robots)
+                if person.refuge is not None and self._to_refuge(person, step):
+                    continue
+                if self._step_off(person, way, nearest, step):
                     continue
                 if person.gait is Gait.PAUSING:
                     person.until = self.time  # no room: walk on when the way lets them
                 else:
                     moved.discard(id(person))  # no room: on their way, if it is free
+        for person in self.people:
+            if id(person) not in moved:
+                person.refuge = None  # off every way that a robot waits to take
         return moved
 
-    def _step_off(self, person: Person, way: np.ndarray, gap: float, nearest: int,
-                  step: float) -> bool:
-        """One step of ``person`` off ``way``: aside, or on along it; whether one was free.
+    def _refuge(self, person: Person, ways: list[np.ndarray],
+                robots: np.ndarray) -> np.ndarray | None:
+        """The walk to the nearest place off every one of ``ways``, within :data:`REFUGE` m.
+
+        Off a way as :meth:`_keep_off_ways` counts it, over the floor a person fits on, round
+        the robots (``robots``: (M, 3) circles of their bodies, kept a body and :data:`ROOM`
+        off); None when there is none.
+        """
+        grid = self.routes.planner.grid
+        bodies = robots.copy()
+        bodies[:, 2] += self.settings.radius + ROOM
+        walk = way_off(self._clearance, grid.origin_x, grid.origin_y, grid.resolution,
+                       person.x, person.y, self.settings.radius, REFUGE, np.concatenate(ways),
+                       self._way_room + grid.resolution, bodies)
+        return walk if len(walk) else None
+
+    def _to_refuge(self, person: Person, step: float) -> bool:
+        """One step of ``person`` along their walk to a refuge; whether one was free."""
+        assert person.refuge is not None
+        here = np.array((person.x, person.y))
+        walk = person.refuge
+        while len(walk) and step > 0.0:
+            gap = float(np.hypot(*(walk[0] - here)))
+            if gap > step:
+                here = here + (walk[0] - here) * (step / gap)
+                break
+            here, walk, step = walk[0], walk[1:], step - gap
+        to = (float(here[0]), float(here[1]))
+        if not self._free(person, to, squeeze=True):
+            person.refuge = None
+            return False
+        person.refuge = walk if len(walk) else None
+        self._move(person, to)
+        return True
+
+    def _aside(self, person: Person, way: np.ndarray, gap: float, nearest: int,
+               step: float) -> bool:
+        """One step of ``person`` aside from ``way``; whether one was free.
 
         ``gap`` is their distance to the way, ``nearest`` the index of its point nearest to
         them. Aside (the side away from the robot, at the way's first point, first) counts
         only when it takes them almost a whole step further from the way (a bend of the way
-        round them, or a wall, leaves no such step); else they walk on along it, towards a point
-        more than a step further on than the nearest, following its bends to where there is
-        room aside. Squeezing past other people, brushing walls.
+        round them, or a wall, leaves no such step). Squeezing past other people.
         """
         ux, uy = way[min(nearest + 1, len(way) - 1)] - way[max(nearest - 1, 0)]
         norm = math.hypot(ux, uy) or 1.0
@@ -107,6 +157,15 @@ class RoomForRobots:
                     >= gap + 0.8 * step and self._free(person, to, squeeze=True)):
                 self._move(person, to)
                 return True
+        return False
+
+    def _step_off(self, person: Person, way: np.ndarray, nearest: int, step: float) -> bool:
+        """One step of ``person`` on along ``way``, off it where there is room; whether free.
+
+        ``nearest`` is the index of its point nearest to them. They walk towards a point more
+        than a step further on than the nearest, following its bends to where there is room
+        aside, brushing walls; from a pocket beside the way, back to it first.
+        """
         spacing = math.hypot(*(way[1] - way[0])) or 1.0
         onward = min(nearest + 2 + int(step / spacing), len(way) - 1)
         dx, dy = way[onward, 0] - person.x, way[onward, 1] - person.y  # on along the way
@@ -224,9 +283,14 @@ class RoomForRobots:
         return False
 
     def _move(self, person: Person, to: Point) -> None:
-        """Put ``person`` at ``to``, a step off their way: the way back and on pass here."""
+        """Put ``person`` at ``to``, a step off their way: the way back and on pass here.
+
+        Here joins the way back only where its last corner is out of sight from ``to``: steps
+        to and fro beside a robot leave a way back as short as the way they came.
+        """
         here = (person.x, person.y)
-        person.trail.append(here)
+        if not person.trail or not self._clear(to, np.array(person.trail[-1]), 0.0):
+            person.trail.append(here)
         route = person.route  # corners close by in sight of the next are passed over
         while (len(route) > 1 and math.dist(route[0], to) <= REJOIN
                and self._clear(to, route[1], 0.0)):
