@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Install everything the checks need, then lint, type-check and run the whole test suite.
 # Usage: bash scripts/test.sh [pytest arguments]
+#        bash scripts/test.sh --quick [pytest arguments]   the unit tier only, on two workers
+#        (tests/conftest.py marks each test unit, bus, subprocess, browser, system or soak)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,4 +25,8 @@ fi
 python3 -m pip install -q --disable-pip-version-check -c constraints.txt -e ".[dev]"
 python3 -m ruff check src tests benchmarks
 python3 -m mypy
+if [ "${1:-}" = "--quick" ]; then
+    shift
+    exec python3 -m pytest -m unit -n 2 "$@"
+fi
 python3 -m pytest "$@"

@@ -67,3 +67,37 @@ def _restore_registered_nodes() -> Iterator[None]:
     registry._REGISTERED._types.update(saved)
     registry._REGISTERED._overridden.clear()
     registry._REGISTERED._overridden.update(overridden)
+
+
+TIERS = ("unit", "bus", "subprocess", "browser", "system", "soak")
+"""The tiers every test falls in, marked automatically (pyproject.toml registers them):
+``scripts/test.sh --quick`` runs the unit tier; the whole suite runs them all."""
+
+
+def _tier_of(item: pytest.Item) -> str:
+    """The tier of one test, from where it is and what it uses (its fixtures, its module)."""
+    path = Path(str(item.fspath))
+    module = getattr(item, "module", None)
+    names = vars(module) if module is not None else {}
+    fixtures = set(getattr(item, "fixturenames", ()))
+    if item.get_closest_marker("soak") is not None:
+        return "soak"
+    if "system" in path.parts or path.name == "test_doc_commands.py":
+        return "system"
+    if "browser" in fixtures or "browser" in path.name or "sync_playwright" in names:
+        return "browser"
+    if "subprocess" in names or "Popen" in names:
+        return "subprocess"
+    if "bus" in fixtures or "Context" in names or "BusConfig" in names:
+        return "bus"
+    if item.get_closest_marker("heavy") is not None:
+        return "system"
+    return "unit"
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Marks each test with its tier (see :data:`TIERS`)."""
+    for item in items:
+        tier = _tier_of(item)
+        if item.get_closest_marker(tier) is None:
+            item.add_marker(getattr(pytest.mark, tier))
