@@ -1,4 +1,4 @@
-"""The grid search: cheapest paths, and no path where the goal's side is closed."""
+"""The grid search: cheapest paths, no path where a side is closed, and a side kept closed."""
 
 from __future__ import annotations
 
@@ -10,7 +10,11 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cyborg.nav.search import SQRT2, astar
+from cyborg.nav.arnl_map import parse_map
+from cyborg.nav.geometry import Pose2D
+from cyborg.nav.planner import Planner, SearchMemory
+from cyborg.nav.search import SQRT2, START_SIDE, astar, search, still_closed
+from tests.small_maps import corridor_map
 
 
 def cheapest(cost: np.ndarray, start: int, goal: int) -> float:
@@ -93,3 +97,47 @@ def test_a_goal_on_a_closed_side_has_no_path_and_an_open_one_has() -> None:
     cost[30, 20] = 1.0
     cells = astar(cost, start, goal)
     assert cells[0] == start and cells[-1] == goal and 30 * 200 + 20 in cells
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**31), st.integers(0, 30), st.integers(0, 30))
+def test_a_side_still_closed_after_changes_has_no_path_indeed(seed: int, opened: int,
+                                                               closed: int) -> None:
+    """A search that found no path, then cells opened and closed at random: when its side is
+    said to be still closed, a search finds no path either; when one does, it was not said."""
+    random = np.random.default_rng(seed)
+    rows, columns = 12, 16
+    cost = 1.0 + random.random((rows, columns))
+    cost[:, 7] = np.inf  # a wall across, with the start west of it and the goal east
+    cost[random.random((rows, columns)) < 0.2] = np.inf
+    start, goal = 5 * columns + 2, 6 * columns + 12
+    cost.flat[start] = cost.flat[goal] = 1.0
+    cells, region, side = search(cost, start, goal)
+    if len(cells):
+        return
+    passable, region = np.isfinite(cost), region.reshape(cost.shape).copy()
+    later = cost.copy()
+    for index in random.integers(rows * columns, size=opened):
+        later.flat[index] = 1.0
+    for index in random.integers(rows * columns, size=closed):
+        later.flat[index] = np.inf
+    later.flat[start] = later.flat[goal] = 1.0
+    target = goal if side == START_SIDE else start
+    if still_closed(later, passable, region, target):
+        assert len(astar(later, start, goal)) == 0
+    assert np.array_equal(passable, np.isfinite(later))
+
+
+def test_a_planner_with_memory_answers_as_without_and_searches_less() -> None:
+    """A robot waiting behind a person in a corridor asks every second: the same answers, with
+    or without memory; with it, a search only when the person stepped away."""
+    planner = Planner(parse_map(corridor_map(1.6)))
+    memory = SearchMemory()
+    start, goal = Pose2D(1.0, 0.8), Pose2D(13.0, 0.8)
+    people = [(6.0, 0.8)] * 5 + [(6.0, 0.85)] * 3 + [(6.0, 3.0)] + [(7.0, 0.8)] * 3
+    for x, y in people:
+        discs = np.array([(x, y, 0.4)])
+        with_memory = planner.plan(start, goal, discs=discs, memory=memory)
+        without = planner.plan(start, goal, discs=discs)
+        assert (with_memory.code, with_memory.length) == (without.code, without.length)
+    assert memory.searches < len(people) - 4

@@ -159,3 +159,16 @@ def test_a_wait_ends_where_the_laser_sees_only_the_maps_walls(shared: Path) -> N
         if sim.navigator.state is not states[-1]:
             states.append(sim.navigator.state)
     assert sim.navigator.state is PathState.REACHED_GOAL, (states, sim.navigator.message)
+
+
+def test_a_robot_nosed_against_a_wall_corner_drives_on_round_it(shared: Path) -> None:
+    # AMROffice: a robot that had stopped for a person at a corridor's end faces the corner of
+    # the wall beside it, its path turning away round it: the corner, in the corridor ahead as
+    # wide as the robot, stopped the follower at every plan (two minutes of FAILED_MOVE); the
+    # map's walls are the path's and the motion check's to keep clear of, not a stop
+    sim = Simulator(read_map(shared / "maps" / "AMROffice.map"), Pose2D(-6.878, -0.225, 0.70))
+    assert sim.go_to("Outside").found
+    sim.run(15.0)
+    assert sim.navigator.state is PathState.MOVING_TO_GOAL, sim.navigator.message
+    assert math.hypot(sim.pose.x + 6.878, sim.pose.y + 0.225) > 2.0, "on its way"
+    assert sim.base.bumps == 0

@@ -35,7 +35,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Path, Pose2D
 from cyborg.nav.grid import MapGrid
-from cyborg.nav.search import astar, shortcut
+from cyborg.nav.search import START_SIDE, astar, search, shortcut, still_closed
 from cyborg.nav.temporary_obstacles import clear_of
 
 
@@ -78,6 +78,38 @@ class PlanResult:
     def length(self) -> float:
         """Metres along the path; infinity without one."""
         return self.path.length if self.path is not None else math.inf
+
+
+@dataclass
+class ClosedSide:
+    """What a plan that found no path learned: the side of start or goal it found closed.
+
+    ``goal`` is the flat cell planned to, ``passable`` the cells that were finite, ``region``
+    the closed side (:func:`~cyborg.nav.search.search`'s), ``from_start`` whether it is the
+    start's side.
+    """
+
+    goal: int
+    passable: np.ndarray
+    region: np.ndarray
+    from_start: bool
+
+
+class SearchMemory:
+    """Lets a planner asked again for the same start and goal say "still no path" quickly.
+
+    A robot waiting for people to clear its way plans again every second from where it
+    stands; each plan without a path searched every cell it could reach. Given one of these,
+    :meth:`Planner.plan` keeps what a plan without a path found closed, and the next plan to
+    the same goal cell, from a start on the closed start's side (or off the closed goal's),
+    first asks whether that side can have opened (:func:`~cyborg.nav.search.still_closed`):
+    only then does it search. The answer is the one a search would give.
+    """
+
+    def __init__(self) -> None:
+        self.closed: ClosedSide | None = None
+        self.searches = 0
+        """Plans that searched (not answered from what was kept)."""
 
 
 class Planner:
@@ -126,12 +158,13 @@ class Planner:
 
     # ------------------------------------------------------------------ planning
     def plan(self, start: Pose2D, goal: Pose2D, *, use_heading: bool = False,
-             obstacles: np.ndarray | None = None,
-             discs: np.ndarray | None = None) -> PlanResult:
+             obstacles: np.ndarray | None = None, discs: np.ndarray | None = None,
+             memory: SearchMemory | None = None) -> PlanResult:
         """Plan from ``start`` to ``goal``.
 
         ``obstacles``: extra (N, 2) points (sensed ones), blocked like walls; ``discs``: (N, 3)
-        temporary obstacles (centre x, y and keep-out radius, m), see the module.
+        temporary obstacles (centre x, y and keep-out radius, m), see the module; ``memory``
+        keeps what a plan without a path found, for the next between the same cells.
         """
         began = time.perf_counter()
         problem = self.check(start, "start") or self.check(goal, "goal")
@@ -156,8 +189,8 @@ class Planner:
             return PlanResult(None, GOAL_OCCUPIED,
                               f"goal ({goal.x:.2f}, {goal.y:.2f}) is taken by an obstacle "
                               f"seen there", time.perf_counter() - began)
-        cells = astar(cost, start_cell[0] * columns + start_cell[1],
-                      goal_cell[0] * columns + goal_cell[1])
+        cells = self._search(cost, start_cell[0] * columns + start_cell[1],
+                             goal_cell[0] * columns + goal_cell[1], memory)
         if len(cells) == 0:
             return PlanResult(None, NO_VALID_PATH,
                               f"no path from ({start.x:.2f}, {start.y:.2f}) to "
@@ -166,6 +199,26 @@ class Planner:
         path = self._smooth(cells, clearance, start, goal)
         return PlanResult(Path(path, goal.theta if use_heading else None),
                           planning_time=time.perf_counter() - began)
+
+    @staticmethod
+    def _search(cost: np.ndarray, start: int, goal: int,
+                memory: SearchMemory | None) -> np.ndarray:
+        """:func:`~cyborg.nav.search.astar`'s cells, answered from ``memory`` where it can."""
+        known = memory.closed if memory is not None else None
+        if (known is not None and known.goal == goal and known.passable.shape == cost.shape
+                and bool(np.isfinite(cost.flat[goal])) == bool(known.passable.flat[goal])
+                # a start on the closed start's side (it reaches what that start reached),
+                # or off the closed goal's side
+                and bool(known.region.flat[start]) == known.from_start
+                and still_closed(cost, known.passable, known.region,
+                                 goal if known.from_start else start)):
+            return np.zeros(0, np.int64)
+        cells, region, side = search(cost, start, goal)
+        if memory is not None:
+            memory.searches += 1
+            memory.closed = None if len(cells) or not side else ClosedSide(
+                goal, np.isfinite(cost), region.reshape(cost.shape), side == START_SIDE)
+        return cells
 
     def passable_near(self, start: Pose2D, goal: Pose2D, obstacles: np.ndarray,
                       margin: float) -> bool:

@@ -20,9 +20,32 @@ FLOOD_EVERY = 4
 """Steps of the search per step of :func:`astar`'s flood from the goal."""
 
 
+NOWHERE = 0
+"""What :func:`search` says of its region when it found a path (or learned nothing)."""
+START_SIDE = 1
+"""The region :func:`search` returns is every cell the start reaches (not the goal)."""
+GOAL_SIDE = 2
+"""The region :func:`search` returns is every cell that reaches the goal (not the start)."""
+
+
 @njit(cache=True)
 def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no cover - jit
     """Cells (flat indices) of a cheapest 8-connected path from start to goal; empty if none.
+
+    See :func:`search`.
+    """
+    return search(cost, start, goal)[0]
+
+
+@njit(cache=True)
+def search(cost: np.ndarray, start: int,
+           goal: int) -> tuple[np.ndarray, np.ndarray, int]:  # pragma: no cover - jit
+    """:func:`astar`'s path, and without one the side it found closed: ``(path, region, side)``.
+
+    ``region`` (flat booleans) is the start's side (``side`` :data:`START_SIDE`: every cell
+    the start reaches) or the goal's (:data:`GOAL_SIDE`: every cell that reaches the goal),
+    whichever the search closed first; :data:`NOWHERE` with a path (or a goal that cannot be
+    entered).
 
     The open cells wait in a binary heap ordered by estimate, then cell (so ties go the same
     way every time). Beside the search, one step in :data:`FLOOD_EVERY`, a flood from the goal
@@ -43,7 +66,7 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
     cells = np.empty(capacity, np.int64)
     keys[0], cells[0], count = 0.0, start, 1
     if goal != start and not np.isfinite(flat[goal]):
-        return np.zeros(0, np.int64)  # the search enters finite cells only
+        return np.zeros(0, np.int64), closed, NOWHERE  # it enters finite cells only
     back = np.zeros(size, np.bool_)  # the flood from the goal
     queue = np.empty(size, np.int64)
     queue[0], back[goal], head, tail = goal, True, 0, 1
@@ -53,7 +76,7 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
         turn += 1
         if flooding and turn % FLOOD_EVERY == 0:
             if head == tail:  # the goal's side is closed, without the start in it
-                return np.zeros(0, np.int64)
+                return np.zeros(0, np.int64), back, GOAL_SIDE
             tail = _flood(flat, rows, columns, back, queue, head, tail)
             head += 1
             flooding = not back[start]
@@ -95,7 +118,7 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
                 _sift_up(keys, cells, count, candidate + h, neighbour)
                 count += 1
     if parent[goal] < 0 and goal != start:
-        return np.zeros(0, np.int64)
+        return np.zeros(0, np.int64), closed, START_SIDE
     length = 1
     cell = goal
     while cell != start:
@@ -106,7 +129,73 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
     for index in range(length - 1, -1, -1):
         path[index] = cell
         cell = parent[cell]
-    return path
+    return path, closed, NOWHERE
+
+
+@njit(cache=True)
+def still_closed(cost: np.ndarray, passable: np.ndarray, region: np.ndarray,
+                 target: int) -> bool:  # pragma: no cover - jit
+    """Whether a side :func:`search` found closed on a cost grid is still closed on ``cost``.
+
+    ``passable`` (booleans, the grid's shape) are the cells that were finite then, ``region``
+    the side then (as :func:`search` gave it, or grown here since), ``target`` the cell it did
+    not hold (the goal for the start's side, the start for the goal's). Whatever changed, the
+    side can now only hold its cells and those it reaches through cells newly finite next to
+    it; when those do not take in ``target``, no path can pass: True. Both are brought up to
+    ``cost`` (``region`` grown by what was reached), to be asked again after the next change.
+    The cells at either end must be finite (or not) as they were.
+    """
+    rows, columns = cost.shape
+    flat, was, inside = cost.ravel(), passable.ravel(), region.ravel()
+    queue = np.empty(rows * columns, np.int64)
+    tail = 0
+    for cell in range(rows * columns):
+        now = np.isfinite(flat[cell])
+        if now and not was[cell] and not inside[cell] and _beside(flat, inside, rows, columns,
+                                                                   cell):
+            inside[cell] = True
+            queue[tail] = cell
+            tail += 1
+        was[cell] = now
+    head = 0
+    while head < tail:
+        cell = queue[head]
+        head += 1
+        if cell == target:
+            return False
+        r, c = cell // columns, cell % columns
+        for k in range(8):
+            dr, dc = _DR[k], _DC[k]
+            nr, nc = r + dr, c + dc
+            if nr < 0 or nr >= rows or nc < 0 or nc >= columns:
+                continue
+            neighbour = nr * columns + nc
+            if inside[neighbour] or not np.isfinite(flat[neighbour]):
+                continue
+            if dr != 0 and dc != 0 and (not np.isfinite(flat[r * columns + nc])
+                                        or not np.isfinite(flat[nr * columns + c])):
+                continue
+            inside[neighbour] = True
+            queue[tail] = neighbour
+            tail += 1
+    return True
+
+
+@njit(cache=True)
+def _beside(flat: np.ndarray, inside: np.ndarray, rows: int, columns: int,
+            cell: int) -> bool:  # pragma: no cover - jit
+    """Whether one step joins finite ``cell`` and a cell ``inside`` (as :func:`astar` steps)."""
+    r, c = cell // columns, cell % columns
+    for k in range(8):
+        dr, dc = _DR[k], _DC[k]
+        nr, nc = r + dr, c + dc
+        if nr < 0 or nr >= rows or nc < 0 or nc >= columns or not inside[nr * columns + nc]:
+            continue
+        if dr != 0 and dc != 0 and (not np.isfinite(flat[r * columns + nc])
+                                    or not np.isfinite(flat[nr * columns + c])):
+            continue
+        return True
+    return False
 
 
 _DR = (-1, -1, -1, 0, 0, 1, 1, 1)

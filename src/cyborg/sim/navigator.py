@@ -36,7 +36,7 @@ from numba import njit
 
 from cyborg.interfaces.robot import PathState as PathState
 from cyborg.nav.geometry import Path, Pose2D
-from cyborg.nav.planner import Planner, PlanResult
+from cyborg.nav.planner import Planner, PlanResult, SearchMemory
 from cyborg.nav.temporary_obstacles import (
     ObstacleSettings,
     TemporaryObstacles,
@@ -101,6 +101,7 @@ class Navigator:
         self._ahead_since: float | None = None  # since when the laser sees the path blocked
         self._blocked_way: Path | None = None  # the way a wait is for
         self._aside: PathFollower | None = None  # making way: the path to the place aside
+        self._memory = SearchMemory()  # what a plan past obstacles without a path found
         self.making_way = False
         """Whether the robot makes way for another (see :meth:`make_way`)."""
 
@@ -180,24 +181,24 @@ class Navigator:
 
     def update(self, now: float, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
                hits: np.ndarray, motion: Motion | None = None,
-               period: float = 0.1) -> tuple[float, float]:
+               period: float = 0.1, mount: float = 0.0) -> tuple[float, float]:
         """Speed (m/s) and turn rate (rad/s) for the next ``period`` seconds.
 
-        ``ranges`` and ``angles`` are the latest scan's, ``hits`` its returns as map points;
-        ``motion``: how the robot moves now (its odometry). With ``motion``, a command whose
-        motion until standstill would touch a wall or a return is replaced by a gentler one
+        ``ranges`` and ``angles`` are the latest scan's (from a scanner ``mount`` m ahead of
+        the robot's centre), ``hits`` its returns as map points; ``motion``: how the robot
+        moves now (its odometry). With ``motion``, a command whose motion until standstill
+        would touch a wall or a return is replaced by a gentler one
         (:func:`cyborg.sim.motion_check.safest_command`). Zero unless moving to a goal;
         braking while waiting for a way past temporary obstacles.
         """
         if self.making_way:
-            return self._step_aside(pose, ranges, angles, hits, motion, period)
+            return self._step_aside(pose, self._front(pose, ranges, angles, mount), hits,
+                                    motion, period)
         if self.state is PathState.WAITING_FOR_PATH:
             return self._wait(now, pose, hits, motion, period)
         if self.state is not PathState.MOVING_TO_GOAL or self.follower is None:
             return 0.0, 0.0
-        slow, stop = front_ranges(ranges, angles,
-                                  (SLOW_CORRIDOR, self.planner.footprint.width / 2))
-        command = self.follower.update(pose, slow, stop)
+        command = self.follower.update(pose, *self._front(pose, ranges, angles, mount))
         self.remaining = command.remaining
         if command.arrived:
             self.state, self.message, self.follower = PathState.REACHED_GOAL, "", None
@@ -232,15 +233,33 @@ class Navigator:
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
         return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
 
-    def _step_aside(self, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
-                    hits: np.ndarray, motion: Motion | None,
-                    period: float) -> tuple[float, float]:
-        """Drive to the place aside while making way, then stand there."""
+    def _front(self, pose: Pose2D, ranges: np.ndarray, angles: np.ndarray,
+               mount: float) -> tuple[float, float]:
+        """The nearest return ahead in the corridor that slows and in the one that stops it.
+
+        The robot slows for whatever is near ahead, and stops only for what the map does not
+        know (returns further than :data:`MAPPED` m from its walls): the path keeps clear of
+        the walls and the motion check keeps the robot off them, while a wall corner ahead of
+        a robot whose path turns away round it would stop it for good.
+        """
+        slow, = front_ranges(ranges, angles, (SLOW_CORRIDOR,))
+        heading = pose.theta + angles
+        points = np.column_stack([
+            pose.x + mount * math.cos(pose.theta) + ranges * np.cos(heading),
+            pose.y + mount * math.sin(pose.theta) + ranges * np.sin(heading)])
+        usable: np.ndarray = np.all(np.isfinite(points), axis=1)
+        rows, columns = self.planner.grid.cells_of(np.where(usable[:, None], points, 0.0))
+        mapped = usable & (self.planner.wall_clearance[rows, columns] <= MAPPED)
+        stop, = front_ranges(np.where(mapped, np.inf, ranges), angles,
+                             (self.planner.footprint.width / 2,))
+        return slow, stop
+
+    def _step_aside(self, pose: Pose2D, front: tuple[float, float], hits: np.ndarray,
+                    motion: Motion | None, period: float) -> tuple[float, float]:
+        """Drive to the place aside while making way, then stand there (``front``: ranges)."""
         if self._aside is None:
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
-        slow, stop = front_ranges(ranges, angles,
-                                  (SLOW_CORRIDOR, self.planner.footprint.width / 2))
-        command = self._aside.update(pose, slow, stop)
+        command = self._aside.update(pose, *front)
         if command.arrived:
             self._aside = None
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
@@ -318,7 +337,7 @@ class Navigator:
         assert self.goal is not None
         near = self._unmapped(pose, hits)
         return self.planner.plan(pose, self.goal, use_heading=self.use_heading, obstacles=near,
-                                 discs=discs)
+                                 discs=discs, memory=self._memory)
 
     def _way_ahead_open(self, pose: Pose2D, hits: np.ndarray) -> bool:
         """Whether a way past what the laser sees on the path ahead opens near the robot.

@@ -361,7 +361,8 @@ class Simulator:
         if self._teleop is not None:
             return self._drive_by_hand(self._teleop)
         return self.navigator.update(self.time, self.base.pose, self.ranges, self.angles,
-                                     self._obstacles(), self._motion(), self._period)
+                                     self._obstacles(), self._motion(), self._period,
+                                     self.laser.spec.mount_x)
 
     def _obstacles(self) -> np.ndarray:
         """What the robot knows is in its way: the laser's returns and the other robots."""
@@ -383,7 +384,8 @@ class Simulator:
                                pose.y - docking.travelled_from[1])
         if docking.phase is DockPhase.APPROACH:
             command = self.navigator.update(now, pose, self.ranges, self.angles,
-                                            self._obstacles(), self._motion(), self._period)
+                                            self._obstacles(), self._motion(), self._period,
+                                            self.laser.spec.mount_x)
             state = self.navigator.state
             if state is PathState.REACHED_GOAL:
                 docking.enter(DockState.DOCKING, DockPhase.DRIVE_IN, now, (pose.x, pose.y))
