@@ -144,6 +144,28 @@ def test_two_robots_meeting_head_on_in_a_doorway_settle_it_and_both_arrive() -> 
     assert first.base.bumps == second.base.bumps == 0
 
 
+def test_a_robot_in_the_doorway_backs_out_to_make_way_for_one_beyond_it() -> None:
+    # the second stands in the door, the first just beyond it in a passage as narrow as the
+    # door: the second makes way back in the room it came from (not past the first, on its
+    # side), backing out of the door
+    passage = [(5000, 2400, 8000, 2400), (5000, 3600, 8000, 3600)]
+    fleet = Fleet(parse_map(room_map([], lines=passage)), 2, start=Pose2D(6.3, 3.0, math.pi))
+    first, second = fleet.simulators
+    assert second.set_pose(Pose2D(5.0, 3.0, 0.0)) is None
+    assert first.go_to(Pose2D(1.5, 3.0)).found and second.go_to(Pose2D(8.5, 3.0)).found
+    backed, beyond = False, False
+    while fleet.time < 120 and not (first.navigator.state.finished
+                                    and second.navigator.state.finished):
+        fleet.step()
+        backed |= second.navigator.making_way and second.base.speed < 0.0
+        beyond |= second.navigator.making_way and second.pose.x > 5.6
+        assert polygon_gap(first.outline, second.outline) >= 0.0
+    assert fleet.way_giving.settled >= 1 and backed and not beyond
+    assert (first.navigator.state, second.navigator.state) == (robot.PathState.REACHED_GOAL,
+                                                               robot.PathState.REACHED_GOAL)
+    assert first.base.bumps == second.base.bumps == 0
+
+
 @pytest.mark.heavy
 def test_a_fleet_on_the_bus_has_one_clock_and_a_namespace_and_frames_per_robot() -> None:
     with Context(BusConfig.isolated()) as context:

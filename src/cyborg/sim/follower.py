@@ -183,3 +183,54 @@ def _nearest_ahead(ranges: np.ndarray, angles: np.ndarray, half_widths: np.ndarr
                 found[corridor] = along
     return found
 
+
+
+@njit(cache=True)
+def ahead_of_the_map(ranges: np.ndarray, angles: np.ndarray, x: float, y: float, theta: float,
+                     clearance: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                     mapped: float, slow_width: float, stop_width: float,
+                     range_max: float = 30.0) -> tuple[float, float]:  # pragma: no cover - jit
+    """:func:`front_ranges` for two corridors, the second blind to the map's walls.
+
+    The scanner stands at ``(x, y)`` facing ``theta``; a return whose point lies in a cell of
+    the ``clearance`` grid (metres to the map's walls; points off it count as its edge) less
+    than ``mapped`` m from a wall is not seen in the ``stop_width`` corridor.
+    """
+    rows, columns = clearance.shape
+    slow, stop = np.inf, np.inf
+    for beam in range(ranges.shape[0]):
+        if not ranges[beam] <= range_max or abs(angles[beam]) >= math.pi / 2:
+            continue
+        along = ranges[beam] * math.cos(angles[beam])
+        side = abs(ranges[beam] * math.sin(angles[beam]))
+        if side <= slow_width and along < slow:
+            slow = along
+        if side <= stop_width and along < stop:
+            px = x + ranges[beam] * math.cos(theta + angles[beam])
+            py = y + ranges[beam] * math.sin(theta + angles[beam])
+            r = min(max(math.floor((py - origin_y) / resolution), 0), rows - 1)
+            c = min(max(math.floor((px - origin_x) / resolution), 0), columns - 1)
+            if clearance[r, c] > mapped:
+                stop = along
+    return slow, stop
+
+
+@njit(cache=True)
+def any_within(points: np.ndarray, others: np.ndarray,
+               limit: float) -> bool:  # pragma: no cover - jit
+    """Whether a point of ``points`` lies closer than ``limit`` to one of ``others``.
+
+    Points outside the box around ``others`` grown by ``limit`` are passed over at once: of a
+    scan's returns, only the few near the path ahead are measured against it.
+    """
+    low_x, high_x = others[:, 0].min() - limit, others[:, 0].max() + limit
+    low_y, high_y = others[:, 1].min() - limit, others[:, 1].max() + limit
+    squared = limit * limit
+    for i in range(points.shape[0]):
+        px, py = points[i, 0], points[i, 1]
+        if px < low_x or px > high_x or py < low_y or py > high_y:
+            continue
+        for j in range(others.shape[0]):
+            if (px - others[j, 0]) ** 2 + (py - others[j, 1]) ** 2 < squared:
+                return True
+    return False

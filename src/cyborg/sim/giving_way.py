@@ -150,8 +150,9 @@ def place_aside(planner: Planner, start: Pose2D, way: np.ndarray,
     Beside: the robot's centre :data:`BESIDE` m from every point of the way (the other robot's,
     (N, 2)) and from the other robot at ``other``, in a cell the planner lets it stand on.
     Nearest by steps over such cells from ``start`` (near it, cells clearing the robot's
-    inscribed radius too, as the planner's escape), around the other robot's body, within
-    :data:`SEARCH` m.
+    inscribed radius too, as the planner's escape), round the other robot by both bodies'
+    circumscribed radii, or as far as it is now if nearer, never closer (a robot in a doorway
+    with the other at its far side makes way back, not past it), within :data:`SEARCH` m.
     """
     grid = planner.grid
     row, column = grid.cell(start.x, start.y)
@@ -166,8 +167,9 @@ def place_aside(planner: Planner, start: Pose2D, way: np.ndarray,
     escape = ((xs[None, :] - start.x) ** 2 + (ys[:, None] - start.y) ** 2
               <= planner.settings.escape_radius ** 2)
     passable = (clearance >= planner.lethal) | (escape & (clearance >= planner.tight))
+    keep = min(2 * planner.lethal, math.hypot(start.x - other.x, start.y - other.y))
     passable &= ((xs[None, :] - other.x) ** 2 + (ys[:, None] - other.y) ** 2
-                 >= (planner.lethal + planner.tight) ** 2)  # not through the other's body
+                 >= keep ** 2)  # never closer to the other, nor past it however it turns
     points = np.vstack([way, [(other.x, other.y)]]) if len(way) else np.array(
         [(other.x, other.y)])
     beside = np.ones(passable.shape, bool)

@@ -32,10 +32,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from cyborg.interfaces.robot import PathState as PathState
-from cyborg.nav.geometry import Path, Pose2D
+from cyborg.nav.geometry import Path, Pose2D, normalize_angle
 from cyborg.nav.planner import Planner, PlanResult, SearchMemory
 from cyborg.nav.temporary_obstacles import (
     ObstacleSettings,
@@ -43,7 +42,13 @@ from cyborg.nav.temporary_obstacles import (
     clear_of,
     path_blocked,
 )
-from cyborg.sim.follower import SLOW_CORRIDOR, FollowerSettings, PathFollower, front_ranges
+from cyborg.sim.follower import (
+    SLOW_CORRIDOR,
+    FollowerSettings,
+    PathFollower,
+    ahead_of_the_map,
+    any_within,
+)
 from cyborg.sim.motion_check import Motion, Surroundings, safest_command
 
 MAPPED = 0.15
@@ -101,6 +106,7 @@ class Navigator:
         self._ahead_since: float | None = None  # since when the laser sees the path blocked
         self._blocked_way: Path | None = None  # the way a wait is for
         self._aside: PathFollower | None = None  # making way: the path to the place aside
+        self._backing: bool | None = None  # whether it backs to the place aside
         self._memory = SearchMemory()  # what a plan past obstacles without a path found
         self.making_way = False
         """Whether the robot makes way for another (see :meth:`make_way`)."""
@@ -167,6 +173,7 @@ class Navigator:
         wait for the other to pass, not a stall) until :meth:`resume`.
         """
         self.making_way, self._aside = True, PathFollower(aside, False, self.settings.follower)
+        self._backing = None  # decided at the first step aside
         self.state, self.message = PathState.WAITING_FOR_PATH, why
         self._waiting_since = self._tried_at = now
         self.follower = None
@@ -242,28 +249,41 @@ class Navigator:
         the walls and the motion check keeps the robot off them, while a wall corner ahead of
         a robot whose path turns away round it would stop it for good.
         """
-        slow, = front_ranges(ranges, angles, (SLOW_CORRIDOR,))
-        heading = pose.theta + angles
-        points = np.column_stack([
-            pose.x + mount * math.cos(pose.theta) + ranges * np.cos(heading),
-            pose.y + mount * math.sin(pose.theta) + ranges * np.sin(heading)])
-        usable: np.ndarray = np.all(np.isfinite(points), axis=1)
-        rows, columns = self.planner.grid.cells_of(np.where(usable[:, None], points, 0.0))
-        mapped = usable & (self.planner.wall_clearance[rows, columns] <= MAPPED)
-        stop, = front_ranges(np.where(mapped, np.inf, ranges), angles,
-                             (self.planner.footprint.width / 2,))
+        grid = self.planner.grid
+        slow, stop = ahead_of_the_map(
+            np.ascontiguousarray(ranges, dtype=np.float64),
+            np.ascontiguousarray(angles, dtype=np.float64),
+            pose.x + mount * math.cos(pose.theta), pose.y + mount * math.sin(pose.theta),
+            pose.theta, self.planner.wall_clearance, grid.origin_x, grid.origin_y,
+            grid.resolution, MAPPED, SLOW_CORRIDOR, self.planner.footprint.width / 2)
         return slow, stop
 
     def _step_aside(self, pose: Pose2D, front: tuple[float, float], hits: np.ndarray,
                     motion: Motion | None, period: float) -> tuple[float, float]:
-        """Drive to the place aside while making way, then stand there (``front``: ranges)."""
+        """Drive to the place aside while making way, then stand there (``front``: ranges).
+
+        A place behind the robot (its way there leaving more than a right angle off its
+        heading) it backs to, slowly, as one backs out of a doorway rather than turn in it:
+        following the way as if it faced backwards, with no laser behind (the motion check
+        keeps it off what it knows is there).
+        """
         if self._aside is None:
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
-        command = self._aside.update(pose, *front)
+        path = self._aside.path
+        if self._backing is None:
+            x, y = path.point_at(min(path.length, self.settings.follower.lookahead))
+            self._backing = abs(normalize_angle(math.atan2(y - pose.y, x - pose.x)
+                                                - pose.theta)) > math.pi / 2
+        if self._backing:
+            command = self._aside.update(Pose2D(pose.x, pose.y, pose.theta + math.pi), math.inf)
+            speed = -min(command.speed, self.settings.follower.slow_speed)
+        else:
+            command = self._aside.update(pose, *front)
+            speed = command.speed
         if command.arrived:
             self._aside = None
             return self._checked(pose, (0.0, 0.0), hits, motion, period)
-        return self._checked(pose, (command.speed, command.turn_rate), hits, motion, period)
+        return self._checked(pose, (speed, command.turn_rate), hits, motion, period)
 
     def _checked(self, pose: Pose2D, command: tuple[float, float], hits: np.ndarray,
                  motion: Motion | None, period: float) -> tuple[float, float]:
@@ -387,24 +407,3 @@ class Navigator:
             self._best = result.length
         elif len(discs):
             self._start_waiting(now, len(discs), self.follower.path if self.follower else None)
-
-
-@njit(cache=True)
-def any_within(points: np.ndarray, others: np.ndarray,
-               limit: float) -> bool:  # pragma: no cover - jit
-    """Whether a point of ``points`` lies closer than ``limit`` to one of ``others``.
-
-    Points outside the box around ``others`` grown by ``limit`` are passed over at once: of a
-    scan's returns, only the few near the path ahead are measured against it.
-    """
-    low_x, high_x = others[:, 0].min() - limit, others[:, 0].max() + limit
-    low_y, high_y = others[:, 1].min() - limit, others[:, 1].max() + limit
-    squared = limit * limit
-    for i in range(points.shape[0]):
-        px, py = points[i, 0], points[i, 1]
-        if px < low_x or px > high_x or py < low_y or py > high_y:
-            continue
-        for j in range(others.shape[0]):
-            if (px - others[j, 0]) ** 2 + (py - others[j, 1]) ** 2 < squared:
-                return True
-    return False
