@@ -9,10 +9,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.spatial import ConvexHull
 
 from cyborg.nav.footprint import PIONEER_LX
 from cyborg.nav.geometry import Pose2D
 from cyborg.sim.bodies import (
+    braking_outline,
     braking_poses,
     cast_onto,
     grown,
@@ -87,6 +89,33 @@ def test_a_moving_robot_covers_its_braking_way() -> None:
         (0.0, 0.0), (0.0, 0.25), (0.0, 0.5), (0.0, 0.75), (0.0, 1.0)]
     backwards = braking_poses(Pose2D(0.0, 0.0, 0.0), -0.5, 0.5)
     assert backwards[-1].x == pytest.approx(-0.25) and len(backwards) == 2
+
+
+def test_the_ground_a_braking_robot_covers_is_outlined_round_every_pose_on_its_way() -> None:
+    """The swept outline's points lie on the edge of the smallest convex shape holding every
+    outline along the braking way, at most 5 cm apart: at 1 m/s forwards the front moves a
+    metre, backing the back."""
+    body = grown(PIONEER_LX.polygon(), 0.1)
+    for pose, speed in ((Pose2D(1.0, 2.0, 0.5), 1.0), (Pose2D(-1.0, 0.0, 2.0), -0.5),
+                        (Pose2D(0.0, 0.0, 0.0), 0.0)):
+        swept = braking_outline(body, pose, speed, 0.5)
+        steps = np.hypot(*np.diff(np.vstack([swept, swept[:1]]), axis=0).T)
+        assert steps.max() <= 0.05 + 1e-9
+        every = np.vstack([outline_at(body, along) for along in braking_poses(pose, speed, 0.5)])
+        hull = every[ConvexHull(every).vertices]
+        edges = list(zip(hull, np.roll(hull, -1, axis=0), strict=True))
+        for point in swept:
+            assert min(segment_distance(point, a, b) for a, b in edges) <= 1e-9
+        assert ConvexHull(swept).volume == pytest.approx(ConvexHull(every).volume)
+    ahead = braking_outline(body, Pose2D(0.0, 0.0, 0.0), 1.0, 0.5)
+    assert ahead[:, 0].max() == pytest.approx(body[:, 0].max() + 1.0)
+    assert ahead[:, 0].min() == pytest.approx(body[:, 0].min())
+
+
+def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Metres from ``point`` to the segment from ``a`` to ``b``."""
+    share = float(np.clip(np.dot(point - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0))
+    return float(np.hypot(*(point - a - share * (b - a))))
 
 
 def test_points_placed_at_several_poses() -> None:

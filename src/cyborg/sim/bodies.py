@@ -11,9 +11,9 @@ an obstacle to the others, exactly as drawn: a convex polygon (the footprint of
   :mod:`cyborg.sim.people`).
 * :func:`outline_points` samples an outline as points, which the motion check and the
   navigator take like laser returns (so a robot knows of another even behind its back, where
-  the laser is blind); placed (:func:`placed`) along a moving robot's braking way too
-  (:func:`braking_poses`), so that two robots driving at each other each keep out of the
-  other's way, not only out of where it is now.
+  the laser is blind); :func:`braking_outline` samples the outline of the ground a moving
+  robot covers along its braking way (:func:`braking_poses`), so that two robots driving at
+  each other each keep out of the other's way, not only out of where it is now.
 """
 
 from __future__ import annotations
@@ -295,3 +295,58 @@ def placed(points: np.ndarray, poses: list[Pose2D]) -> np.ndarray:
     cos, sin = np.cos(theta), np.sin(theta)
     px, py = points[:, 0][None, :], points[:, 1][None, :]
     return np.column_stack([(x + cos * px - sin * py).ravel(), (y + sin * px + cos * py).ravel()])
+
+
+def braking_outline(polygon: np.ndarray, pose: Pose2D, speed: float, deceleration: float,
+                    spacing: float = OUTLINE_SPACING) -> np.ndarray:
+    """Points along the outline of the ground a robot covers until it stands, braking straight.
+
+    ``polygon`` (K x 2, convex, counter-clockwise, in the robot's frame) swept along the
+    braking way of :func:`braking_poses` (at ``speed`` m/s, braking at ``deceleration``
+    m/s²) is the polygon with its front half moved forward by the way (its back half, when
+    backing): the outline of every pose along the way at once, at most ``spacing`` apart.
+    """
+    way = speed * abs(speed) / (2.0 * deceleration)
+    swept = np.array(polygon, dtype=np.float64)
+    if way != 0.0:
+        ahead = _leading(swept, way > 0.0)
+        swept[ahead, 0] += way
+    return _along(outline_at(swept, pose), spacing)
+
+
+def _leading(polygon: np.ndarray, forward: bool) -> np.ndarray:
+    """The corners of ``polygon`` on its front (``forward``) or back, from bottom to top.
+
+    Of a convex counter-clockwise polygon: those from its lowest corner to its highest going
+    round its front (the rightmost of equally low ones to the rightmost of equally high ones);
+    going round its back for the back. Moved along x, they and the rest outline the sweep.
+    """
+    ys, xs = polygon[:, 1], polygon[:, 0]
+    count = len(polygon)
+    low = min(range(count), key=lambda k: (ys[k], -xs[k] if forward else xs[k]))
+    high = min(range(count), key=lambda k: (-ys[k], -xs[k] if forward else xs[k]))
+    first, last = (low, high) if forward else (high, low)
+    steps = (last - first) % count
+    return np.array([(first + k) % count for k in range(steps + 1)], dtype=np.int64)
+
+
+@njit(cache=True)
+def _along(outline: np.ndarray, spacing: float) -> np.ndarray:  # pragma: no cover - jit
+    """:func:`outline_points`, compiled."""
+    count = outline.shape[0]
+    total = 0
+    for i in range(count):
+        j = (i + 1) % count
+        total += max(1, math.ceil(math.hypot(outline[j, 0] - outline[i, 0],
+                                             outline[j, 1] - outline[i, 1]) / spacing))
+    points = np.empty((total, 2))
+    index = 0
+    for i in range(count):
+        j = (i + 1) % count
+        dx, dy = outline[j, 0] - outline[i, 0], outline[j, 1] - outline[i, 1]
+        steps = max(1, math.ceil(math.hypot(dx, dy) / spacing))
+        for k in range(steps):
+            points[index, 0] = outline[i, 0] + k / steps * dx
+            points[index, 1] = outline[i, 1] + k / steps * dy
+            index += 1
+    return points

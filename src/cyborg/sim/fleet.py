@@ -41,7 +41,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import KEEP_CLEAR, braking_poses, grown, outline_points, placed
+from cyborg.sim.bodies import KEEP_CLEAR, braking_outline, grown
 from cyborg.sim.giving_way import WayGiving
 from cyborg.sim.loop import PacedLoop, SimulationLock
 from cyborg.sim.people import NOBODY, Crowd, Meeting
@@ -128,14 +128,15 @@ class Fleet:
                            for choice, charge in zip(starts, charges, strict=True)]
         self.start_choices = starts
         self._steps = 0
-        self._samples = [outline_points(grown(sim.base.footprint.polygon(), KEEP_CLEAR))
-                         for sim in self.simulators]  # around each body, in its own frame
+        self._grown = [grown(sim.base.footprint.polygon(), KEEP_CLEAR)
+                       for sim in self.simulators]  # around each body, in its own frame
         # centres further apart than this cannot touch within a physics step
         self._contact = 2 * max(sim.base.span for sim in self.simulators) + CONTACT_MARGIN
         self.crowd: Crowd | None = None  # people walking among the robots
         self.way_giving = WayGiving(count)  # robots that meet head-on settle it
         self._met: list[Meeting] = []
         self._touching: list[tuple[np.ndarray, ...]] = [()] * count  # people each may touch
+        self._braking: list[tuple[Pose2D, float, np.ndarray] | None] = [None] * count
 
     @property
     def map(self) -> ArnlMap:
@@ -155,9 +156,10 @@ class Fleet:
     def step(self) -> None:
         """Advance every robot one physics step, each meeting the others where they are now.
 
-        At each sensor step a robot also learns the points along the others' outlines and
-        their braking ways (:mod:`cyborg.sim.bodies`), which its navigator keeps clear of; the
-        fleet's ``crowd``, if any, walks then, and each robot meets the people too.
+        At each sensor step a robot also learns the points along the outline of the ground each
+        other one covers until it stands, braking (:func:`~cyborg.sim.bodies.braking_outline`),
+        which its navigator keeps clear of; the fleet's ``crowd``, if any, walks then, and each
+        robot meets the people too.
         """
         sensing = self._steps % self.steps_per_sensor == 0  # as each simulator counts
         self._steps += 1
@@ -176,9 +178,7 @@ class Fleet:
             met = self._met[index] if self._met else None
             if sensing:
                 near = self._near(index)
-                placed_points = [placed(self._samples[other], braking_poses(
-                    self.simulators[other].pose, self.simulators[other].base.speed,
-                    self.simulators[other].base.limits.acceleration)) for other in near]
+                placed_points = [self._braking_points(other) for other in near]
                 if met:
                     placed_points.append(met.points)
                     self._touching[index] = within(met.bodies, sim.pose,
@@ -194,6 +194,17 @@ class Fleet:
             outlines[index] = sim.outline  # where the next robot meets it
         if sensing and len(self.simulators) > 1:
             self.way_giving.step(self.simulators, self.time)
+
+    def _braking_points(self, index: int) -> np.ndarray:
+        """Points along robot ``index``'s outline and braking way (kept while it stands)."""
+        base = self.simulators[index].base
+        key = (base.pose, base.speed)
+        known = self._braking[index]
+        if known is None or known[0] is not key[0] or known[1] != key[1]:
+            points = braking_outline(self._grown[index], base.pose, base.speed,
+                                     base.limits.acceleration)
+            known = self._braking[index] = (base.pose, base.speed, points)
+        return known[2]
 
     def _near(self, index: int, reach: float | None = None) -> list[int]:
         """The indices of the robots on ``index``'s map within ``reach`` m (its laser's)."""

@@ -182,12 +182,17 @@ def _safest(x: float, y: float, theta: float, v: float, w: float, speed: float, 
                  radius)
     needed = min(margin, body_gap(x, y, theta, offsets, radius, clearance, ox, oy,
                                   resolution, near))
-    best, best_gap = candidates[0], -np.inf
-    for cmd_v, cmd_w in candidates:
+    for cmd_v, cmd_w in candidates:  # each played only until it fails
         gap = _motion_gap(x, y, theta, v, w, cmd_v, cmd_w, accel, turn_accel, dt, period,
-                          needed, offsets, radius, clearance, ox, oy, resolution, near)
+                          needed, offsets, radius, clearance, ox, oy, resolution, near,
+                          needed)
         if gap >= needed:
             return cmd_v, cmd_w
+    best, best_gap = candidates[0], -np.inf
+    for cmd_v, cmd_w in candidates:  # none is safe: the one keeping most room, played out
+        gap = _motion_gap(x, y, theta, v, w, cmd_v, cmd_w, accel, turn_accel, dt, period,
+                          needed, offsets, radius, clearance, ox, oy, resolution, near,
+                          -np.inf)
         if gap >= best_gap:
             best, best_gap = (cmd_v, cmd_w), gap
     return best
@@ -201,16 +206,19 @@ def _stopping_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: f
                   hits: np.ndarray) -> float:  # pragma: no cover - jit
     near = _near(hits, x, y, v, w, cmd_v, cmd_w, accel, turn_accel, period, offsets, radius)
     return _motion_gap(x, y, theta, v, w, cmd_v, cmd_w, accel, turn_accel, dt, period, enough,
-                       offsets, radius, clearance, ox, oy, resolution, near)
+                       offsets, radius, clearance, ox, oy, resolution, near, -np.inf)
 
 
 @njit(cache=True)
 def _motion_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: float,
                 cmd_w: float, accel: float, turn_accel: float, dt: float, period: float,
                 enough: float, offsets: np.ndarray, radius: float, clearance: np.ndarray,
-                ox: float, oy: float, resolution: float,
-                near: np.ndarray) -> float:  # pragma: no cover - jit
-    """:func:`stopping_gap` over returns already sifted to those near (``near``)."""
+                ox: float, oy: float, resolution: float, near: np.ndarray,
+                fails: float) -> float:  # pragma: no cover - jit
+    """:func:`stopping_gap` over returns already sifted to those near (``near``).
+
+    Ends early, with a gap below ``fails``, at the first pose found closer than that.
+    """
     farthest = np.abs(offsets).max()
     # the motion, integrated as the simulated drive does (its arc_step, body_gap). A body whose
     # gap was g can move g before touching, give or take a grid cell: poses are looked at only
@@ -228,6 +236,8 @@ def _motion_gap(x: float, y: float, theta: float, v: float, w: float, cmd_v: flo
         if looked - moved - slack < enough:
             looked = body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
             lowest, moved = min(lowest, looked), 0.0
+            if lowest < fails:
+                break
         if t >= period and v == 0.0 and w == 0.0:
             break
     return lowest

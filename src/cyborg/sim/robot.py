@@ -211,9 +211,12 @@ def body_gap(x: float, y: float, theta: float, offsets: np.ndarray, radius: floa
         r = int((cy - oy) // resolution)
         c = int((cx - ox) // resolution)
         gap = clearance[r, c] if 0 <= r < rows and 0 <= c < columns else 0.0
+        squared = gap * gap  # the nearest point's distance, squared (a root only for it)
         for i in range(points.shape[0]):
-            d = math.hypot(points[i, 0] - cx, points[i, 1] - cy)
-            if d < gap:
-                gap = d
+            dx, dy = points[i, 0] - cx, points[i, 1] - cy
+            if dx * dx + dy * dy < squared:
+                squared = dx * dx + dy * dy
+        if squared < gap * gap:
+            gap = math.sqrt(squared)
         lowest = min(lowest, gap - radius)
     return lowest
