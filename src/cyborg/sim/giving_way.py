@@ -40,7 +40,7 @@ STANDOFF = 3.0
 """Seconds two robots stand, each on the other's way, before one makes way."""
 STILL = 0.05
 """Metres per second under which a robot counts as standing."""
-AHEAD = 4.0
+AHEAD = 6.0
 """Metres of a robot's way ahead within which another robot stands in its way."""
 ON_THE_WAY = 1.0
 """Metres from a way within which a robot's centre is on it (two bodies side by side)."""
