@@ -4,37 +4,19 @@ limit disables the tree and cancels the goal. On an isolated bus with a scripted
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from cyborg.bt import Action, NodeRegistry, Status, default_registry
+from cyborg.bt import NodeRegistry, default_registry
 from cyborg.bus import Context, Node
 from cyborg.runner.tree_runner import TreeRunnerNode
+from tests.bt.test_busy_tick import SPINNING, Spin
 from tests.robot.fake_robot import FakeRobot
 from tests.runner.test_services import Caller
 from tests.runner.test_services import bus as bus  # the fixture
 from tests.running_system import wait_until, write_tree
-
-SPINNING = threading.Event()
-
-
-class Spin(Action):
-    """RUNNING on its first tick, then a Python loop that never ends."""
-
-    def on_start(self) -> None:
-        self.ticked = 0
-
-    def tick(self) -> Status:
-        self.ticked += 1
-        if self.ticked == 1:
-            return Status.RUNNING
-        SPINNING.set()
-        turns = 0
-        while True:
-            turns += 1
 
 
 def spin_registry() -> NodeRegistry:
