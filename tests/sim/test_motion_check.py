@@ -9,6 +9,7 @@ import random
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cyborg.nav.arnl_map import parse_map, read_map
@@ -167,3 +168,21 @@ def test_hours_of_goals_replaced_at_random_moments_touch_no_wall(shared: Path) -
 
 def finished(sim: Simulator) -> bool:
     return sim.navigator.state.finished and sim.docking.state is DockState.UNDOCKED
+
+
+def test_a_robot_wedged_beside_another_creeps_out_rather_than_stand_for_good() -> None:
+    # another robot's outline (kept 10 cm clear of) runs along the robot's left side, 7 cm
+    # inside that margin; the follower wants forwards and round to the right, which swings the
+    # back a hair closer: it used to brake, every period, for good
+    sim = Simulator(parse_map(room_map([])), start=Pose2D(2.5, 1.5, 0.0))
+    grid = sim.planner.grid
+    beside = [(1.0 + 0.02 * k, 1.5 + 0.17) for k in range(80)]  # a line of points, y = 1.67
+    around = Surroundings(sim.planner.wall_clearance, (grid.origin_x, grid.origin_y),
+                          grid.resolution, np.array(beside))
+    wanted = (0.6, -1.5)
+    assert stopping_gap(2.5, 1.5, 0.0, moving(0.0), wanted, 0.1, sim.planner.footprint,
+                        around) < stopping_gap(2.5, 1.5, 0.0, moving(0.0), (0.0, 0.0), 0.1,
+                                               sim.planner.footprint, around) < MARGIN
+    command = safest_command(2.5, 1.5, 0.0, moving(0.0), wanted, 0.1, sim.planner.footprint,
+                             around)
+    assert abs(command[0]) == CREEP and command[1] == 0.0, command

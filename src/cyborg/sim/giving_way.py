@@ -18,7 +18,8 @@ at a door:
   has no such place, the first one makes way instead; when neither has, they wait as before.
 * **On again.** The one that made way plans to its goal again (:meth:`~cyborg.sim.
   navigator.Navigator.resume`) once the other has no goal any more, or no longer lies on its
-  way, or after :data:`GIVE_UP` seconds.
+  way, or after :data:`GIVE_UP` seconds; or when it has stood :data:`STUCK` seconds short of
+  its place (it cannot get there): then the next time the two meet, the other makes way.
 """
 
 from __future__ import annotations
@@ -50,6 +51,9 @@ SEARCH = 6.0
 """Metres around a robot within which it looks for a place to make way."""
 GIVE_UP = 40.0
 """Seconds after which a robot making way goes on whatever the other does."""
+STUCK = 5.0
+"""Seconds a robot making way may stand short of its place before it goes on, and the other
+makes way the next time they meet."""
 
 
 @dataclass
@@ -69,6 +73,7 @@ class WayGiving:
         """The robots making way now, by index."""
         self.settled = 0
         """Standoffs settled so far."""
+        self._first_gives: set[frozenset[int]] = set()  # pairs whose first makes way next
 
     def step(self, robots: Sequence[Simulator], now: float) -> None:
         """Look at the robots as they are at ``now``: settle standoffs, send those aside on."""
@@ -103,8 +108,14 @@ class WayGiving:
 
     def _settle(self, robots: Sequence[Simulator], ways: list[np.ndarray], first: int,
                 second: int, now: float) -> None:
-        """The lower in priority (``second``) makes way; if it cannot, ``first`` does."""
-        for giver, taker in ((second, first), (first, second)):
+        """The lower in priority (``second``) makes way; if it cannot, ``first`` does.
+
+        The other way round when the second, making way for the first, got stuck last time.
+        """
+        order = ((second, first), (first, second))
+        if frozenset((first, second)) in self._first_gives:
+            order = order[::-1]
+        for giver, taker in order:
             sim, other = robots[giver], robots[taker]
             blockers = outline_points(other.outline, 0.1)
             place = place_aside(sim.planner, sim.pose, ways[taker], other.pose)
@@ -128,9 +139,14 @@ class WayGiving:
                 continue
             passed = (not self._active(other)
                       or not on_way(ways[yielding.to], sim.pose, math.inf))
-            if passed or now - yielding.since >= GIVE_UP:
+            still = self._still_since[giver]
+            stuck = (sim.navigator.stepping_aside and still is not None
+                     and now - max(still, yielding.since) >= STUCK)
+            if passed or stuck or now - yielding.since >= GIVE_UP:
                 del self.yielding[giver]
                 self._still_since[giver] = None  # a standoff again only after STANDOFF s
+                if stuck:  # it cannot get out of the way: the other makes way next time
+                    self._first_gives ^= {frozenset((giver, yielding.to))}
                 sim.navigator.resume(now, sim.pose)
 
 

@@ -94,8 +94,10 @@ def safest_command(x: float, y: float, theta: float, motion: Motion,
     that already, does not get closer); otherwise the first safe of: the same speed with half
     and a quarter of the turn; no speed with half and a quarter of the turn; when the wanted
     turn was on the spot, :data:`CREEP` forwards, then backwards, on a tight arc (full, then
-    half turn), then straight; and at last braking straight. When none is safe, the one
-    keeping most room (the gentler one of equals).
+    half turn), then straight; otherwise, where the robot is closer than :data:`MARGIN`
+    already (wedged beside another robot), :data:`CREEP` straight forwards, then backwards;
+    and at last braking straight. When none is safe, the one keeping most room (the gentler
+    one of equals).
 
     Checked again every control period, this keeps the robot clear by induction: once a safe
     command was chosen, braking after it was found clear, so next period braking still is.
@@ -173,15 +175,16 @@ def _safest(x: float, y: float, theta: float, v: float, w: float, speed: float, 
     """
     candidates = [(speed, turn), (speed, turn / 2), (speed, turn / 4), (0.0, turn / 2),
                   (0.0, turn / 4)]
+    near = _near(hits, x, y, v, w, max(abs(speed), creep), abs(turn), accel, turn_accel,
+                 period, offsets, radius)
+    standing = body_gap(x, y, theta, offsets, radius, clearance, ox, oy, resolution, near)
+    needed = min(margin, standing)
     if speed == 0.0 and turn != 0.0:  # a turn on the spot: or on a tight arc, or straight
         candidates += [(creep, turn), (creep, turn / 2), (-creep, turn), (-creep, turn / 2),
                        (creep, 0.0), (-creep, 0.0)]
+    elif standing < margin:  # closer than it should be already: or out straight
+        candidates += [(creep, 0.0), (-creep, 0.0)]
     candidates.append((0.0, 0.0))
-    fastest = max(abs(speed), creep if speed == 0.0 and turn != 0.0 else 0.0)
-    near = _near(hits, x, y, v, w, fastest, abs(turn), accel, turn_accel, period, offsets,
-                 radius)
-    needed = min(margin, body_gap(x, y, theta, offsets, radius, clearance, ox, oy,
-                                  resolution, near))
     for cmd_v, cmd_w in candidates:  # each played only until it fails
         gap = _motion_gap(x, y, theta, v, w, cmd_v, cmd_w, accel, turn_accel, dt, period,
                           needed, offsets, radius, clearance, ox, oy, resolution, near,

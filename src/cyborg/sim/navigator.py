@@ -155,6 +155,11 @@ class Navigator:
         return way.sample(along, along + reach, step)
 
     @property
+    def stepping_aside(self) -> bool:
+        """Whether the robot makes way and has not reached the place aside yet."""
+        return self.making_way and self._aside is not None
+
+    @property
     def waiting(self) -> bool:
         """Whether the robot stands waiting for a way past temporary obstacles."""
         return self.state is PathState.WAITING_FOR_PATH
