@@ -7,7 +7,7 @@ from pathlib import Path as FilePath
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cyborg.bus import MessageTypes
@@ -42,6 +42,23 @@ def test_path_length_progress_and_messages() -> None:
         Pose2D(1, 2, 0.5))
     with pytest.raises(ValueError, match="at least one point"):
         Path([])
+
+
+@settings(deadline=None)
+@given(st.lists(st.tuples(st.floats(-5, 5), st.floats(-5, 5)), min_size=1, max_size=6),
+       st.floats(-1, 12), st.floats(-1, 12), st.sampled_from([0.05, 0.1, 0.2, 1.0]))
+def test_points_sampled_along_a_path_lie_where_interpolation_puts_them(
+        points: list[tuple[float, float]], start: float, stop: float, step: float) -> None:
+    """Every ``step`` m from ``start`` up to ``stop`` (clamped to the path), repeated corners
+    and all: as ``np.interp`` over the path's lengths gives them."""
+    path = Path(points)
+    distances = np.arange(max(start, 0.0), min(stop, path.length), step)
+    lengths = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path.points, axis=0).T))])
+    expected = np.column_stack([np.interp(distances, lengths, path.points[:, 0]),
+                                np.interp(distances, lengths, path.points[:, 1])])
+    found = path.sample(start, stop, step)
+    assert found.shape == expected.shape
+    np.testing.assert_allclose(found, expected, atol=1e-9)
 
 
 def test_path_through_the_door_keeps_clear_of_walls() -> None:

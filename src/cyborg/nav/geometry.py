@@ -193,9 +193,10 @@ class Path:
 
     def sample(self, start: float, stop: float, step: float) -> np.ndarray:
         """Points every ``step`` metres along the path from ``start`` up to ``stop``."""
-        distances = np.arange(max(start, 0.0), min(stop, self.length), step)
-        return np.column_stack([np.interp(distances, self._cumulative, self.points[:, 0]),
-                                np.interp(distances, self._cumulative, self.points[:, 1])])
+        first, last = max(start, 0.0), min(stop, self.length)
+        if not last > first or not step > 0:
+            return np.zeros((0, 2))
+        return _sample(self.points, self._cumulative, first, last, step)
 
     def heading_at(self, distance: float) -> float:
         """Direction of travel at ``distance`` along the path (0 for a single point)."""
@@ -253,6 +254,31 @@ class Path:
 
     def __repr__(self) -> str:
         return f"Path({len(self.points)} points, {self.length:.2f} m)"
+
+
+@njit(cache=True)
+def _sample(points: np.ndarray, cumulative: np.ndarray, first: float, last: float,
+            step: float) -> np.ndarray:  # pragma: no cover - jit
+    """The points at ``first``, ``first + step``, ... short of ``last`` metres along the path.
+
+    As ``np.interp`` at ``np.arange(first, last, step)``: between the points around each
+    distance, the first point where a segment has no length.
+    """
+    count = math.ceil((last - first) / step)
+    out = np.empty((count, 2))
+    segment = 0
+    for k in range(count):
+        distance = first + k * step
+        while segment < cumulative.shape[0] - 2 and cumulative[segment + 1] <= distance:
+            segment += 1
+        span = cumulative[segment + 1] - cumulative[segment] if cumulative.shape[0] > 1 else 0.0
+        share = (distance - cumulative[segment]) / span if span > 0 else 0.0
+        share = min(max(share, 0.0), 1.0)
+        out[k, 0] = points[segment, 0] + share * (points[min(segment + 1, points.shape[0] - 1), 0]
+                                                  - points[segment, 0])
+        out[k, 1] = points[segment, 1] + share * (points[min(segment + 1, points.shape[0] - 1), 1]
+                                                  - points[segment, 1])
+    return out
 
 
 @njit(cache=True)

@@ -298,20 +298,27 @@ def placed(points: np.ndarray, poses: list[Pose2D]) -> np.ndarray:
 
 
 def braking_outline(polygon: np.ndarray, pose: Pose2D, speed: float, deceleration: float,
-                    spacing: float = OUTLINE_SPACING) -> np.ndarray:
+                    spacing: float = OUTLINE_SPACING,
+                    sides: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Points along the outline of the ground a robot covers until it stands, braking straight.
 
     ``polygon`` (K x 2, convex, counter-clockwise, in the robot's frame) swept along the
     braking way of :func:`braking_poses` (at ``speed`` m/s, braking at ``deceleration``
     m/s²) is the polygon with its front half moved forward by the way (its back half, when
     backing): the outline of every pose along the way at once, at most ``spacing`` apart.
+    ``sides``: the polygon's :func:`halves`, when known.
     """
     way = speed * abs(speed) / (2.0 * deceleration)
     swept = np.array(polygon, dtype=np.float64)
     if way != 0.0:
-        ahead = _leading(swept, way > 0.0)
-        swept[ahead, 0] += way
+        front, back = sides if sides is not None else halves(swept)
+        swept[front if way > 0.0 else back, 0] += way
     return _along(outline_at(swept, pose), spacing)
+
+
+def halves(polygon: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The corners of a convex counter-clockwise ``polygon`` on its front, and on its back."""
+    return _leading(polygon, True), _leading(polygon, False)
 
 
 def _leading(polygon: np.ndarray, forward: bool) -> np.ndarray:

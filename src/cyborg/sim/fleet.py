@@ -41,7 +41,7 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner
 from cyborg.sim.battery import Battery
-from cyborg.sim.bodies import KEEP_CLEAR, braking_outline, grown
+from cyborg.sim.bodies import KEEP_CLEAR, braking_outline, grown, halves
 from cyborg.sim.giving_way import WayGiving
 from cyborg.sim.loop import PacedLoop, SimulationLock
 from cyborg.sim.people import NOBODY, Crowd, Meeting
@@ -130,6 +130,7 @@ class Fleet:
         self._steps = 0
         self._grown = [grown(sim.base.footprint.polygon(), KEEP_CLEAR)
                        for sim in self.simulators]  # around each body, in its own frame
+        self._sides = [halves(body) for body in self._grown]
         # centres further apart than this cannot touch within a physics step
         self._contact = 2 * max(sim.base.span for sim in self.simulators) + CONTACT_MARGIN
         self.crowd: Crowd | None = None  # people walking among the robots
@@ -164,6 +165,7 @@ class Fleet:
         sensing = self._steps % self.steps_per_sensor == 0  # as each simulator counts
         self._steps += 1
         outlines = [sim.outline for sim in self.simulators]  # set_pose may have moved one
+        poses = [sim.pose for sim in self.simulators]
         if sensing and self.crowd is not None:
             sim = self.simulators[0]
             walked = self.crowd.due(self.steps_per_sensor / sim.settings.physics_rate)
@@ -177,7 +179,7 @@ class Fleet:
         for index, sim in enumerate(self.simulators):
             met = self._met[index] if self._met else None
             if sensing:
-                near = self._near(index)
+                near = self._near(index, poses)
                 placed_points = [self._braking_points(other) for other in near]
                 if met:
                     placed_points.append(met.points)
@@ -188,10 +190,10 @@ class Fleet:
                 sim.meet(bodies + met.bodies if met else bodies, points,
                          met.circles if met else None)
             # the drive needs only the bodies it may touch this step (the same while they stand)
-            touching = tuple(outlines[other] for other in self._near(index, self._contact))
+            touching = tuple(outlines[other] for other in self._near(index, poses, self._contact))
             sim.base.others = touching + self._touching[index] if met else touching
             sim.step()
-            outlines[index] = sim.outline  # where the next robot meets it
+            outlines[index], poses[index] = sim.outline, sim.pose  # where the next meets it
         if sensing and len(self.simulators) > 1:
             self.way_giving.step(self.simulators, self.time)
 
@@ -202,19 +204,22 @@ class Fleet:
         known = self._braking[index]
         if known is None or known[0] is not key[0] or known[1] != key[1]:
             points = braking_outline(self._grown[index], base.pose, base.speed,
-                                     base.limits.acceleration)
+                                     base.limits.acceleration, sides=self._sides[index])
             known = self._braking[index] = (base.pose, base.speed, points)
         return known[2]
 
-    def _near(self, index: int, reach: float | None = None) -> list[int]:
-        """The indices of the robots on ``index``'s map within ``reach`` m (its laser's)."""
-        sim = self.simulators[index]
-        pose = sim.pose
+    def _near(self, index: int, poses: list[Pose2D], reach: float | None = None) -> list[int]:
+        """The indices of the robots on ``index``'s map within ``reach`` m (its laser's).
+
+        ``poses`` are where the robots stand now.
+        """
+        sims = self.simulators
+        sim, here = sims[index], poses[index]
         reach = sim.laser.spec.range_max + 1.0 if reach is None else reach
-        x, y, world = pose.x, pose.y, sim.map
-        return [number for number, other in enumerate(self.simulators)
-                if other is not sim and other.map is world
-                and math.hypot(other.pose.x - x, other.pose.y - y) <= reach]
+        x, y, world = here.x, here.y, sim.map
+        return [number for number, there in enumerate(poses)
+                if number != index and sims[number].map is world
+                and math.hypot(there.x - x, there.y - y) <= reach]
 
 
 def within(bodies: tuple[np.ndarray, ...], pose: Pose2D,
