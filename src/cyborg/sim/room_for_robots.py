@@ -88,7 +88,8 @@ class RoomForRobots:
                     if self._aside(person, way, float(gaps[nearest]), nearest, step):
                         continue
                     person.refuge = self._refuge(person, standing, robots)
-                if person.refuge is not None and self._to_refuge(person, step):
+                if person.refuge is not None:
+                    self._to_refuge(person, step)
                     continue
                 if self._step_off(person, way, nearest, step):
                     continue
@@ -117,8 +118,11 @@ class RoomForRobots:
                        self._way_room + grid.resolution, bodies)
         return walk if len(walk) else None
 
-    def _to_refuge(self, person: Person, step: float) -> bool:
-        """One step of ``person`` along their walk to a refuge; whether one was free."""
+    def _to_refuge(self, person: Person, step: float) -> None:
+        """One step of ``person`` along their walk to a refuge (cell to cell: clear of walls).
+
+        Round its corners: a straight line to where the step ends could cut one.
+        """
         assert person.refuge is not None
         here = np.array((person.x, person.y))
         walk = person.refuge
@@ -128,13 +132,8 @@ class RoomForRobots:
                 here = here + (walk[0] - here) * (step / gap)
                 break
             here, walk, step = walk[0], walk[1:], step - gap
-        to = (float(here[0]), float(here[1]))
-        if not self._free(person, to, squeeze=True):
-            person.refuge = None
-            return False
         person.refuge = walk if len(walk) else None
-        self._move(person, to)
-        return True
+        self._move(person, (float(here[0]), float(here[1])))
 
     def _aside(self, person: Person, way: np.ndarray, gap: float, nearest: int,
                step: float) -> bool:
@@ -223,8 +222,10 @@ class RoomForRobots:
         Whoever is closer than :data:`ROOM` to a robot's body steps away from it; whoever is
         ahead of it (within :data:`AHEAD` along its heading, and its body and ours and
         :data:`ROOM` aside) steps aside, else further ahead, and with no room for either ends
-        a pause; but someone walking on their way passes in front of a robot standing still.
-        A robot stuck beside a person would be stuck for good.
+        a pause; but someone walking on their way passes in front of a robot standing still,
+        and someone walking to a refuge off a waiting robot's way (:meth:`_refuge`, never
+        nearer to a robot than where they set off) keeps to that. A robot stuck beside a
+        person would be stuck for good.
         """
         s = self.settings
         for index, (cx, cy, radius) in enumerate(robots):
@@ -236,8 +237,9 @@ class RoomForRobots:
             driving = index >= len(speeds) or abs(speeds[index]) >= STILL
             heading = headings[index] if index < len(headings) else math.nan
             for person in (self.people[k] for k in np.flatnonzero(touched)):
-                self._room_for(person, cx, cy, need, None if math.isnan(heading) else heading,
-                               driving, dt)
+                if person.refuge is None:
+                    self._room_for(person, cx, cy, need,
+                                   None if math.isnan(heading) else heading, driving, dt)
 
     def _room_for(self, person: Person, cx: float, cy: float, need: float,
                   heading: float | None, driving: bool, dt: float) -> None:
