@@ -7,13 +7,22 @@ import itertools
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cyborg.nav.arnl_map import parse_map
 from cyborg.nav.geometry import Pose2D
 from cyborg.nav.planner import Planner, SearchMemory
-from cyborg.nav.search import SQRT2, START_SIDE, astar, search, still_closed
+from cyborg.nav.search import (
+    NO_LANDMARKS,
+    SQRT2,
+    START_SIDE,
+    astar,
+    landmark_costs,
+    search,
+    still_closed,
+)
 from tests.small_maps import corridor_map
 
 
@@ -86,6 +95,30 @@ def test_the_search_finds_a_cheapest_path_or_none_as_an_exhaustive_one_does(
             path_cost(cost, cells), expected, rel_tol=1e-9)
 
 
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**31), st.floats(0.0, 0.4), st.integers(1, 4), st.floats(0.0, 2.0))
+def test_landmarks_on_a_grid_no_dearer_find_as_cheap_a_path_or_none(
+        seed: int, walls: float, count: int, dearer: float) -> None:
+    """Landmarks learnt on a grid, a search on that grid made dearer and walled here and there
+    (as a plan's obstacles make it): a path exactly when one exists, as cheap as the
+    cheapest."""
+    random = np.random.default_rng(seed)
+    rows, columns = 14, 18
+    cheap = 1.0 + random.random((rows, columns)) * 3.0
+    cheap[random.random((rows, columns)) < walls] = np.inf
+    landmarks = landmark_costs(cheap, int(random.integers(rows * columns)), count)
+    cost = cheap + dearer * random.random((rows, columns))
+    cost[random.random((rows, columns)) < 0.1] = np.inf
+    start, goal = int(random.integers(rows * columns)), int(random.integers(rows * columns))
+    cells = search(cost, start, goal, landmarks)[0]
+    expected = cheapest(cost, start, goal)
+    if math.isinf(expected) or not math.isfinite(cost.flat[goal]):
+        assert len(cells) == 0 or start == goal
+    else:
+        assert cells[0] == start and cells[-1] == goal
+        assert path_cost(cost, cells) == pytest.approx(expected, rel=1e-4, abs=0.05)
+
+
 def test_a_goal_on_a_closed_side_has_no_path_and_an_open_one_has() -> None:
     """A wall across a corridor with the goal in a room behind it: no path, both ways round;
     a gap in it: the path goes through the gap."""
@@ -112,7 +145,7 @@ def test_a_side_still_closed_after_changes_has_no_path_indeed(seed: int, opened:
     cost[random.random((rows, columns)) < 0.2] = np.inf
     start, goal = 5 * columns + 2, 6 * columns + 12
     cost.flat[start] = cost.flat[goal] = 1.0
-    cells, region, side = search(cost, start, goal)
+    cells, region, side = search(cost, start, goal, NO_LANDMARKS)
     if len(cells):
         return
     passable, region = np.isfinite(cost), region.reshape(cost.shape).copy()

@@ -17,6 +17,7 @@ from cyborg.sim.bodies import (
     braking_outline,
     braking_poses,
     cast_onto,
+    cast_onto_fan,
     grown,
     nearest_gap,
     outline_at,
@@ -56,6 +57,25 @@ def test_beams_stop_at_the_first_edge_of_an_outline() -> None:
     cast_onto(square(3.0, 0.0), 0.0, 0.0, angles, ranges)
     # straight at it: its near side, 2.5 m; sideways and backwards: missed; a wall nearer stays
     assert ranges.tolist() == pytest.approx([2.5, 10.0, 10.0, 0.5])
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**31))
+def test_a_laser_fan_is_cut_short_by_an_outline_as_beam_by_beam(seed: int) -> None:
+    """A convex outline anywhere, the scanner anywhere (inside it too), a fan of 541 beams
+    over 270° starting at any angle: the beams tried within the outline's width end where
+    every beam tried alone ends."""
+    random = np.random.default_rng(seed)
+    middle, radius = random.uniform(-3, 3, 2), random.uniform(0.1, 0.8)
+    turns = np.sort(random.uniform(0, 2 * np.pi, 12))
+    outline = np.column_stack([middle[0] + radius * np.cos(turns),
+                               middle[1] + radius * np.sin(turns)])
+    x, y = random.uniform(-3, 3, 2)
+    first, increment = random.uniform(-4, 4), math.radians(270) / 540
+    alone, fan = np.full(541, 30.0), np.full(541, 30.0)
+    cast_onto(outline, x, y, first + np.arange(541) * increment, alone)
+    cast_onto_fan(outline, x, y, first, increment, fan)
+    assert np.array_equal(alone, fan)
 
 
 def test_points_along_an_outline_are_close_together_and_on_it() -> None:

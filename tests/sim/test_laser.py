@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from cyborg.sim.follower import front_ranges
-from cyborg.sim.laser import Laser, LaserSpec, cast_rays, cast_rays_far
+from cyborg.sim.laser import Laser, LaserSpec, cast_rays, cast_rays_far, room_grid
 
 
 def test_the_points_of_a_scan_are_where_its_valid_beams_end() -> None:
@@ -50,7 +50,8 @@ def test_leaping_through_open_space_finds_the_walls_the_cell_walk_finds(
     angles[:4] = (0.0, math.pi / 2, math.pi, -math.pi / 2)  # along the grid's lines
     walked, leapt = np.empty(361), np.empty(361)
     cast_rays(occupied, 0.0, 1.0, 0.05, x, y, angles, reach, walked)
-    cast_rays_far(occupied, clearance, 0.0, 1.0, 0.05, x, y, angles, reach, leapt)
+    cast_rays_far(room_grid(occupied, clearance, 0.05), 0.0, 1.0, 0.05, x, y, angles, reach,
+                  leapt)
     assert np.array_equal(np.isfinite(walked), np.isfinite(leapt))
     assert leapt[np.isfinite(leapt)] == pytest.approx(walked[np.isfinite(walked)], abs=1e-9)
 

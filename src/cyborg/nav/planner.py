@@ -35,7 +35,15 @@ from cyborg.nav.arnl_map import ArnlMap
 from cyborg.nav.footprint import PIONEER_LX, Footprint
 from cyborg.nav.geometry import Path, Pose2D
 from cyborg.nav.grid import MapGrid
-from cyborg.nav.search import START_SIDE, astar, search, shortcut, still_closed
+from cyborg.nav.search import (
+    NO_LANDMARKS,
+    START_SIDE,
+    astar,
+    landmark_costs,
+    search,
+    shortcut,
+    still_closed,
+)
 from cyborg.nav.temporary_obstacles import clear_of
 
 
@@ -50,6 +58,16 @@ class PlannerSettings:
     smoothing_margin: float = 0.55  # clearance shortcuts keep where the grid path had it
     escape_radius: float = 0.8  # around start and goal, cells clearing the inscribed radius
 
+
+LANDMARKS = 8
+"""Landmarks a planner that plans often estimates its searches by (see :func:`~cyborg.nav.
+search.search`)."""
+LANDMARK_BYTES = 32 * 1024 * 1024
+"""The most memory a planner's landmarks take: fewer landmarks on a larger map, none past
+about a million cells."""
+LANDMARKS_AFTER = 20
+"""Plans after which a planner learns its landmarks (a second or so on the campus): one that
+plans a few times only never pays for them."""
 
 # Result codes (Nav2's ComputePathToPose error names).
 NONE, START_OCCUPIED, GOAL_OCCUPIED, NO_VALID_PATH, OUTSIDE_MAP = (
@@ -131,6 +149,9 @@ class Planner:
         self.wall_clearance = self.grid.clearance(self.grid.walls)
         self.clearance = self.grid.clearance()
         self.cost = self._cost(self.clearance)
+        self._opened = 2.0 + 2.0 * self.settings.cost_weight  # a tight cell near start, goal
+        self._landmarks = NO_LANDMARKS
+        self._plans = 0
 
     # ------------------------------------------------------------------ checks
     def check(self, pose: Pose2D, role: str = "goal") -> tuple[str, str] | None:
@@ -189,6 +210,9 @@ class Planner:
             return PlanResult(None, GOAL_OCCUPIED,
                               f"goal ({goal.x:.2f}, {goal.y:.2f}) is taken by an obstacle "
                               f"seen there", time.perf_counter() - began)
+        self._plans += 1
+        if self._plans == LANDMARKS_AFTER:
+            self._landmarks = self._learn_landmarks(start_cell[0] * columns + start_cell[1])
         cells = self._search(cost, start_cell[0] * columns + start_cell[1],
                              goal_cell[0] * columns + goal_cell[1], memory)
         if len(cells) == 0:
@@ -200,8 +224,23 @@ class Planner:
         return PlanResult(Path(path, goal.theta if use_heading else None),
                           planning_time=time.perf_counter() - began)
 
-    @staticmethod
-    def _search(cost: np.ndarray, start: int, goal: int,
+    def _learn_landmarks(self, start: int) -> np.ndarray:
+        """Costs to far-apart landmarks on the grid as cheap as any plan's can be.
+
+        Every cell that clears the inscribed radius (the tightest a plan opens, near its start
+        and goal) at the smaller of its cost and an opened cell's; the landmarks in the part
+        of the map the flat cell ``start`` lies in (where the plans are); (cells, K) float32,
+        K :data:`LANDMARKS`, fewer where they would take more than :data:`LANDMARK_BYTES`.
+        """
+        cells = self.cost.size
+        count = min(LANDMARKS, LANDMARK_BYTES // (4 * cells))
+        if count <= 0:
+            return NO_LANDMARKS
+        opened = np.where(self.clearance >= self.tight, self._opened, np.inf)
+        cheapest = np.ascontiguousarray(np.fmin(self.cost, opened))
+        return landmark_costs(cheapest, start, count)
+
+    def _search(self, cost: np.ndarray, start: int, goal: int,
                 memory: SearchMemory | None) -> np.ndarray:
         """:func:`~cyborg.nav.search.astar`'s cells, answered from ``memory`` where it can."""
         known = memory.closed if memory is not None else None
@@ -213,7 +252,7 @@ class Planner:
                 and still_closed(cost, known.passable, known.region,
                                  goal if known.from_start else start)):
             return np.zeros(0, np.int64)
-        cells, region, side = search(cost, start, goal)
+        cells, region, side = search(cost, start, goal, self._landmarks)
         if memory is not None:
             memory.searches += 1
             memory.closed = None if len(cells) or not side else ClosedSide(
@@ -315,7 +354,7 @@ class Planner:
         near = np.hypot(rr - row, cc - column) * grid.resolution <= radius
         window = clearance[r0:r1, c0:c1]
         tight = near & (window >= self.tight) & ~np.isfinite(cost[r0:r1, c0:c1])
-        cost[r0:r1, c0:c1][tight] = 2.0 + 2.0 * self.settings.cost_weight
+        cost[r0:r1, c0:c1][tight] = self._opened
 
     def _smooth(self, cells: np.ndarray, clearance: np.ndarray, start: Pose2D,
                 goal: Pose2D) -> np.ndarray:

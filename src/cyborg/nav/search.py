@@ -16,8 +16,12 @@ import numpy as np
 from numba import njit
 
 SQRT2 = math.sqrt(2.0)
-FLOOD_EVERY = 4
+FLOOD_EVERY = 1
 """Steps of the search per step of :func:`astar`'s flood from the goal."""
+LANDMARK_SLACK = 0.01
+"""Cost taken off a landmark's estimate: more than float32 rounds costs of 100,000 cells."""
+NO_LANDMARKS = np.zeros((0, 0), np.float32)
+"""No landmarks: the octile estimate alone."""
 
 
 NOWHERE = 0
@@ -34,13 +38,20 @@ def astar(cost: np.ndarray, start: int, goal: int) -> np.ndarray:  # pragma: no 
 
     See :func:`search`.
     """
-    return search(cost, start, goal)[0]
+    return search(cost, start, goal, NO_LANDMARKS)[0]
 
 
 @njit(cache=True)
-def search(cost: np.ndarray, start: int,
-           goal: int) -> tuple[np.ndarray, np.ndarray, int]:  # pragma: no cover - jit
+def search(cost: np.ndarray, start: int, goal: int,
+           landmarks: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:  # pragma: no cover
     """:func:`astar`'s path, and without one the side it found closed: ``(path, region, side)``.
+
+    ``landmarks`` ((cells, K), float32; K may be 0) are the costs from every cell to K
+    landmarks on a grid no dearer than ``cost`` anywhere (:func:`landmark_costs`): the
+    estimate of what is left from a cell is then at least the largest difference of its cost
+    and the goal's to a landmark (less :data:`LANDMARK_SLACK` for rounding), which is never
+    more than it costs (the triangle inequality), so the path is as cheap; and a cell that
+    reaches no landmark the goal reaches, or the other way round, cannot reach the goal.
 
     ``region`` (flat booleans) is the start's side (``side`` :data:`START_SIDE`: every cell
     the start reaches) or the goal's (:data:`GOAL_SIDE`: every cell that reaches the goal),
@@ -67,6 +78,7 @@ def search(cost: np.ndarray, start: int,
     keys[0], cells[0], count = 0.0, start, 1
     if goal != start and not np.isfinite(flat[goal]):
         return np.zeros(0, np.int64), closed, NOWHERE  # it enters finite cells only
+    to_goal = landmarks[goal] if landmarks.shape[1] else np.zeros(0, np.float32)
     back = np.zeros(size, np.bool_)  # the flood from the goal
     queue = np.empty(size, np.int64)
     queue[0], back[goal], head, tail = goal, True, 0, 1
@@ -111,7 +123,10 @@ def search(cost: np.ndarray, start: int,
                 g[neighbour] = candidate
                 parent[neighbour] = current
                 ar, ac = abs(nr - goal_r), abs(nc - goal_c)
-                h = (SQRT2 - 1.0) * min(ar, ac) + max(ar, ac)
+                h = _beyond(landmarks, to_goal, neighbour,
+                            (SQRT2 - 1.0) * min(ar, ac) + max(ar, ac))
+                if h == np.inf:
+                    continue  # on no side of the goal's landmarks: it cannot reach the goal
                 if count == capacity:
                     capacity *= 2
                     keys, cells = _grown(keys, count, capacity), _grown(cells, count, capacity)
@@ -196,6 +211,89 @@ def _beside(flat: np.ndarray, inside: np.ndarray, rows: int, columns: int,
             continue
         return True
     return False
+
+
+@njit(cache=True)
+def _beyond(landmarks: np.ndarray, to_goal: np.ndarray, cell: int,
+            octile: float) -> float:  # pragma: no cover - jit
+    """The estimate of what is left from ``cell``: the octile distance, or the landmarks'."""
+    estimate = octile
+    for k in range(to_goal.shape[0]):
+        here, there = landmarks[cell, k], to_goal[k]
+        if np.isfinite(here) and np.isfinite(there):
+            estimate = max(estimate, abs(here - there) - LANDMARK_SLACK)
+        elif np.isfinite(here) != np.isfinite(there):
+            return np.inf
+    return estimate
+
+
+@njit(cache=True)
+def landmark_costs(cost: np.ndarray, first: int, count: int) -> np.ndarray:  # pragma: no cover
+    """The costs from every cell to ``count`` landmarks of ``cost``: (cells, count), float32.
+
+    The landmarks lie far apart: the first is the cell dearest to reach from ``first``, each
+    next the one whose cheapest way to the landmarks so far is dearest (inf: not reached).
+    Steps as :func:`astar` takes them.
+    """
+    size = cost.size
+    found = np.full((size, count), np.inf, np.float32)
+    nearest = _costs_from(cost, first)
+    for k in range(count):
+        landmark, dearest = -1, -1.0
+        for cell in range(size):
+            if np.isfinite(nearest[cell]) and nearest[cell] > dearest:
+                landmark, dearest = cell, nearest[cell]
+        if landmark < 0:
+            break
+        costs = _costs_from(cost, landmark)
+        for cell in range(size):
+            found[cell, k] = costs[cell]
+            nearest[cell] = costs[cell] if k == 0 else min(nearest[cell], costs[cell])
+    return found
+
+
+@njit(cache=True)
+def _costs_from(cost: np.ndarray, source: int) -> np.ndarray:  # pragma: no cover - jit
+    """The cheapest cost from ``source`` to every cell (Dijkstra, :func:`astar`'s steps)."""
+    rows, columns = cost.shape
+    flat = cost.ravel()
+    g = np.full(rows * columns, np.inf)
+    g[source] = 0.0
+    capacity = 1024
+    keys = np.empty(capacity)
+    cells = np.empty(capacity, np.int64)
+    keys[0], cells[0], count = 0.0, source, 1
+    while count > 0:
+        current, far = cells[0], keys[0]
+        count -= 1
+        if count > 0:
+            _sift_down(keys, cells, count)
+        if far > g[current]:
+            continue
+        r, c = current // columns, current % columns
+        here = flat[current]
+        for k in range(8):
+            dr, dc = _DR[k], _DC[k]
+            nr, nc = r + dr, c + dc
+            if nr < 0 or nr >= rows or nc < 0 or nc >= columns:
+                continue
+            neighbour = nr * columns + nc
+            there = flat[neighbour]
+            if not np.isfinite(there):
+                continue
+            diagonal = dr != 0 and dc != 0
+            if diagonal and (not np.isfinite(flat[r * columns + nc])
+                             or not np.isfinite(flat[nr * columns + c])):
+                continue
+            candidate = far + (SQRT2 if diagonal else 1.0) * 0.5 * (here + there)
+            if candidate < g[neighbour]:
+                g[neighbour] = candidate
+                if count == capacity:
+                    capacity *= 2
+                    keys, cells = _grown(keys, count, capacity), _grown(cells, count, capacity)
+                _sift_up(keys, cells, count, candidate, neighbour)
+                count += 1
+    return g
 
 
 _DR = (-1, -1, -1, 0, 0, 1, 1, 1)

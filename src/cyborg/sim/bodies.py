@@ -182,6 +182,51 @@ def cast_onto(outline: np.ndarray, x: float, y: float, angles: np.ndarray,
 
 
 @njit(cache=True)
+def cast_onto_fan(outline: np.ndarray, x: float, y: float, first: float, increment: float,
+                  ranges: np.ndarray) -> None:  # pragma: no cover - jit
+    """:func:`cast_onto` for a laser's evenly spaced beams, ``first + k increment``.
+
+    Only the beams within the angular width of the circle around the outline are tried.
+    """
+    count = outline.shape[0]
+    cx, cy, radius = 0.0, 0.0, 0.0
+    for k in range(count):
+        cx += outline[k, 0] / count
+        cy += outline[k, 1] / count
+    for k in range(count):
+        radius = max(radius, math.hypot(outline[k, 0] - cx, outline[k, 1] - cy))
+    distance = math.hypot(cx - x, cy - y)
+    beams = ranges.shape[0]
+    if distance <= radius + 1e-9:  # the scanner within its circle: every beam
+        low, high = 0, beams - 1
+    else:
+        half = math.asin(min(1.0, (radius + 1e-9) / distance))
+        offset = (math.atan2(cy - y, cx - x) - half - first) % (2.0 * math.pi)
+        low = math.ceil(offset / increment)
+        high = math.floor((offset + 2.0 * half) / increment)
+    turn = round(2.0 * math.pi / increment)
+    for step in range(low, high + 1):
+        beam = step
+        if beam >= beams:
+            beam -= turn  # a scan wider than it is long
+            if beam < 0 or beam >= beams:
+                continue
+        angle = first + beam * increment
+        dx, dy = math.cos(angle), math.sin(angle)
+        for i in range(count):
+            j = (i + 1) % count
+            ax, ay = outline[i, 0] - x, outline[i, 1] - y
+            ex, ey = outline[j, 0] - outline[i, 0], outline[j, 1] - outline[i, 1]
+            denominator = dx * ey - dy * ex
+            if denominator == 0.0:
+                continue
+            along = (ax * ey - ay * ex) / denominator
+            share = (ax * dy - ay * dx) / denominator
+            if along >= 0.0 and 0.0 <= share <= 1.0 and along < ranges[beam]:
+                ranges[beam] = along
+
+
+@njit(cache=True)
 def cast_onto_circles(circles: np.ndarray, x: float, y: float, first: float, increment: float,
                       ranges: np.ndarray) -> None:  # pragma: no cover - jit
     """Shorten ``ranges`` whose beams hit one of ``circles`` ((N, 3): x, y, radius; m).

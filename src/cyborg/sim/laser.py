@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
-from cyborg.sim.bodies import cast_onto, cast_onto_circles
+from cyborg.sim.bodies import cast_onto_circles, cast_onto_fan
 
 SQRT2 = math.sqrt(2.0)
 LEAP = 2.0
@@ -93,20 +93,33 @@ def cast_rays(occupied: np.ndarray, origin_x: float, origin_y: float, resolution
         out[beam] = hit * resolution if hit <= limit else np.inf
 
 
-@njit(cache=True)
-def cast_rays_far(occupied: np.ndarray, clearance: np.ndarray, origin_x: float, origin_y: float,
-                  resolution: float, x: float, y: float, angles: np.ndarray, range_max: float,
-                  out: np.ndarray) -> None:  # pragma: no cover - jit
-    """:func:`cast_rays`, leaping through open space: the same ranges, fewer cells visited.
+def room_grid(occupied: np.ndarray, clearance: np.ndarray, resolution: float) -> np.ndarray:
+    """The grid :func:`cast_rays_far` walks: 0 where occupied, else 1 + the cells clear.
 
     ``clearance`` holds, per cell, the metres from its centre to the nearest occupied cell's
     centre (as :meth:`~cyborg.nav.grid.MapGrid.clearance` gives them). No point of a cell lies
-    closer than that less ``sqrt(2)`` cells to any point of an occupied cell, so a beam in a cell
-    with more than :data:`LEAP` cells to spare goes on that far from where it leaves the cell
-    at once, and walks the grid cell by cell again from there: where it enters its first
-    occupied cell is the same (to rounding).
+    closer than that less ``sqrt(2)`` cells to any point of an occupied cell: the whole cells
+    of that (less a hair, at most 254) are clear from anywhere in it. One byte a cell.
     """
-    rows, columns = occupied.shape
+    clear = np.floor(np.maximum(np.asarray(clearance, np.float64) / resolution - SQRT2 - 0.01,
+                                0.0))
+    room = (1 + np.minimum(clear, 254)).astype(np.uint8)
+    room[np.asarray(occupied, bool)] = 0
+    return room
+
+
+@njit(cache=True)
+def cast_rays_far(room: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                  x: float, y: float, angles: np.ndarray, range_max: float,
+                  out: np.ndarray) -> None:  # pragma: no cover - jit
+    """:func:`cast_rays`, leaping through open space: the same ranges, fewer cells visited.
+
+    ``room`` is :func:`room_grid`'s: a beam in a cell with more than :data:`LEAP` cells clear
+    goes on that far from where it leaves the cell at once, and walks the grid cell by cell
+    again from there; where it enters its first occupied cell (0) is the same (to rounding).
+    One byte a cell is all it reads.
+    """
+    rows, columns = room.shape
     gx = (x - origin_x) / resolution
     gy = (y - origin_y) / resolution
     limit = range_max / resolution
@@ -132,12 +145,12 @@ def cast_rays_far(occupied: np.ndarray, clearance: np.ndarray, origin_x: float, 
                 restart = False
             if r < 0 or r >= rows or c < 0 or c >= columns:
                 break
-            if occupied[r, c]:
+            here = room[r, c]
+            if here == 0:
                 hit = travelled
                 break
-            free = clearance[r, c] / resolution - SQRT2  # cells clear from all of this one
-            if free > LEAP:  # on from where the beam leaves the cell, a hair short of that
-                travelled = min(next_c, next_r) + free - 0.01
+            if here - 1 > LEAP:  # on from where the beam leaves the cell
+                travelled = min(next_c, next_r) + (here - 1)
                 restart = True
             elif next_c < next_r:
                 travelled = next_c
@@ -168,6 +181,38 @@ def beam_points(ranges: np.ndarray, relative: np.ndarray, x: float, y: float, th
     return points[:count].copy()
 
 
+_NO_CORNERS = np.zeros((0, 2))
+_NO_STARTS = np.zeros(1, np.int64)
+_NO_CIRCLES = np.zeros((0, 3))
+
+
+@njit(cache=True)
+def _seen(walls: np.ndarray, corners: np.ndarray, starts: np.ndarray, circles: np.ndarray,
+          x: float, y: float, theta: float, angle_min: float,
+          increment: float, noise: np.ndarray, range_min: float,
+          range_max: float) -> np.ndarray:  # pragma: no cover - jit
+    """The ranges a scan reads: the walls' ``walls``, shortened by bodies and circles, noisy.
+
+    The bodies are outlines one after another in ``corners`` (body ``k`` from ``starts[k]``
+    to ``starts[k + 1]``), the circles (N, 3) rows of x, y, radius; beam ``k`` leaves
+    ``(x, y)`` at ``theta + angle_min + k increment``. What is beyond ``range_max`` reads
+    ``range_max + 1``; the rest gets ``noise`` and is kept within ``range_min`` and
+    ``range_max + 1``.
+    """
+    ranges = walls.copy()
+    for body in range(starts.shape[0] - 1):
+        cast_onto_fan(corners[starts[body]:starts[body + 1]], x, y, angle_min + theta,
+                      increment, ranges)
+    if circles.shape[0]:
+        cast_onto_circles(circles, x, y, angle_min + theta, increment, ranges)
+    for beam in range(ranges.shape[0]):
+        if ranges[beam] <= range_max:
+            ranges[beam] = min(max(ranges[beam] + noise[beam], range_min), range_max + 1.0)
+        else:
+            ranges[beam] = range_max + 1.0
+    return ranges
+
+
 class Laser:
     """Scans an occupancy grid from a robot pose.
 
@@ -187,7 +232,7 @@ class Laser:
         if clearance is None:
             clearance = (ndimage.distance_transform_edt(~self.occupied) * resolution
                          if self.occupied.any() else np.full(self.occupied.shape, 1e6))
-        self._clearance = np.asarray(clearance, dtype=np.float32)
+        self._room = room_grid(self.occupied, clearance, resolution)
         self._walls = np.empty(self.spec.beams)  # the walls' ranges from `_walls_from`
         self._walls_from: tuple[float, float, float] | None = None
         self._random = np.random.default_rng(seed)
@@ -203,26 +248,21 @@ class Laser:
         spec = self.spec
         sx = x + spec.mount_x * math.cos(theta)
         sy = y + spec.mount_x * math.sin(theta)
-        angles = self._relative + theta
         if self._walls_from != (sx, sy, theta):  # a scanner that stands sees the same walls
-            cast_rays_far(self.occupied, self._clearance, self.origin[0], self.origin[1],
-                          self.resolution, sx, sy, angles, spec.range_max, self._walls)
+            cast_rays_far(self._room, self.origin[0], self.origin[1], self.resolution, sx, sy,
+                          self._relative + theta, spec.range_max, self._walls)
             self._walls_from = (sx, sy, theta)
-        self._ranges[:] = self._walls
-        if bodies or (circles is not None and len(circles)):
-            for outline in bodies:
-                cast_onto(np.ascontiguousarray(outline, dtype=np.float64), sx, sy, angles,
-                          self._ranges)
-            if circles is not None and len(circles):
-                cast_onto_circles(np.ascontiguousarray(circles, dtype=np.float64), sx, sy,
-                                  spec.angle_min + theta, spec.angle_increment, self._ranges)
-            self._ranges[self._ranges > spec.range_max] = np.inf
-        ranges = self._ranges.copy()
-        if spec.noise > 0:
-            ranges += self._random.normal(0.0, spec.noise, ranges.shape)
-        ranges[~np.isfinite(self._ranges)] = spec.range_max + 1.0
-        np.clip(ranges, spec.range_min, spec.range_max + 1.0, out=ranges)
-        return ranges
+        corners, starts = _NO_CORNERS, _NO_STARTS
+        if bodies:
+            corners = np.ascontiguousarray(np.concatenate(bodies), dtype=np.float64)
+            starts = np.cumsum([0, *(len(outline) for outline in bodies)])
+        if circles is None or not len(circles):
+            circles = _NO_CIRCLES
+        noise = (self._random.normal(0.0, spec.noise, spec.beams) if spec.noise > 0
+                 else np.zeros(spec.beams))
+        return _seen(self._walls, corners, starts, np.ascontiguousarray(circles, np.float64),
+                     sx, sy, theta, spec.angle_min, spec.angle_increment, noise,
+                     spec.range_min, spec.range_max)
 
     def points(self, x: float, y: float, theta: float, ranges: np.ndarray) -> np.ndarray:
         """The (N, 2) map points where beams with a valid range hit."""
