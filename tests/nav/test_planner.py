@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import threading
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -137,3 +138,29 @@ def test_a_way_near_by_is_found_in_a_small_box_and_a_closed_door_has_none() -> N
     # the room's far side is only reached round a wall the small box leaves out
     assert not planner.passable_near(Pose2D(4.0, 1.0), Pose2D(6.0, 1.0), nothing, margin=0.5)
     assert planner.passable_near(Pose2D(4.0, 1.0), Pose2D(6.0, 1.0), nothing, margin=2.5)
+
+
+def test_plans_with_obstacles_leave_later_plans_and_other_threads_as_they_were() -> None:
+    """Plans past people and sensed points, from two threads at once, then plans without: each
+    as a planner of its own gives it."""
+    arnl_map = parse_map(room_map([]))
+    shared, fresh = Planner(arnl_map), Planner(arnl_map)
+    people = np.array([(5.0, 3.3, 0.3)])
+    points = np.array([(5.0, 2.5), (5.0, 2.55)])
+    asks = [dict(discs=people), dict(obstacles=points), {}, dict(discs=people, obstacles=points)]
+    expected = [fresh.plan(LEFT, RIGHT, **ask) for ask in asks]  # type: ignore[arg-type]
+    found: dict[int, list[float]] = {0: [], 1: []}
+
+    def plan_all(index: int) -> None:
+        for _ in range(20):
+            for ask in asks:
+                found[index].append(shared.plan(LEFT, RIGHT, **ask).length)  # type: ignore[arg-type]
+
+    threads = [threading.Thread(target=plan_all, args=(index,)) for index in (0, 1)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for lengths in found.values():
+        assert lengths == [result.length for result in expected] * 20
+    assert shared.plan(LEFT, RIGHT).length == fresh.plan(LEFT, RIGHT).length

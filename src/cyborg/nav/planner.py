@@ -25,6 +25,7 @@ because someone stands there).
 from __future__ import annotations
 
 import math
+import threading
 import time
 from dataclasses import dataclass
 
@@ -68,6 +69,9 @@ about a million cells."""
 LANDMARKS_AFTER = 20
 """Plans after which a planner learns its landmarks (a second or so on the campus): one that
 plans a few times only never pays for them."""
+
+Window = tuple[slice, slice]
+"""Rows and columns of a grid: what a plan changed in the scratch grids."""
 
 # Result codes (Nav2's ComputePathToPose error names).
 NONE, START_OCCUPIED, GOAL_OCCUPIED, NO_VALID_PATH, OUTSIDE_MAP = (
@@ -150,6 +154,8 @@ class Planner:
         self.clearance = self.grid.clearance()
         self.cost = self._cost(self.clearance)
         self._opened = 2.0 + 2.0 * self.settings.cost_weight  # a tight cell near start, goal
+        self._lock = threading.Lock()  # plans from any thread share the scratch grids
+        self._grids: tuple[np.ndarray, np.ndarray] | None = None
         self._landmarks = NO_LANDMARKS
         self._plans = 0
 
@@ -191,17 +197,25 @@ class Planner:
         problem = self.check(start, "start") or self.check(goal, "goal")
         if problem is not None:
             return PlanResult(None, *problem, planning_time=time.perf_counter() - began)
-        if obstacles is not None and len(obstacles):
-            clearance, cost = self._around(obstacles)
-        else:
-            clearance, cost = self.clearance, self.cost.copy()
-        for pose in (start, goal):
-            self._open_escape(cost, clearance, pose)
-        if discs is not None and len(discs):
-            clearance = clearance.copy()
-            self.stamp_discs(clearance, cost, clear_of(
-                discs, [(start.x, start.y), (goal.x, goal.y)], self.lethal,
-                2 * self.grid.resolution))
+        with self._lock:
+            clearance, cost = self._scratch()
+            changed: list[Window] = []
+            try:
+                if obstacles is not None and len(obstacles):
+                    self._around(obstacles, clearance, cost, changed)
+                for pose in (start, goal):
+                    self._open_escape(cost, clearance, pose, changed)
+                if discs is not None and len(discs):
+                    self.stamp_discs(clearance, cost, clear_of(
+                        discs, [(start.x, start.y), (goal.x, goal.y)], self.lethal,
+                        2 * self.grid.resolution), changed)
+                return self._plan_on(clearance, cost, start, goal, use_heading, memory, began)
+            finally:
+                self._restore(changed)
+
+    def _plan_on(self, clearance: np.ndarray, cost: np.ndarray, start: Pose2D, goal: Pose2D,
+                 use_heading: bool, memory: SearchMemory | None, began: float) -> PlanResult:
+        """:meth:`plan` on the grids made for it (obstacles, escapes and discs in them)."""
         _rows, columns = self.grid.shape
         start_cell = self.grid.cell(start.x, start.y)
         goal_cell = self.grid.cell(goal.x, goal.y)
@@ -271,27 +285,35 @@ class Planner:
         if self.check(start, "start") or self.check(goal, "goal"):
             return False
         grid = self.grid
-        _clearance, cost = self._around(obstacles) if len(obstacles) else (self.clearance,
-                                                                           self.cost.copy())
-        for pose in (start, goal):
-            self._open_escape(cost, self.clearance, pose)
         corners = np.array([(start.x, start.y), (goal.x, goal.y)])
         rows, columns = grid.cells_of(np.vstack([corners.min(axis=0) - margin,
                                                  corners.max(axis=0) + margin]))
-        window = np.ascontiguousarray(cost[rows[0]:rows[1] + 1, columns[0]:columns[1] + 1])
+        with self._lock:
+            clearance, cost = self._scratch()
+            changed: list[Window] = []
+            try:
+                if len(obstacles):
+                    self._around(obstacles, clearance, cost, changed)
+                for pose in (start, goal):
+                    self._open_escape(cost, self.clearance, pose, changed)
+                window = np.ascontiguousarray(cost[rows[0]:rows[1] + 1,
+                                                   columns[0]:columns[1] + 1])
+            finally:
+                self._restore(changed)
         width = window.shape[1]
         (r0, c0), (r1, c1) = grid.cell(start.x, start.y), grid.cell(goal.x, goal.y)
         return len(astar(window, (r0 - rows[0]) * width + c0 - columns[0],
                          (r1 - rows[0]) * width + c1 - columns[0])) > 0
 
-    def stamp_discs(self, clearance: np.ndarray, cost: np.ndarray, discs: np.ndarray) -> None:
+    def stamp_discs(self, clearance: np.ndarray, cost: np.ndarray, discs: np.ndarray,
+                    changed: list[Window] | None = None) -> None:
         """Stamp (N, 3) discs into a clearance grid and its cost grid, in place.
 
         Around each disc a window of cells gets the smaller of its clearance and its distance
         to the disc's edge, and the larger of its cost and the cost that distance gives (the
         planner's lethal radius and ramp, as near a wall); cells outside the windows are left
         as they are, so a few discs cost a few thousand cells, whatever the map's size. A
-        disc with a number that is not finite is left out.
+        disc with a number that is not finite is left out. The windows join ``changed``.
         """
         grid, resolution = self.grid, self.grid.resolution
         rows, columns = grid.shape
@@ -305,6 +327,8 @@ class Planner:
             c0, c1 = max(column - span, 0), min(column + span + 1, columns)
             if r0 >= r1 or c0 >= c1:
                 continue
+            if changed is not None:
+                changed.append((slice(r0, r1), slice(c0, c1)))
             centres_y = grid.origin_y + (np.arange(r0, r1) + 0.5) * resolution
             centres_x = grid.origin_x + (np.arange(c0, c1) + 0.5) * resolution
             gap = np.hypot(centres_x[None, :] - x, centres_y[:, None] - y) - keep_out
@@ -313,13 +337,32 @@ class Planner:
             np.maximum(cost[r0:r1, c0:c1], self._cost(np.maximum(gap, 0.0)),
                        out=cost[r0:r1, c0:c1])
 
-    def _around(self, obstacles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Clearance and cost with ``obstacles`` (N x 2 points, m) added to the map's.
+    def _scratch(self) -> tuple[np.ndarray, np.ndarray]:
+        """Grids a plan changes in windows and :meth:`_restore` sets back: the map's, copied.
+
+        Copied once, not at every plan (two copies of the map's grids made a plan on the
+        campus a millisecond dearer); the caller holds the lock.
+        """
+        if self._grids is None:
+            self._grids = (self.clearance.copy(), self.cost.copy())
+        return self._grids
+
+    def _restore(self, changed: list[Window]) -> None:
+        """Set the windows ``changed`` of the scratch grids back to the map's own."""
+        if self._grids is not None:
+            clearance, cost = self._grids
+            for window in changed:
+                clearance[window] = self.clearance[window]
+                cost[window] = self.cost[window]
+
+    def _around(self, obstacles: np.ndarray, clearance: np.ndarray, cost: np.ndarray,
+                changed: list[Window]) -> None:
+        """Add ``obstacles`` (N x 2 points, m) to the map's ``clearance`` and ``cost``, in place.
 
         The clearance to walls and points is the smaller of the two clearances, and points
         change the cost only within the lethal distance and the cost ramp of them: so only the
         window around the points is computed again (a distance transform of that window),
-        not the whole map.
+        not the whole map; it joins ``changed``.
         """
         grid = self.grid
         reach = math.ceil(max(self.lethal + self.settings.cost_ramp,
@@ -331,11 +374,10 @@ class Planner:
         free = np.ones((r1 - r0, c1 - c0), bool)
         free[rows - r0, columns - c0] = False
         near = (ndimage.distance_transform_edt(free) * grid.resolution).astype(np.float32)
-        clearance, cost = self.clearance.copy(), self.cost.copy()
+        changed.append((slice(r0, r1), slice(c0, c1)))
         window = np.minimum(clearance[r0:r1, c0:c1], near)
         clearance[r0:r1, c0:c1] = window
         cost[r0:r1, c0:c1] = self._cost(window)
-        return clearance, cost
 
     def _cost(self, clearance: np.ndarray) -> np.ndarray:
         ramp = self.settings.cost_ramp
@@ -343,13 +385,19 @@ class Planner:
         cost = 1.0 + self.settings.cost_weight * closeness ** 2
         return np.where(clearance >= self.lethal, cost, np.inf)
 
-    def _open_escape(self, cost: np.ndarray, clearance: np.ndarray, pose: Pose2D) -> None:
-        """Let the search use tight cells (clearing only the inscribed radius) near ``pose``."""
+    def _open_escape(self, cost: np.ndarray, clearance: np.ndarray, pose: Pose2D,
+                     changed: list[Window] | None = None) -> None:
+        """Let the search use tight cells (clearing only the inscribed radius) near ``pose``.
+
+        The window joins ``changed``, if given.
+        """
         grid, radius = self.grid, self.settings.escape_radius
         reach = math.ceil(radius / grid.resolution)
         row, column = grid.cell(pose.x, pose.y)
         r0, r1 = max(row - reach, 0), min(row + reach + 1, grid.shape[0])
         c0, c1 = max(column - reach, 0), min(column + reach + 1, grid.shape[1])
+        if changed is not None:
+            changed.append((slice(r0, r1), slice(c0, c1)))
         rr, cc = np.mgrid[r0:r1, c0:c1]
         near = np.hypot(rr - row, cc - column) * grid.resolution <= radius
         window = clearance[r0:r1, c0:c1]

@@ -164,13 +164,14 @@ class Fleet:
         """
         sensing = self._steps % self.steps_per_sensor == 0  # as each simulator counts
         self._steps += 1
-        outlines = [sim.outline for sim in self.simulators]  # set_pose may have moved one
-        poses = [sim.pose for sim in self.simulators]
+        sims = self.simulators
+        poses = [sim.pose for sim in sims]  # set_pose may have moved one
         if sensing and self.crowd is not None:
             sim = self.simulators[0]
             walked = self.crowd.due(self.steps_per_sensor / sim.settings.physics_rate)
             if walked:
-                self.crowd.advance(walked, outlines, [sim.pose.theta for sim in self.simulators],
+                self.crowd.advance(walked, [sim.outline for sim in sims],
+                                   [sim.pose.theta for sim in self.simulators],
                                    [sim.base.speed for sim in self.simulators],
                                    [sim.way_ahead() for sim in self.simulators])
             self._met = [self.crowd.meeting(sim.pose.x, sim.pose.y, sim.laser.spec.range_max)
@@ -186,14 +187,15 @@ class Fleet:
                     self._touching[index] = within(met.bodies, sim.pose,
                                                    sim.base.span + CONTACT_MARGIN)
                 points = np.concatenate(placed_points) if placed_points else np.zeros((0, 2))
-                bodies = tuple(outlines[other] for other in near)
+                bodies = tuple(sims[other].outline for other in near)
                 sim.meet(bodies + met.bodies if met else bodies, points,
                          met.circles if met else None)
             # the drive needs only the bodies it may touch this step (the same while they stand)
-            touching = tuple(outlines[other] for other in self._near(index, poses, self._contact))
+            touching = tuple(sims[other].outline  # kept while it stands, made when asked
+                             for other in self._near(index, poses, self._contact))
             sim.base.others = touching + self._touching[index] if met else touching
             sim.step()
-            outlines[index], poses[index] = sim.outline, sim.pose  # where the next meets it
+            poses[index] = sim.pose  # where the next robot meets it
         if sensing and len(self.simulators) > 1:
             self.way_giving.step(self.simulators, self.time)
 

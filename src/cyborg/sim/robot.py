@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from cyborg.nav.footprint import PIONEER_LX, Footprint
-from cyborg.nav.geometry import Pose2D, normalize_angle
+from cyborg.nav.geometry import Pose2D
 from cyborg.sim.bodies import gap_below, outline_at, outline_bounds
 
 
@@ -83,22 +83,22 @@ class RobotBase:
 
     def command(self, speed: float, turn_rate: float, dt: float) -> None:
         """Move for ``dt`` seconds towards the commanded speed and turn rate."""
-        limits = self.limits
-        speed = max(-limits.max_speed, min(limits.max_speed, speed))
-        turn_rate = max(-limits.max_turn_rate, min(limits.max_turn_rate, turn_rate))
-        self.speed += _limited(speed - self.speed, limits.acceleration * dt)
-        self.turn_rate += _limited(turn_rate - self.turn_rate, limits.turn_acceleration * dt)
-        pose = self.pose
+        limits, pose = self.limits, self.pose
+        offsets, radius = self._circles
+        self.speed, self.turn_rate, x, y, theta, gap = _drive(
+            pose.x, pose.y, pose.theta, self.speed, self.turn_rate, speed, turn_rate,
+            limits.max_speed, limits.max_turn_rate, limits.acceleration,
+            limits.turn_acceleration, dt, offsets, radius, self.clearance, self.origin[0],
+            self.origin[1], self.resolution)
         if self.speed == 0.0 and self.turn_rate == 0.0:  # standing: the body stays put
-            heading = normalize_angle(pose.theta)
-            if heading != pose.theta:
-                self.pose = Pose2D(pose.x, pose.y, heading)
+            if theta != pose.theta:
+                self.pose = Pose2D(pose.x, pose.y, theta)
             if self.bumpers.any and self.body_clearance(self.pose) >= self.resolution:
                 self.bumpers = Bumpers()
             return
-        x, y, theta = arc_step(pose.x, pose.y, pose.theta, self.speed, self.turn_rate, dt)
-        moved = Pose2D(x, y, normalize_angle(theta))
-        gap = self.body_clearance(moved)
+        moved = Pose2D(x, y, theta)
+        if self.others:
+            gap = min(gap, self.robots_gap(moved, below=gap))
         if gap < 0.0 and gap <= self.body_clearance(pose):  # overlaps, and not backing off
             if not self.bumpers.any:
                 self.bumps += 1
@@ -170,8 +170,30 @@ class RobotBase:
         return self.body_clearance(pose) < 0.0
 
 
-def _limited(change: float, most: float) -> float:
-    return max(-most, min(most, change))
+@njit(cache=True)
+def _drive(x: float, y: float, theta: float, speed: float, turn_rate: float,
+           wanted_speed: float, wanted_turn: float, max_speed: float, max_turn: float,
+           acceleration: float, turn_acceleration: float, dt: float, offsets: np.ndarray,
+           radius: float, clearance: np.ndarray, ox: float, oy: float,
+           resolution: float) -> tuple[float, float, float, float, float,
+                                       float]:  # pragma: no cover - jit
+    """One step of the drive: the new speed and turn rate, the pose, its gap to the walls.
+
+    The command is clamped to the limits and followed within the accelerations; standing
+    (both zero) the pose is the same (its heading normalised) and the gap not measured (nan).
+    """
+    wanted_speed = max(-max_speed, min(max_speed, wanted_speed))
+    wanted_turn = max(-max_turn, min(max_turn, wanted_turn))
+    most = acceleration * dt
+    speed += max(-most, min(most, wanted_speed - speed))
+    most = turn_acceleration * dt
+    turn_rate += max(-most, min(most, wanted_turn - turn_rate))
+    if speed == 0.0 and turn_rate == 0.0:
+        return speed, turn_rate, x, y, (theta + math.pi) % (2 * math.pi) - math.pi, np.nan
+    x, y, theta = arc_step(x, y, theta, speed, turn_rate, dt)
+    theta = (theta + math.pi) % (2 * math.pi) - math.pi
+    return speed, turn_rate, x, y, theta, body_gap(x, y, theta, offsets, radius, clearance,
+                                                    ox, oy, resolution, _NO_POINTS)
 
 
 _NO_POINTS = np.zeros((0, 2))
